@@ -1,0 +1,485 @@
+// Chip: the command decoder, register access rules, STATUS latching, pins and
+// faults around the motion engine. Rules are from spec/dspin-reference.md §1-§6.
+#include "core/chip.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace l6470emu {
+namespace {
+
+constexpr std::uint32_t kPosMask = 0x3FFFFF;
+constexpr std::uint32_t kConfigOcSd = 1u << 7;
+constexpr std::uint32_t kConfigSwMode = 1u << 4;
+constexpr std::uint32_t kStepModeSyncEn = 1u << 7;
+
+std::string hex(std::uint32_t v, int digits) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%0*X", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+Chip::Chip(const Variant& variant, Quirks quirks) : variant_(&variant), quirks_(quirks) {
+  reset_logic();
+  come_out_of_reset();
+}
+
+// ---------------------------------------------------------------- reset
+
+void Chip::reset_logic() {
+  for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
+  const std::int32_t keep_nothing = 0;
+  motion_ = MotionState{};
+  motion_.abs_pos = keep_nothing;
+  refresh_profile();
+  collecting_ = false;
+  args_seen_ = 0;
+  arg_ = 0;
+  response_ = 0;
+  response_left_ = 0;
+  ocd_shutdown_ = false;
+  switch_act_ = false;
+  // Any logic reset forces the UVLO flag active; ongoing faults show at once.
+  latched_ = condition_;
+  latched_.uvlo = true;
+}
+
+void Chip::come_out_of_reset() {
+  // A switch already closed when the logic starts is seen as a turn-on event
+  // (community report: the chip leaves HiZ at power-up when SW is low).
+  if (!sw_level_) switch_turn_on_event();
+}
+
+// ---------------------------------------------------------------- SPI
+
+std::uint8_t Chip::on_byte(std::uint8_t byte) {
+  if (!stby_level_) return 0x00;
+  if (collecting_) {
+    arg_ = (arg_ << 8) | byte;
+    if (++args_seen_ == pending_.arg_bytes) {
+      collecting_ = false;
+      execute(pending_, arg_);
+    }
+  } else {
+    Opcode op = classify_opcode(byte);
+    bool valid = true;
+    if (op.command == Command::SetParam || op.command == Command::GetParam) {
+      const RegisterInfo* r = variant_->at_address(op.param);
+      if (r == nullptr) {
+        wrong_command(byte, "no register at this address");
+        valid = false;
+      } else if (op.command == Command::SetParam) {
+        if (r->access == Access::R && quirks_.read_only_write == ReadOnlyWrite::wrong_cmd_at_command_byte) {
+          wrong_command(byte, "SetParam of a read-only register");
+          valid = false;
+        } else {
+          op.arg_bytes = r->spi_bytes();
+        }
+      }
+    } else if (op.command == Command::Unknown || op.command == Command::Reserved) {
+      wrong_command(byte, op.command == Command::Reserved ? "reserved opcode" : "no such command");
+      valid = false;
+    }
+    if (valid) {
+      if (op.arg_bytes > 0) {
+        pending_ = op;
+        collecting_ = true;
+        args_seen_ = 0;
+        arg_ = 0;
+      } else {
+        execute(op, 0);
+      }
+    }
+  }
+  if (response_left_ == 0) return 0x00;
+  --response_left_;
+  return static_cast<std::uint8_t>(response_ >> (8 * response_left_));
+}
+
+void Chip::load_response(std::uint32_t value, std::uint8_t bytes) {
+  response_ = value;
+  response_left_ = bytes;
+}
+
+void Chip::execute(const Opcode& op, std::uint32_t arg) {
+  switch (op.command) {
+    case Command::NOP:
+      return;
+    case Command::SetParam:
+      exec_set_param(op.param, arg);
+      return;
+    case Command::GetParam: {
+      const RegisterInfo& r = *variant_->at_address(op.param);
+      load_response(register_value(r), r.spi_bytes());
+      return;
+    }
+    case Command::GetStatus:
+      load_response(status(), 2);
+      clear_status_on_get_status();
+      return;
+    case Command::Run:
+      if (motion_command_allowed("Run")) start_run(motion_, profile_, op.dir, std::uint64_t{arg & 0xFFFFF} << 12);
+      return;
+    case Command::GoUntil:
+      if (motion_command_allowed("GoUntil")) {
+        switch_act_ = op.act;
+        start_go_until(motion_, profile_, op.dir, std::uint64_t{arg & 0xFFFFF} << 12);
+      }
+      return;
+    case Command::ReleaseSW:
+      if (motion_command_allowed("ReleaseSW")) {
+        switch_act_ = op.act;
+        start_release_sw(motion_, profile_, op.dir);
+      }
+      return;
+    case Command::StepClock:
+      if (!motor_stopped(motion_)) return not_performable("StepClock while the motor runs");
+      if (motion_command_allowed("StepClock")) start_step_clock(motion_, op.dir);
+      return;
+    case Command::Move: {
+      if (!motor_stopped(motion_)) return not_performable("Move while the motor runs");
+      if (!motion_command_allowed("Move")) return;
+      const std::uint32_t n = arg & kPosMask;
+      const std::int32_t target =
+          sign_extend(static_cast<std::uint32_t>(motion_.abs_pos) + (op.dir ? n : 0u - n), 22);
+      start_positioning(motion_, profile_, op.dir, target, n);
+      return;
+    }
+    case Command::GoTo:
+    case Command::GoTo_DIR:
+    case Command::GoHome:
+    case Command::GoMark: {
+      if (motion_busy(motion_, profile_)) return not_performable("positioning command while BUSY");
+      if (!motion_command_allowed(to_string(op.command).data())) return;
+      std::int32_t target = 0;
+      if (op.command == Command::GoTo || op.command == Command::GoTo_DIR)
+        target = sign_extend(arg & kPosMask, 22);
+      else if (op.command == Command::GoMark)
+        target = sign_extend(regs_[variant_->find(Reg::MARK)->address], 22);
+      if (op.command == Command::GoTo_DIR) {
+        start_positioning(motion_, profile_, op.dir, target, directed_distance(motion_.abs_pos, target, op.dir));
+      } else {
+        const Path path = shortest_path(motion_.abs_pos, target);
+        start_positioning(motion_, profile_, path.forward, target, path.steps);
+      }
+      return;
+    }
+    case Command::ResetPos:
+      motion_.abs_pos = 0;
+      return;
+    case Command::ResetDevice:
+      reset_logic();
+      come_out_of_reset();
+      return;
+    case Command::SoftStop:
+    case Command::SoftHiZ:
+      if (hiz_forced()) {
+        hard_hiz(motion_);
+        return;
+      }
+      soft_stop(motion_, profile_, op.command == Command::SoftHiZ);
+      return;
+    case Command::HardStop:
+      if (hiz_forced()) {
+        hard_hiz(motion_);
+        return;
+      }
+      hard_stop(motion_);
+      return;
+    case Command::HardHiZ:
+      hard_hiz(motion_);
+      return;
+    case Command::Reserved:
+    case Command::Unknown:
+      return;  // rejected at the opcode byte
+  }
+}
+
+bool Chip::motion_command_allowed(const char* what) {
+  if (!hiz_forced()) return true;
+  std::string why = what;
+  why += " while a fault holds the bridges in HiZ";
+  not_performable(why.c_str());
+  return false;
+}
+
+void Chip::exec_set_param(std::uint8_t address, std::uint32_t value) {
+  const RegisterInfo& r = *variant_->at_address(address);
+  if (r.access == Access::R) {
+    std::string why = "SetParam of read-only ";
+    why += r.name;
+    return not_performable(why.c_str());
+  }
+  value &= r.mask();
+  Access access = r.access;
+  if ((r.flags & kWriteConflict) != 0 && quirks_.bemf_write == BemfWriteCondition::when_stopped) access = Access::WS;
+  if (access == Access::WS && !motor_stopped(motion_)) {
+    std::string why = "SetParam of ";
+    why += r.name;
+    why += " while the motor runs";
+    return not_performable(why.c_str());
+  }
+  if (access == Access::WH && !motion_.hiz) {
+    std::string why = "SetParam of ";
+    why += r.name;
+    why += " while the bridges are enabled";
+    return not_performable(why.c_str());
+  }
+  write_register(r, value);
+}
+
+void Chip::write_register(const RegisterInfo& r, std::uint32_t value) {
+  switch (r.id) {
+    case Reg::ABS_POS:
+      motion_.abs_pos = sign_extend(value, 22);
+      return;
+    case Reg::EL_POS:
+      motion_.el_pos = static_cast<std::uint16_t>(value);
+      return;
+    case Reg::STEP_MODE:
+      if ((value & 7u) != (regs_[r.address] & 7u)) {
+        // A new step mode restarts the electrical position at the first microstep.
+        motion_.el_pos &= 0x180;
+        motion_.frac = 0;
+      }
+      break;
+    default:
+      break;
+  }
+  regs_[r.address] = value;
+  refresh_profile();
+}
+
+void Chip::refresh_profile() {
+  auto reg = [&](Reg id) -> std::uint32_t {
+    const RegisterInfo* r = variant_->find(id);
+    return r ? regs_[r->address] : 0;
+  };
+  const std::uint32_t acc = reg(Reg::ACC);
+  profile_.acc = acc;
+  profile_.dec = reg(Reg::DEC);
+  profile_.max_speed = std::uint64_t{reg(Reg::MAX_SPEED)} << 22;
+  const std::uint32_t min = reg(Reg::MIN_SPEED);
+  profile_.min_speed = std::uint64_t{min & 0xFFF} << 16;
+  profile_.lspd_opt = (min & 0x1000) != 0;
+  profile_.infinite = variant_->infinite_acceleration && acc == 0xFFF;
+  profile_.step_sel = static_cast<std::uint8_t>(reg(Reg::STEP_MODE) & 7u);
+}
+
+std::uint32_t Chip::register_value(const RegisterInfo& r) const {
+  switch (r.id) {
+    case Reg::ABS_POS: return static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
+    case Reg::EL_POS: return motion_.el_pos;
+    case Reg::SPEED: return static_cast<std::uint32_t>(motion_.speed >> 12) & r.mask();
+    case Reg::ADC_OUT: return adc_code_;
+    case Reg::STATUS: return status();
+    default: return regs_[r.address];
+  }
+}
+
+// ---------------------------------------------------------------- STATUS
+
+LiveStatus Chip::live_status() const {
+  LiveStatus l;
+  l.hiz = motion_.hiz;
+  l.busy = motion_busy(motion_, profile_);
+  l.sw_closed = !sw_level_;
+  l.forward = motion_.dir;
+  l.step_clock = motion_.activity == Activity::step_clock;
+  l.mot = mot_status(motion_, profile_);
+  return l;
+}
+
+std::uint16_t Chip::status() const {
+  if (!stby_level_) return 0;
+  return encode_status(variant_->status, latched_, live_status());
+}
+
+void Chip::clear_status_on_get_status() {
+  latched_ = condition_;
+  // GetStatus also lets the bridges be enabled again once the overcurrent is gone.
+  if (!condition_.ocd) ocd_shutdown_ = false;
+}
+
+void Chip::wrong_command(std::uint8_t byte, const char* why) {
+  latched_.wrong_cmd = true;
+  if (sink_) sink_({now_, DiagnosticKind::wrong_cmd, "byte " + hex(byte, 2) + ": " + why});
+}
+
+void Chip::not_performable(const char* what) {
+  latched_.notperf_cmd = true;
+  if (sink_) sink_({now_, DiagnosticKind::notperf_cmd, what});
+}
+
+// ---------------------------------------------------------------- time
+
+void Chip::advance_to(Tick tick) {
+  if (tick <= now_) return;
+  if (motion_active(motion_)) reference_advance(motion_, profile_, tick - now_);
+  now_ = tick;
+}
+
+Tick Chip::next_event_tick() const { return motion_active(motion_) ? now_ + 1 : kNever; }
+
+// ---------------------------------------------------------------- pins
+
+bool Chip::busy_sync_pin() const {
+  if (!stby_level_) return true;
+  const std::uint32_t step_mode = regs_[variant_->find(Reg::STEP_MODE)->address];
+  if ((step_mode & kStepModeSyncEn) != 0) {
+    const unsigned sync_sel = (step_mode >> 4) & 7u;
+    return ((motion_.el_pos >> (7 - sync_sel)) & 1u) != 0;
+  }
+  return !motion_busy(motion_, profile_);
+}
+
+bool Chip::flag_pin() const {
+  const std::uint32_t enabled = regs_[variant_->find(Reg::ALARM_EN)->address];
+  const AlarmFlags& a = latched_;
+  for (unsigned bit = 0; bit < 8; ++bit) {
+    if (((enabled >> bit) & 1u) == 0) continue;
+    bool on = false;
+    switch (variant_->alarms[bit]) {
+      case Alarm::none: break;
+      case Alarm::overcurrent: on = a.ocd; break;
+      case Alarm::thermal_shutdown: on = a.thermal >= Thermal::bridge_shutdown; break;
+      case Alarm::thermal_warning: on = a.thermal >= Thermal::warning; break;
+      case Alarm::uvlo: on = a.uvlo; break;
+      case Alarm::adc_uvlo: on = a.uvlo_adc; break;
+      case Alarm::stall_a: on = a.stall_a; break;
+      case Alarm::stall_b: on = a.stall_b; break;
+      case Alarm::stall_any: on = a.stall_a || a.stall_b; break;
+      case Alarm::switch_turn_on: on = a.sw_evn; break;
+      case Alarm::command_error: on = a.wrong_cmd || a.notperf_cmd; break;
+    }
+    if (on) return false;
+  }
+  return true;
+}
+
+void Chip::set_sw_pin(bool level) {
+  if (level == sw_level_) return;
+  sw_level_ = level;
+  if (!stby_level_) return;
+  if (!level)
+    switch_turn_on_event();
+  else
+    switch_release_event();
+}
+
+void Chip::switch_turn_on_event() {
+  latched_.sw_evn = true;
+  const bool sw_mode = (regs_[variant_->find(Reg::CONFIG)->address] & kConfigSwMode) != 0;
+  if (motion_.activity == Activity::go_until) {
+    if (switch_act_)
+      regs_[variant_->find(Reg::MARK)->address] = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
+    else
+      motion_.abs_pos = 0;
+    if (sw_mode)
+      soft_stop(motion_, profile_, false);
+    else
+      hard_stop(motion_);
+    return;
+  }
+  // SW_MODE = 0: every turn-on event is a HardStop interrupt, bridges included.
+  if (!sw_mode && !hiz_forced()) hard_stop(motion_);
+}
+
+void Chip::switch_release_event() {
+  if (motion_.activity != Activity::release_sw) return;
+  if (switch_act_)
+    regs_[variant_->find(Reg::MARK)->address] = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
+  else
+    motion_.abs_pos = 0;
+  hard_stop(motion_);
+}
+
+void Chip::set_stck_pin(bool level) {
+  const bool rising = level && !stck_level_;
+  stck_level_ = level;
+  if (rising && stby_level_ && motion_.activity == Activity::step_clock) take_microstep(motion_, profile_);
+}
+
+void Chip::set_stby_rst_pin(bool level) {
+  if (level == stby_level_) return;
+  stby_level_ = level;
+  reset_logic();
+  if (level) come_out_of_reset();
+}
+
+void Chip::set_adc_input(std::uint8_t code) { adc_code_ = std::min<std::uint8_t>(code, 31); }
+
+// ---------------------------------------------------------------- faults
+
+bool Chip::hiz_forced() const {
+  return condition_.uvlo || condition_.thermal >= Thermal::bridge_shutdown || ocd_shutdown_;
+}
+
+void Chip::apply_forced_hiz() {
+  if (hiz_forced()) hard_hiz(motion_);
+}
+
+void Chip::set_undervoltage(bool active) {
+  condition_.uvlo = active;
+  if (!stby_level_) return;
+  if (active) latched_.uvlo = true;
+  apply_forced_hiz();
+}
+
+void Chip::set_adc_undervoltage(bool active) {
+  condition_.uvlo_adc = active;
+  if (stby_level_ && active) latched_.uvlo_adc = true;
+}
+
+void Chip::set_thermal(Thermal t) {
+  condition_.thermal = t;
+  if (!stby_level_) return;
+  latched_.thermal = std::max(latched_.thermal, t);
+  apply_forced_hiz();
+}
+
+void Chip::set_overcurrent(bool active) {
+  condition_.ocd = active;
+  if (!stby_level_ || !active) return;
+  latched_.ocd = true;
+  if ((regs_[variant_->find(Reg::CONFIG)->address] & kConfigOcSd) != 0) ocd_shutdown_ = true;
+  apply_forced_hiz();
+}
+
+void Chip::set_stall(Bridge bridge, bool active) {
+  (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
+  if (!stby_level_ || !active) return;
+  (bridge == Bridge::A ? latched_.stall_a : latched_.stall_b) = true;
+}
+
+// ---------------------------------------------------------------- inspection
+
+std::uint32_t Chip::peek(Reg id) const {
+  const RegisterInfo* r = variant_->find(id);
+  return r ? register_value(*r) : 0;
+}
+
+std::uint32_t Chip::peek_address(std::uint8_t address) const {
+  const RegisterInfo* r = variant_->at_address(address);
+  return r ? register_value(*r) : 0;
+}
+
+std::string Chip::dump() const {
+  std::string out;
+  out += std::string(variant_->name) + " at tick " + std::to_string(now_) + (stby_level_ ? "" : " (in standby)") + "\n";
+  for (const auto& r : variant_->registers) {
+    const std::uint32_t v = register_value(r);
+    char line[96];
+    std::snprintf(line, sizeof line, "  0x%02X %-10s = 0x%0*X", r.address, std::string(r.name).c_str(),
+                  r.spi_bytes() * 2, v);
+    out += line;
+    if (r.is_signed()) out += "  (" + std::to_string(sign_extend(v, r.bits)) + ")";
+    if (r.id == Reg::STATUS) out += "  [" + describe_status(variant_->status, static_cast<std::uint16_t>(v)) + "]";
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,156 @@
+// One dSPIN-family chip: register file, command decoder, STATUS, pins and the
+// motion engine, advanced on a virtual 250 ns clock. The SPI face is byte-level
+// (one call per byte decoded at a CS rising edge); bus framing lives in spi/ and daisychain/.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "core/commands.hpp"
+#include "core/diagnostics.hpp"
+#include "core/motion.hpp"
+#include "core/quirks.hpp"
+#include "core/registers.hpp"
+#include "core/status.hpp"
+#include "core/tick.hpp"
+#include "core/variant.hpp"
+
+namespace l6470emu {
+
+/// Which power bridge a stall was detected on.
+enum class Bridge : std::uint8_t { A, B };
+
+/// A chip of the family, from power-up on. Copying a chip copies its whole state.
+class Chip {
+ public:
+  /// A chip just out of power-up: registers at reset, bridges HiZ, UVLO latched, FLAG low.
+  explicit Chip(const Variant& variant = l6470(), Quirks quirks = {});
+
+  const Variant& variant() const { return *variant_; }
+  const Quirks& quirks() const { return quirks_; }
+
+  // ---- SPI face -----------------------------------------------------------
+
+  /// The byte in the chip's shift register at a CS rising edge: decode it and
+  /// return the byte the chip loads for the next transfer (0x00 with no response
+  /// pending). In standby the byte is ignored and 0x00 is returned.
+  std::uint8_t on_byte(std::uint8_t byte);
+
+  /// Whether the chip takes part in SPI (false while STBY/RST is held low).
+  bool spi_enabled() const { return stby_level_; }
+
+  // ---- time ---------------------------------------------------------------
+
+  /// The chip's current virtual time.
+  Tick now() const { return now_; }
+  /// Runs the chip up to `tick` (never backwards; an earlier tick is ignored).
+  void advance_to(Tick tick);
+  /// The next tick at which the chip changes on its own (kNever when idle).
+  Tick next_event_tick() const;
+
+  // ---- pins (the physical world; host programs only see SPI and these) ------
+
+  /// BUSY\SYNC output level: false = pulled low (busy, or the SYNC clock low).
+  bool busy_sync_pin() const;
+  /// FLAG output level: false = pulled low (an enabled alarm is active).
+  bool flag_pin() const;
+  /// SW input level; false = switch closed (pin pulled to ground). Edges act at now().
+  void set_sw_pin(bool level);
+  bool sw_pin() const { return sw_level_; }
+  /// STCK input level; a rising edge in step-clock mode makes one microstep.
+  void set_stck_pin(bool level);
+  /// STBY\RST input; low holds the logic in reset with SPI silent, rising edge = power-up state.
+  void set_stby_rst_pin(bool level);
+  /// The ADC_OUT conversion of the ADCIN pin, 0..31 (larger values saturate).
+  void set_adc_input(std::uint8_t code);
+
+  // ---- faults ---------------------------------------------------------------
+
+  /// Motor supply below VSthOff (true) or back above VSthOn (false).
+  void set_undervoltage(bool active);
+  /// ADC input undervoltage (UVLO_ADC, gate-driver parts).
+  void set_adc_undervoltage(bool active);
+  /// Die temperature class.
+  void set_thermal(Thermal t);
+  /// Overcurrent in a power MOSFET; with CONFIG.OC_SD the bridges shut down.
+  void set_overcurrent(bool active);
+  /// Stall (step loss) detected on a bridge.
+  void set_stall(Bridge bridge, bool active);
+
+  // ---- inspection without side effects --------------------------------------
+
+  /// The value GetParam would return now for `id` (0 when the variant lacks it).
+  std::uint32_t peek(Reg id) const;
+  /// The value GetParam would return now for `address` (0 for a hole).
+  std::uint32_t peek_address(std::uint8_t address) const;
+  /// STATUS as GetParam(STATUS) reads it, without clearing anything.
+  std::uint16_t status() const;
+  /// ABS_POS as a signed number of (micro)steps.
+  std::int32_t position() const { return motion_.abs_pos; }
+  /// The motion engine's state (speed in 2^-40 step/tick and so on).
+  const MotionState& motion() const { return motion_; }
+  /// The profile the registers currently define.
+  const Profile& profile() const { return profile_; }
+  /// Whether the bridges are in high impedance.
+  bool hiz() const { return motion_.hiz; }
+  /// Text dump of every register, STATUS decoded.
+  std::string dump() const;
+
+  /// Where diagnostics go (unknown opcodes, refused commands).
+  void set_diagnostic_sink(DiagnosticSink sink) { sink_ = std::move(sink); }
+
+ private:
+  void reset_logic();
+  void come_out_of_reset();
+  void execute(const Opcode& op, std::uint32_t arg);
+  void exec_set_param(std::uint8_t address, std::uint32_t value);
+  void write_register(const RegisterInfo& r, std::uint32_t value);
+  void load_response(std::uint32_t value, std::uint8_t bytes);
+  void refresh_profile();
+  void clear_status_on_get_status();
+  bool hiz_forced() const;
+  void apply_forced_hiz();
+  void switch_turn_on_event();
+  void switch_release_event();
+  void wrong_command(std::uint8_t byte, const char* why);
+  void not_performable(const char* what);
+  AlarmFlags live_alarms() const;
+  LiveStatus live_status() const;
+  bool motion_command_allowed(const char* what);
+  std::uint32_t register_value(const RegisterInfo& r) const;
+
+  const Variant* variant_;
+  Quirks quirks_;
+  Tick now_ = 0;
+
+  // register storage by address (live registers are computed)
+  std::array<std::uint32_t, 32> regs_{};
+
+  // decoder: opcode being collected and its argument bytes
+  Opcode pending_{};
+  bool collecting_ = false;
+  std::uint8_t args_seen_ = 0;
+  std::uint32_t arg_ = 0;
+
+  // response being shifted out, MSB first
+  std::uint32_t response_ = 0;
+  std::uint8_t response_left_ = 0;
+
+  MotionState motion_{};
+  Profile profile_{};
+
+  AlarmFlags latched_{};   // what STATUS shows
+  AlarmFlags condition_{}; // what is physically going on (events are never conditions)
+  bool ocd_shutdown_ = false;  // bridges held off by OCD until GetStatus releases it
+  bool switch_act_ = false;    // ACT of the GoUntil/ReleaseSW in progress
+
+  bool sw_level_ = true;
+  bool stck_level_ = false;
+  bool stby_level_ = true;
+  std::uint8_t adc_code_ = 0;
+
+  DiagnosticSink sink_;
+};
+
+}  // namespace l6470emu

@@ -1,0 +1,30 @@
+// Diagnostics: host mistakes the chip notices (unknown opcodes, refused commands).
+// The chip reports them to an optional sink; it never stops because of them.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/tick.hpp"
+
+namespace l6470emu {
+
+/// What kind of mistake a diagnostic reports.
+enum class DiagnosticKind : std::uint8_t {
+  wrong_cmd,    ///< byte that is no command, or a register address that does not exist
+  notperf_cmd,  ///< command refused in the current state
+  ignored,      ///< a byte or pin change the chip ignored (standby, ...)
+};
+
+/// One diagnostic, stamped with the tick at which the chip noticed it.
+struct Diagnostic {
+  Tick tick = 0;
+  DiagnosticKind kind = DiagnosticKind::wrong_cmd;
+  std::string message;
+};
+
+/// Receives diagnostics; may be empty.
+using DiagnosticSink = std::function<void(const Diagnostic&)>;
+
+}  // namespace l6470emu

@@ -1,0 +1,74 @@
+// A chip variant as data: its register table, STATUS layout, ALARM_EN meaning
+// and a few capabilities. There is no class per variant; the model reads these.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "core/registers.hpp"
+#include "core/status_layout.hpp"
+
+namespace l6470emu {
+
+/// Everything that distinguishes one family member from another.
+struct Variant {
+  std::string_view name;                   ///< "L6470", ...
+  std::span<const RegisterInfo> registers; ///< ascending addresses
+  StatusLayout status;                     ///< STATUS bit positions
+  AlarmLayout alarms;                      ///< ALARM_EN bit meanings
+  std::uint8_t max_step_sel = 7;           ///< finest STEP_SEL (7 = 1/128)
+  bool infinite_acceleration = true;       ///< ACC = 0xFFF skips the ramps
+  /// Table index of each address (0..31), -1 for a hole or a reserved address.
+  std::array<std::int8_t, 32> index_of_address{};
+  /// Table index of each register id, -1 when the variant has no such register.
+  std::array<std::int8_t, static_cast<std::size_t>(Reg::count)> index_of_reg{};
+
+  /// The register at `address`, or nullptr when the variant has none there.
+  constexpr const RegisterInfo* at_address(std::uint8_t address) const {
+    if (address >= 32) return nullptr;
+    const auto i = index_of_address[address];
+    return i < 0 ? nullptr : &registers[static_cast<std::size_t>(i)];
+  }
+  /// The description of `id`, or nullptr when the variant lacks it.
+  constexpr const RegisterInfo* find(Reg id) const {
+    const auto i = index_of_reg[static_cast<std::size_t>(id)];
+    return i < 0 ? nullptr : &registers[static_cast<std::size_t>(i)];
+  }
+  /// Whether the variant has register `id`.
+  constexpr bool has(Reg id) const { return find(id) != nullptr; }
+};
+
+/// Builds a Variant from its table, filling in the derived look-ups.
+constexpr Variant make_variant(std::string_view name, std::span<const RegisterInfo> table,
+                               StatusLayout status, AlarmLayout alarms,
+                               std::uint8_t max_step_sel, bool infinite_acceleration) {
+  Variant v{name, table, status, alarms, max_step_sel, infinite_acceleration, {}, {}};
+  for (auto& i : v.index_of_address) i = -1;
+  for (auto& i : v.index_of_reg) i = -1;
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    v.index_of_address[table[i].address] = static_cast<std::int8_t>(i);
+    v.index_of_reg[static_cast<std::size_t>(table[i].id)] = static_cast<std::int8_t>(i);
+  }
+  return v;
+}
+
+/// Checks a register table at compile time: unique ascending addresses in 0x01..0x1F,
+/// widths of 1..24 bits, reset values inside the width, live registers read-only or positions.
+constexpr bool register_table_is_consistent(std::span<const RegisterInfo> table) {
+  unsigned previous = 0;
+  for (const auto& r : table) {
+    if (r.address <= previous || r.address > 0x1F) return false;
+    if (r.bits == 0 || r.bits > 24) return false;
+    if ((r.reset & ~r.mask()) != 0) return false;
+    if (r.spi_bytes() < 1 || r.spi_bytes() > 3) return false;
+    previous = r.address;
+  }
+  return true;
+}
+
+/// The L6470 (dSPIN, voltage mode, integrated bridges).
+const Variant& l6470();
+
+}  // namespace l6470emu

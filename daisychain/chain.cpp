@@ -1,0 +1,83 @@
+// Chain: the shared shift register of a daisy chain, kept as a ring buffer so a
+// byte costs O(1) whatever the chain length. Chips in standby break the chain
+// (their SDO floats; modelled as 0x00 and the bytes they receive are lost).
+#include "daisychain/chain.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace l6470emu {
+
+Chain::Chain(std::vector<Chip> chips) : chips_(std::move(chips)), ring_(chips_.size(), 0) {
+  if (chips_.empty() || chips_.size() > kMaxChips)
+    throw std::invalid_argument("a chain has 1 to 256 chips, not " + std::to_string(chips_.size()));
+}
+
+Chain::Chain(std::size_t n, const Variant& variant, Quirks quirks)
+    : Chain(std::vector<Chip>(n, Chip(variant, quirks))) {}
+
+void Chain::select() {
+  if (selected_) return;
+  selected_ = true;
+  bytes_in_frame_ = 0;
+  standby_in_frame_ = any_in_standby();
+}
+
+bool Chain::any_in_standby() const {
+  for (const auto& c : chips_)
+    if (!c.spi_enabled()) return true;
+  return false;
+}
+
+std::uint8_t Chain::exchange(std::uint8_t mosi) {
+  if (!selected_) return 0x00;  // SDO is high impedance while CS is high
+  ++bytes_in_frame_;
+  const std::size_t n = ring_.size();
+  const std::uint8_t miso = ring_[head_];
+  ring_[head_] = mosi;
+  head_ = head_ + 1 == n ? 0 : head_ + 1;
+  if (standby_in_frame_) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (!chips_[i].spi_enabled()) set_shift_register(i, 0x00);
+    if (!chips_[0].spi_enabled()) return 0x00;
+  }
+  return miso;
+}
+
+void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
+}
+
+void Chain::deselect() {
+  if (!selected_) return;
+  selected_ = false;
+  // A CS pulse without clocks leaves the shift registers as they are: nothing is decoded.
+  if (bytes_in_frame_ == 0) return;
+  for (std::size_t i = 0; i < chips_.size(); ++i) set_shift_register(i, chips_[i].on_byte(shift_register(i)));
+}
+
+void Chain::advance_to(Tick tick) {
+  if (tick <= now_) return;
+  for (auto& c : chips_) c.advance_to(tick);
+  now_ = tick;
+}
+
+void Chain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  select();
+  exchange(tx, rx);
+  deselect();
+}
+
+std::vector<std::uint8_t> Chain::frame(std::span<const std::uint8_t> tx) {
+  std::vector<std::uint8_t> rx(tx.size());
+  frame(tx, rx);
+  return rx;
+}
+
+Tick Chain::next_event_tick() const {
+  Tick t = kNever;
+  for (const auto& c : chips_) t = std::min(t, c.next_event_tick());
+  return t;
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The README's two commands:
+#   scripts/quickstart.sh demo   set up (Debian packages, build) and run the demo
+#   scripts/quickstart.sh test   set up and run the whole test suite, then again under ASan+UBSan
+set -euo pipefail
+cd "$(dirname "$0")/.."
+what=${1:-}
+case "$what" in
+  demo)
+    scripts/setup.sh build
+    exec build/l6470emu demo "${@:2}"
+    ;;
+  test)
+    scripts/setup.sh build
+    echo "== tests (RelWithDebInfo) =="
+    ctest --test-dir build --output-on-failure -j"$(nproc)"
+    echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer =="
+    scripts/setup.sh build-asan -DL6470EMU_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+      ctest --test-dir build-asan --output-on-failure -j"$(nproc)"
+    ;;
+  *)
+    echo "usage: scripts/quickstart.sh demo|test" >&2
+    exit 2
+    ;;
+esac

@@ -1,0 +1,38 @@
+// spidev message execution: Linux spi_sync semantics of cs_change and delay_usecs.
+#include "spi/message.hpp"
+
+#include <algorithm>
+
+namespace l6470emu {
+
+Tick transfer_ticks(std::uint32_t bytes, std::uint32_t speed_hz) {
+  if (bytes == 0) return 0;
+  if (speed_hz == 0) speed_hz = 1;
+  const std::uint64_t bits = std::uint64_t{bytes} * 8;
+  const Tick t = (bits * kTicksPerSecond + speed_hz - 1) / speed_hz;
+  return std::max<Tick>(t, bytes);
+}
+
+void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const BusTiming& timing) {
+  for (std::size_t i = 0; i < transfers.size(); ++i) {
+    const SpiTransfer& t = transfers[i];
+    const bool last = i + 1 == transfers.size();
+    if (!dev.selected()) dev.select();
+    const std::uint32_t speed = t.speed_hz ? t.speed_hz : timing.default_speed_hz;
+    const Tick per_byte = transfer_ticks(1, speed);
+    for (std::uint32_t k = 0; k < t.len; ++k) {
+      const std::uint8_t out = t.tx.empty() ? 0 : t.tx[k];
+      dev.advance_to(dev.now() + per_byte);
+      const std::uint8_t in = dev.exchange(out);
+      if (!t.rx.empty()) t.rx[k] = in;
+    }
+    if (t.delay_usecs) dev.advance_to(dev.now() + ticks_from_us(t.delay_usecs));
+    const bool raise = last ? !t.cs_change : t.cs_change;
+    if (raise) {
+      dev.deselect();
+      dev.advance_to(dev.now() + timing.cs_high_ticks);
+    }
+  }
+}
+
+}  // namespace l6470emu

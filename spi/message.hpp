@@ -1,0 +1,40 @@
+// spidev message semantics (struct spi_ioc_transfer): a message is a list of
+// transfers under one chip-select; cs_change and delays follow the Linux spidev
+// rules, and transfer time is turned into virtual ticks here, in one place.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/tick.hpp"
+#include "spi/spi_device.hpp"
+
+namespace l6470emu {
+
+/// One transfer of a spidev message, as in struct spi_ioc_transfer.
+struct SpiTransfer {
+  std::span<const std::uint8_t> tx;  ///< bytes to send; empty = send zeros (rx-only transfer)
+  std::span<std::uint8_t> rx;        ///< where to put received bytes; empty = discard (tx-only)
+  std::uint32_t len = 0;             ///< bytes in the transfer
+  std::uint32_t speed_hz = 0;        ///< 0 = the device default
+  std::uint16_t delay_usecs = 0;     ///< wait after the transfer, before CS changes
+  bool cs_change = false;            ///< deselect after this transfer (or stay selected after the last)
+};
+
+/// Bus timing used to turn bytes into ticks.
+struct BusTiming {
+  std::uint32_t default_speed_hz = 5'000'000;  ///< SCK when a transfer does not say
+  Tick cs_high_ticks = 4;                       ///< CS high between frames (1 µs)
+};
+
+/// Ticks needed to clock `bytes` bytes at `speed_hz` (rounded up, at least one tick per byte).
+Tick transfer_ticks(std::uint32_t bytes, std::uint32_t speed_hz);
+
+/// Runs one spidev message against `dev`, advancing its clock as the bytes take time:
+/// CS drops at the start (unless already low from a previous cs_change on the last transfer),
+/// `cs_change` on a transfer other than the last raises CS after it (and drops it again),
+/// and on the last transfer keeps CS low after the message.
+void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const BusTiming& timing = {});
+
+}  // namespace l6470emu
