@@ -1,8 +1,35 @@
 // The l6470emu command-line program: subcommands over the emulator library.
 #include <CLI/CLI.hpp>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "tools/demo.hpp"
+#include "tools/tables.hpp"
+
+namespace {
+
+int update_readme(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    std::cerr << "l6470emu: cannot read " << path << "\n";
+    return 1;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string fresh = l6470emu::refresh_generated_blocks(text.str());
+  if (fresh == text.str()) return 0;
+  std::ofstream out(path, std::ios::trunc);
+  out << fresh;
+  if (!out) {
+    std::cerr << "l6470emu: cannot write " << path << "\n";
+    return 1;
+  }
+  std::cout << "updated the generated tables in " << path << "\n";
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"l6470emu: register-level emulator of the ST L6470-family SPI motion engines"};
@@ -14,7 +41,18 @@ int main(int argc, char** argv) {
   demo->add_option("--chips", chips, "chips in the chain (1..256)")->check(CLI::Range(1, 256));
   demo->add_option("--seconds", seconds, "virtual seconds to run at most")->check(CLI::Range(1, 3600));
 
+  std::string table = "l6470-registers";
+  std::string readme;
+  auto* tables = app.add_subcommand("tables", "print the tables the model uses, as Markdown");
+  tables->add_option("--table", table, "which table")
+      ->check(CLI::IsMember({"l6470-registers", "l6470-status", "commands"}));
+  tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
+
   CLI11_PARSE(app, argc, argv);
   if (*demo) return l6470emu::run_demo(chips, seconds, std::cout);
+  if (*tables) {
+    if (!readme.empty()) return update_readme(readme);
+    std::cout << l6470emu::generated_block(table);
+  }
   return 0;
 }

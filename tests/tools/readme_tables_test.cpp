@@ -1,0 +1,46 @@
+// The README's register, STATUS and command tables are generated from the model's own tables.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "tools/tables.hpp"
+
+namespace l6470emu {
+namespace {
+
+std::string read_readme() {
+  std::ifstream in(std::string(L6470EMU_SOURCE_DIR) + "/README.md");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Readme, GeneratedTablesMatchTheModel) {
+  const std::string text = read_readme();
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(refresh_generated_blocks(text), text)
+      << "README tables are stale: run build/l6470emu tables --update-readme README.md";
+}
+
+TEST(Readme, HasEveryGeneratedBlock) {
+  const std::string text = read_readme();
+  for (const char* name : {"l6470-registers", "l6470-status", "commands"})
+    EXPECT_NE(text.find(std::string("<!-- BEGIN generated:") + name + " -->"), std::string::npos) << name;
+}
+
+TEST(RegisterTableMarkdown, ListsEveryL6470RegisterAndTheReservedAddresses) {
+  const std::string t = register_table_markdown(l6470());
+  for (const auto& r : l6470().registers) EXPECT_NE(t.find(std::string(r.name)), std::string::npos) << r.name;
+  EXPECT_NE(t.find("| 0x1A | (none)"), std::string::npos);
+  EXPECT_NE(t.find("| 0x18 | CONFIG | 16 | 2 | 0x2E88 | WH |"), std::string::npos);
+}
+
+TEST(StatusTableMarkdown, PutsSckModOnBit15AndHizOnBit0) {
+  const std::string t = status_table_markdown(l6470());
+  EXPECT_NE(t.find("| 15 | SCK_MOD"), std::string::npos);
+  EXPECT_NE(t.find("| 0 | HiZ |"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace l6470emu

@@ -1,0 +1,150 @@
+// Markdown rendering of the register, STATUS and command tables.
+#include "tools/tables.hpp"
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include "core/commands.hpp"
+
+namespace l6470emu {
+namespace {
+
+std::string flags_text(const RegisterInfo& r) {
+  std::string s;
+  if (r.is_signed()) s += "22-bit two's complement; ";
+  if (r.is_live()) s += "computed by the model; ";
+  if (r.flags & kWriteConflict) s += "write condition is a quirk (docs/quirks.md); ";
+  if (!s.empty()) s.resize(s.size() - 2);
+  return s;
+}
+
+}  // namespace
+
+std::string register_table_markdown(const Variant& v) {
+  std::string out = "| Addr | Register | Bits | SPI bytes | Reset | Write | Notes |\n|---|---|---|---|---|---|---|\n";
+  for (const auto& r : v.registers) {
+    char row[160];
+    std::snprintf(row, sizeof row, "| 0x%02X | %s | %u | %u | 0x%0*X | %s | %s |\n", r.address,
+                  std::string(r.name).c_str(), r.bits, r.spi_bytes(), (r.bits + 3) / 4, r.reset,
+                  std::string(to_string(r.access)).c_str(), flags_text(r).c_str());
+    out += row;
+  }
+  for (unsigned a = 1; a < 32; ++a)
+    if (!v.at_address(static_cast<std::uint8_t>(a))) {
+      char row[96];
+      std::snprintf(row, sizeof row, "| 0x%02X | (none) | | | | | WRONG_CMD |\n", a);
+      out += row;
+    }
+  return out;
+}
+
+std::string status_table_markdown(const Variant& v) {
+  std::array<std::string, 16> names;
+  const StatusLayout& l = v.status;
+  auto put = [&](std::int8_t bit, const char* name) {
+    if (bit < 0) return;
+    if (!names[bit].empty()) names[bit] += " / ";
+    names[bit] += name;
+  };
+  put(l.hiz, "HiZ");
+  put(l.busy, "BUSY (low = busy)");
+  put(l.sw_f, "SW_F");
+  put(l.sw_evn, "SW_EVN (latched)");
+  put(l.dir, "DIR (1 = forward)");
+  if (l.mot_status >= 0) {
+    put(static_cast<std::int8_t>(l.mot_status + 1), "MOT_STATUS[1]");
+    put(l.mot_status, "MOT_STATUS[0]");
+  }
+  if (l.notperf_cmd == l.wrong_cmd) {
+    put(l.wrong_cmd, "CMD_ERROR (latched)");
+  } else {
+    put(l.notperf_cmd, "NOTPERF_CMD (latched)");
+    put(l.wrong_cmd, "WRONG_CMD (latched)");
+  }
+  put(l.uvlo, "UVLO (low = active, latched)");
+  put(l.uvlo_adc, "UVLO_ADC (low = active, latched)");
+  put(l.th_wrn, "TH_WRN (low = active, latched)");
+  put(l.th_sd, "TH_SD (low = active, latched)");
+  if (l.th_status >= 0) {
+    put(static_cast<std::int8_t>(l.th_status + 1), "TH_STATUS[1]");
+    put(l.th_status, "TH_STATUS[0]");
+  }
+  put(l.ocd, "OCD (low = active, latched)");
+  put(l.step_loss_a, "STEP_LOSS_A / STALL_A (low = active, latched)");
+  put(l.step_loss_b, "STEP_LOSS_B / STALL_B (low = active, latched)");
+  put(l.sck_mod, "SCK_MOD (step-clock mode)");
+  std::string out = "| Bit | Field |\n|---|---|\n";
+  for (int bit = 15; bit >= 0; --bit)
+    out += "| " + std::to_string(bit) + " | " + (names[bit].empty() ? "(unused)" : names[bit]) + " |\n";
+  return out;
+}
+
+std::string command_table_markdown() {
+  std::string out = "| Command | Opcodes | Argument bytes |\n|---|---|---|\n";
+  // Group consecutive opcodes of the same command (DIR/ACT variants).
+  int b = 0;
+  while (b < 256) {
+    const Opcode op = classify_opcode(static_cast<std::uint8_t>(b));
+    if (op.command == Command::Unknown) { ++b; continue; }
+    int e = b;
+    std::string list;
+    for (int x = b; x < 256; ++x) {
+      const Opcode o = classify_opcode(static_cast<std::uint8_t>(x));
+      if (o.command != op.command) {
+        if (o.command == Command::Unknown && x - e < 9) continue;  // DIR/ACT variants have gaps
+        break;
+      }
+      char h[8];
+      std::snprintf(h, sizeof h, "0x%02X", x);
+      if (o.command == Command::SetParam || o.command == Command::GetParam) {
+        if (x == b) list = std::string(h);
+        list = list.substr(0, 4) + "–" + h;
+      } else {
+        list += (list.empty() ? "" : ", ") + std::string(h);
+      }
+      e = x;
+    }
+    std::string args;
+    switch (op.command) {
+      case Command::SetParam: args = "register length (1–3)"; break;
+      case Command::GetParam: args = "0 (answer: register length)"; break;
+      case Command::GetStatus: args = "0 (answer: 2)"; break;
+      case Command::Reserved: args = "— (treated as unknown: WRONG_CMD)"; break;
+      default: args = std::to_string(op.arg_bytes); break;
+    }
+    out += "| " + std::string(to_string(op.command)) + " | " + list + " | " + args + " |\n";
+    b = e + 1;
+  }
+  return out;
+}
+
+std::string generated_block(std::string_view name) {
+  if (name == "l6470-registers") return register_table_markdown(l6470());
+  if (name == "l6470-status") return status_table_markdown(l6470());
+  if (name == "commands") return command_table_markdown();
+  return "";
+}
+
+std::string refresh_generated_blocks(std::string_view text) {
+  static constexpr std::string_view kBegin = "<!-- BEGIN generated:";
+  std::string out;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t b = text.find(kBegin, pos);
+    if (b == std::string_view::npos) break;
+    const std::size_t name_end = text.find(" -->", b);
+    if (name_end == std::string_view::npos) break;
+    const std::string name(text.substr(b + kBegin.size(), name_end - b - kBegin.size()));
+    const std::string end_marker = "<!-- END generated:" + name + " -->";
+    const std::size_t e = text.find(end_marker, name_end);
+    if (e == std::string_view::npos) break;
+    out.append(text.substr(pos, name_end + 4 - pos));
+    out += "\n" + generated_block(name);
+    pos = e;
+  }
+  out.append(text.substr(pos));
+  return out;
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,28 @@
+// Markdown tables generated from the variant tables the emulator itself uses,
+// so the README cannot drift from the model (a test checks it is in sync).
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/variant.hpp"
+
+namespace l6470emu {
+
+/// Register map of `v`: address, name, bits, SPI bytes, reset value, access class.
+std::string register_table_markdown(const Variant& v);
+
+/// STATUS bit layout of `v`, bit 15 first.
+std::string status_table_markdown(const Variant& v);
+
+/// The opcodes the decoder accepts and their argument bytes.
+std::string command_table_markdown();
+
+/// The generated block called `name` ("l6470-registers", "l6470-status", "commands"), or "" if unknown.
+std::string generated_block(std::string_view name);
+
+/// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of
+/// `text` with the current generated content; returns the new text.
+std::string refresh_generated_blocks(std::string_view text);
+
+}  // namespace l6470emu
