@@ -317,7 +317,7 @@ void Chip::not_performable(const char* what) {
 
 void Chip::advance_to(Tick tick) {
   if (tick <= now_) return;
-  if (motion_active(motion_)) reference_advance(motion_, profile_, tick - now_);
+  if (motion_active(motion_)) motion_advance(engine_, motion_, profile_, tick - now_);
   now_ = tick;
 }
 

@@ -9,6 +9,7 @@
 
 #include "core/commands.hpp"
 #include "core/diagnostics.hpp"
+#include "core/fast_motion.hpp"
 #include "core/motion.hpp"
 #include "core/quirks.hpp"
 #include "core/registers.hpp"
@@ -48,6 +49,9 @@ class Chip {
   void advance_to(Tick tick);
   /// The next tick at which the chip changes on its own (kNever when idle).
   Tick next_event_tick() const;
+  /// Chooses the motion engine: the event-driven one (default) or the tick-by-tick reference.
+  void set_motion_engine(MotionEngine e) { engine_ = e; }
+  MotionEngine motion_engine() const { return engine_; }
 
   // ---- pins (the physical world; host programs only see SPI and these) ------
 
@@ -123,6 +127,7 @@ class Chip {
   const Variant* variant_;
   Quirks quirks_;
   Tick now_ = 0;
+  MotionEngine engine_ = MotionEngine::fast;
 
   // register storage by address (live registers are computed)
   std::array<std::uint32_t, 32> regs_{};

@@ -43,6 +43,11 @@ class Chain final : public SpiDevice {
   /// One CS frame returning the MISO bytes.
   std::vector<std::uint8_t> frame(std::span<const std::uint8_t> tx);
 
+  /// Chooses the motion engine of every chip (the event-driven one is the default).
+  void set_motion_engine(MotionEngine e) {
+    for (auto& c : chips_) c.set_motion_engine(e);
+  }
+
   /// The earliest next_event_tick() of the chips.
   Tick next_event_tick() const;
 

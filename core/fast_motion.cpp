@@ -1,0 +1,191 @@
+// Closed-form jumps over uniform ticks. A uniform tick changes the speed by a
+// constant delta (+ACC, -DEC or 0) and triggers nothing; after i of them the
+// distance travelled is S(i) = i*v + delta*i*(i+1)/2, and since at most one
+// microstep fits in a tick, the microsteps made are (frac + S(i)) / microstep.
+// Boundary ticks (a ramp reaching its end, braking starting, the target being
+// reached, a reversal turning round) are left to reference_tick().
+#include "core/fast_motion.hpp"
+
+#include <algorithm>
+
+#include "core/registers.hpp"
+
+namespace l6470emu {
+namespace {
+
+using u128 = unsigned __int128;
+
+/// The rule of the next tick when it is uniform: speed delta sign and the tick at which
+/// the ramp reaches its end (cap: the first non-uniform tick because of the ramp), or
+/// nullopt-like `valid=false` when the next tick is a boundary tick anyway.
+struct Rule {
+  bool valid = false;
+  int sign = 0;             ///< +1 accelerate by ACC, -1 decelerate by DEC, 0 constant
+  std::uint64_t delta = 0;  ///< |speed change| per tick
+  Tick cap = kNever;        ///< 1-based index of the tick that ends the ramp
+};
+
+Tick ceil_div(std::uint64_t a, std::uint64_t b) { return (a + b - 1) / b; }
+
+/// A ramp from v toward t as approach() does it.
+Rule ramp(std::uint64_t v, std::uint64_t t, const Profile& p) {
+  Rule r;
+  r.valid = true;
+  if (v == t) return r;
+  if (p.infinite) { r.valid = false; return r; }
+  if (v < t) {
+    if (p.acc == 0) return r;  // ACC = 0 would never get there: constant
+    r.sign = +1;
+    r.delta = p.acc;
+    r.cap = ceil_div(t - v, p.acc);
+  } else {
+    if (p.dec == 0) return r;
+    r.sign = -1;
+    r.delta = p.dec;
+    r.cap = ceil_div(v - t, p.dec);
+  }
+  return r;
+}
+
+/// Speed after i uniform ticks.
+std::uint64_t speed_after(std::uint64_t v, const Rule& r, Tick i) {
+  const u128 change = static_cast<u128>(r.delta) * i;
+  return static_cast<std::uint64_t>(r.sign >= 0 ? v + change : v - change);
+}
+
+/// Distance of i uniform ticks (speeds v+delta, v+2*delta, ... v+i*delta).
+u128 distance_after(std::uint64_t v, const Rule& r, Tick i) {
+  const u128 base = static_cast<u128>(v) * i;
+  const u128 tri = static_cast<u128>(r.delta) * i * (static_cast<u128>(i) + 1) / 2;
+  return r.sign >= 0 ? base + tri : base - tri;
+}
+
+/// Smallest i in [lo, hi] with pred(i) true (pred monotone: false...true), or hi+1.
+template <class Pred>
+Tick first_true(Tick lo, Tick hi, Pred pred) {
+  if (lo > hi) return hi + 1;
+  if (!pred(hi)) return hi + 1;
+  while (lo < hi) {
+    const Tick mid = lo + (hi - lo) / 2;
+    if (pred(mid))
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
+/// Uniform ticks of a ramp that ends at the cap tick, bounded by `limit`.
+Tick ramp_limit(const Rule& r, Tick limit) {
+  if (!r.valid) return 0;
+  return r.cap == kNever ? limit : std::min(limit, r.cap - 1);
+}
+
+}  // namespace
+
+Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit) {
+  const std::uint64_t floor = p.floor_speed();
+  switch (s.activity) {
+    case Activity::idle:
+    case Activity::step_clock:
+      return limit;
+    case Activity::stopping: {
+      if (s.speed <= floor) return 0;
+      return ramp_limit(ramp(s.speed, floor, p), limit);
+    }
+    case Activity::run:
+    case Activity::go_until:
+    case Activity::release_sw: {
+      if (s.reversing) {
+        if (s.speed <= floor) return 0;
+        return ramp_limit(ramp(s.speed, floor, p), limit);
+      }
+      const std::uint64_t target = constant_speed_target(s, p);
+      if (s.activity == Activity::run && target == 0) return 0;  // about to finish
+      const Rule r = ramp(s.speed, target, p);
+      if (!r.valid) return 0;
+      return ramp_limit(r, limit);
+    }
+    case Activity::position: {
+      if (s.reversing) {
+        if (s.speed <= floor) return 0;
+        return ramp_limit(ramp(s.speed, floor, p), limit);
+      }
+      Rule r;
+      if (s.braking) {
+        r = s.speed > floor ? ramp(s.speed, floor, p) : Rule{true, 0, 0, kNever};
+      } else {
+        r = ramp(s.speed, p.max_speed, p);
+      }
+      if (!r.valid) return 0;
+      Tick n = ramp_limit(r, limit);
+      const u128 remaining = static_cast<u128>(s.steps_left) * p.microstep() - s.frac;
+      // The tick that reaches the target ends the run of uniform ticks.
+      const Tick finish = first_true(1, n, [&](Tick i) { return distance_after(s.speed, r, i) >= remaining; });
+      n = std::min(n, finish - 1);
+      if (!s.braking && !p.infinite) {
+        // Braking is decided at the start of tick k+1 from the state after k ticks;
+        // braking_distance(v_k) + S(k) never decreases along a ramp toward MAX_SPEED.
+        auto brakes_after = [&](Tick k) {
+          const std::uint64_t v = speed_after(s.speed, r, k);
+          return v > floor && braking_distance(v, p) >= remaining - distance_after(s.speed, r, k);
+        };
+        if (brakes_after(0)) return 0;
+        n = std::min(n, first_true(1, n, brakes_after));
+      }
+      return n;
+    }
+  }
+  return 0;
+}
+
+void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return;
+  const std::uint64_t floor = p.floor_speed();
+  Rule r;
+  switch (s.activity) {
+    case Activity::stopping:
+      r = ramp(s.speed, floor, p);
+      break;
+    case Activity::run:
+    case Activity::go_until:
+    case Activity::release_sw:
+      r = s.reversing ? ramp(s.speed, floor, p) : ramp(s.speed, constant_speed_target(s, p), p);
+      break;
+    case Activity::position:
+      if (s.reversing)
+        r = ramp(s.speed, floor, p);
+      else if (s.braking)
+        r = s.speed > floor ? ramp(s.speed, floor, p) : Rule{true, 0, 0, kNever};
+      else
+        r = ramp(s.speed, p.max_speed, p);
+      break;
+    default:
+      return;
+  }
+  const u128 total = s.frac + distance_after(s.speed, r, n);
+  const u128 steps = total / p.microstep();
+  s.frac = static_cast<std::uint64_t>(total % p.microstep());
+  s.speed = speed_after(s.speed, r, n);
+  if (steps == 0) return;
+  const std::uint32_t mod22 = static_cast<std::uint32_t>(steps & 0x3FFFFF);
+  const std::uint32_t mod512 = static_cast<std::uint32_t>(steps & 0x1FF);
+  const std::uint32_t pos = static_cast<std::uint32_t>(s.abs_pos) + (s.dir ? mod22 : 0x400000u - mod22);
+  s.abs_pos = sign_extend(pos & 0x3FFFFF, 22);
+  const std::uint32_t el = mod512 * p.el_increment();
+  s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? el : 512u * 128u - el)) & 0x1FF);
+  if (s.activity == Activity::position && !s.reversing) s.steps_left -= static_cast<std::uint32_t>(steps);
+}
+
+void fast_advance(MotionState& s, const Profile& p, Tick ticks) {
+  while (ticks > 0 && motion_active(s)) {
+    const Tick n = uniform_ticks(s, p, ticks);
+    apply_uniform_ticks(s, p, n);
+    ticks -= n;
+    if (ticks == 0) break;
+    reference_tick(s, p);
+    --ticks;
+  }
+}
+
+}  // namespace l6470emu
