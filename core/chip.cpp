@@ -29,6 +29,7 @@ Chip::Chip(const Variant& variant, Quirks quirks) : variant_(&variant), quirks_(
 // ---------------------------------------------------------------- reset
 
 void Chip::reset_logic() {
+  uniform_known_ = false;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
   const std::int32_t keep_nothing = 0;
   motion_ = MotionState{};
@@ -43,7 +44,9 @@ void Chip::reset_logic() {
   switch_act_ = false;
   // Any logic reset forces the UVLO flag active; ongoing faults show at once.
   latched_ = condition_;
+  latched_changed();
   latched_.uvlo = true;
+  latched_changed();
 }
 
 void Chip::come_out_of_reset() {
@@ -56,7 +59,9 @@ void Chip::come_out_of_reset() {
 
 std::uint8_t Chip::on_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
-  if (collecting_) {
+  if (byte == 0x00 && !collecting_) {
+    // NOP: only clocks a pending answer on.
+  } else if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
       collecting_ = false;
@@ -104,6 +109,9 @@ void Chip::load_response(std::uint32_t value, std::uint8_t bytes) {
 }
 
 void Chip::execute(const Opcode& op, std::uint32_t arg) {
+  // Reading commands leave the motion as it is; everything else may change it.
+  if (op.command != Command::GetStatus && op.command != Command::GetParam && op.command != Command::NOP)
+    uniform_known_ = false;
   switch (op.command) {
     case Command::NOP:
       return;
@@ -284,32 +292,42 @@ std::uint32_t Chip::register_value(const RegisterInfo& r) const {
 LiveStatus Chip::live_status() const {
   LiveStatus l;
   l.hiz = motion_.hiz;
-  l.busy = motion_busy(motion_, profile_);
+  const MotionFlags f = motion_flags(motion_, profile_);
+  l.busy = f.busy;
   l.sw_closed = !sw_level_;
   l.forward = motion_.dir;
   l.step_clock = motion_.activity == Activity::step_clock;
-  l.mot = mot_status(motion_, profile_);
+  l.mot = f.mot;
   return l;
 }
 
 std::uint16_t Chip::status() const {
   if (!stby_level_) return 0;
-  return encode_status(variant_->status, latched_, live_status());
+  return static_cast<std::uint16_t>(latched_bits_ | encode_live(variant_->status, live_status()));
 }
 
+void Chip::latched_changed() { latched_bits_ = encode_latched(variant_->status, latched_); }
+
+
+
 void Chip::clear_status_on_get_status() {
-  latched_ = condition_;
+  if (!(latched_ == condition_)) {
+    latched_ = condition_;
+    latched_changed();
+  }
   // GetStatus also lets the bridges be enabled again once the overcurrent is gone.
   if (!condition_.ocd) ocd_shutdown_ = false;
 }
 
 void Chip::wrong_command(std::uint8_t byte, const char* why) {
   latched_.wrong_cmd = true;
+  latched_changed();
   if (sink_) sink_({now_, DiagnosticKind::wrong_cmd, "byte " + hex(byte, 2) + ": " + why});
 }
 
 void Chip::not_performable(const char* what) {
   latched_.notperf_cmd = true;
+  latched_changed();
   if (sink_) sink_({now_, DiagnosticKind::notperf_cmd, what});
 }
 
@@ -317,8 +335,28 @@ void Chip::not_performable(const char* what) {
 
 void Chip::advance_to(Tick tick) {
   if (tick <= now_) return;
-  if (motion_active(motion_)) motion_advance(engine_, motion_, profile_, tick - now_);
+  Tick left = tick - now_;
   now_ = tick;
+  if (engine_ == MotionEngine::reference) {
+    reference_advance(motion_, profile_, left);
+    return;
+  }
+  // fast_advance(), remembering the length of the current run of uniform ticks
+  // between calls so that frequent polling does not search for it again.
+  while (left > 0 && motion_active(motion_)) {
+    if (!uniform_known_) {
+      uniform_left_ = uniform_ticks(motion_, profile_, kNever - 1);
+      uniform_known_ = true;
+    }
+    const Tick n = std::min(uniform_left_, left);
+    apply_uniform_ticks(motion_, profile_, n);
+    uniform_left_ -= n;
+    left -= n;
+    if (left == 0) break;
+    reference_tick(motion_, profile_);
+    --left;
+    uniform_known_ = false;
+  }
 }
 
 Tick Chip::next_event_tick() const { return motion_active(motion_) ? now_ + 1 : kNever; }
@@ -360,6 +398,7 @@ bool Chip::flag_pin() const {
 }
 
 void Chip::set_sw_pin(bool level) {
+  uniform_known_ = false;
   if (level == sw_level_) return;
   sw_level_ = level;
   if (!stby_level_) return;
@@ -371,6 +410,7 @@ void Chip::set_sw_pin(bool level) {
 
 void Chip::switch_turn_on_event() {
   latched_.sw_evn = true;
+  latched_changed();
   const bool sw_mode = (regs_[variant_->find(Reg::CONFIG)->address] & kConfigSwMode) != 0;
   if (motion_.activity == Activity::go_until) {
     if (switch_act_)
@@ -397,12 +437,14 @@ void Chip::switch_release_event() {
 }
 
 void Chip::set_stck_pin(bool level) {
+  uniform_known_ = false;
   const bool rising = level && !stck_level_;
   stck_level_ = level;
   if (rising && stby_level_ && motion_.activity == Activity::step_clock) take_microstep(motion_, profile_);
 }
 
 void Chip::set_stby_rst_pin(bool level) {
+  uniform_known_ = false;
   if (level == stby_level_) return;
   stby_level_ = level;
   reset_logic();
@@ -422,28 +464,35 @@ void Chip::apply_forced_hiz() {
 }
 
 void Chip::set_undervoltage(bool active) {
+  uniform_known_ = false;
   condition_.uvlo = active;
   if (!stby_level_) return;
   if (active) latched_.uvlo = true;
+  latched_changed();
   apply_forced_hiz();
 }
 
 void Chip::set_adc_undervoltage(bool active) {
   condition_.uvlo_adc = active;
   if (stby_level_ && active) latched_.uvlo_adc = true;
+  latched_changed();
 }
 
 void Chip::set_thermal(Thermal t) {
+  uniform_known_ = false;
   condition_.thermal = t;
   if (!stby_level_) return;
   latched_.thermal = std::max(latched_.thermal, t);
+  latched_changed();
   apply_forced_hiz();
 }
 
 void Chip::set_overcurrent(bool active) {
+  uniform_known_ = false;
   condition_.ocd = active;
   if (!stby_level_ || !active) return;
   latched_.ocd = true;
+  latched_changed();
   if ((regs_[variant_->find(Reg::CONFIG)->address] & kConfigOcSd) != 0) ocd_shutdown_ = true;
   apply_forced_hiz();
 }
@@ -452,6 +501,7 @@ void Chip::set_stall(Bridge bridge, bool active) {
   (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
   if (!stby_level_ || !active) return;
   (bridge == Bridge::A ? latched_.stall_a : latched_.stall_b) = true;
+  latched_changed();
 }
 
 // ---------------------------------------------------------------- inspection

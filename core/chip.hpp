@@ -38,6 +38,9 @@ class Chip {
   /// pending). In standby the byte is ignored and 0x00 is returned.
   std::uint8_t on_byte(std::uint8_t byte);
 
+  /// Whether the decoder is in the middle of a command (collecting argument bytes).
+  bool collecting_arguments() const { return collecting_; }
+
   /// Whether the chip takes part in SPI (false while STBY/RST is held low).
   bool spi_enabled() const { return stby_level_; }
 
@@ -144,8 +147,14 @@ class Chip {
 
   MotionState motion_{};
   Profile profile_{};
+  // Fast engine: uniform ticks left from now_, valid until a command, pin or fault changes things.
+  Tick uniform_left_ = 0;
+  bool uniform_known_ = false;
+
+  void latched_changed();
 
   AlarmFlags latched_{};   // what STATUS shows
+  std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
   AlarmFlags condition_{}; // what is physically going on (events are never conditions)
   bool ocd_shutdown_ = false;  // bridges held off by OCD until GetStatus releases it
   bool switch_act_ = false;    // ACT of the GoUntil/ReleaseSW in progress

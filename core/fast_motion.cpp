@@ -164,8 +164,9 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
       return;
   }
   const u128 total = s.frac + distance_after(s.speed, r, n);
-  const u128 steps = total / p.microstep();
-  s.frac = static_cast<std::uint64_t>(total % p.microstep());
+  const unsigned shift = 40u - p.step_sel;  // a microstep is 2^shift
+  const u128 steps = total >> shift;
+  s.frac = static_cast<std::uint64_t>(total) & (p.microstep() - 1);
   s.speed = speed_after(s.speed, r, n);
   if (steps == 0) return;
   const std::uint32_t mod22 = static_cast<std::uint32_t>(steps & 0x3FFFFF);

@@ -121,6 +121,23 @@ MotStatus mot_status(const MotionState& s, const Profile& p) {
   return MotStatus::stopped;
 }
 
+MotionFlags motion_flags(const MotionState& s, const Profile& p) {
+  switch (s.activity) {
+    case Activity::idle:
+    case Activity::step_clock:
+      return {MotStatus::stopped, false};
+    case Activity::run: {
+      if (s.reversing) return {MotStatus::deceleration, true};
+      const std::uint64_t t = constant_speed_target(s, p);
+      if (s.speed < t) return {MotStatus::acceleration, true};
+      if (s.speed > t) return {MotStatus::deceleration, true};
+      return {MotStatus::constant_speed, false};
+    }
+    default:
+      return {mot_status(s, p), true};
+  }
+}
+
 bool motion_busy(const MotionState& s, const Profile& p) {
   switch (s.activity) {
     case Activity::idle:
@@ -132,12 +149,6 @@ bool motion_busy(const MotionState& s, const Profile& p) {
       return true;
   }
 }
-
-bool motor_stopped(const MotionState& s) {
-  return s.activity == Activity::idle || s.activity == Activity::step_clock;
-}
-
-bool motion_active(const MotionState& s) { return !motor_stopped(s); }
 
 unsigned __int128 braking_distance(std::uint64_t v, const Profile& p) {
   const std::uint64_t f = p.floor_speed();

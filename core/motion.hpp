@@ -88,8 +88,14 @@ MotStatus mot_status(const MotionState& s, const Profile& p);
 /// Whether a constant-speed, positioning, motion or stop command keeps BUSY low.
 bool motion_busy(const MotionState& s, const Profile& p);
 
+/// MOT_STATUS and BUSY together (what STATUS and the BUSY pin need), in one pass.
+struct MotionFlags { MotStatus mot; bool busy; };
+MotionFlags motion_flags(const MotionState& s, const Profile& p);
+
 /// Whether the motor counts as stopped (Move, StepClock and WS registers accept only then).
-bool motor_stopped(const MotionState& s);
+inline bool motor_stopped(const MotionState& s) {
+  return s.activity == Activity::idle || s.activity == Activity::step_clock;
+}
 
 /// Distance covered while braking from `v` to the profile floor, one tick at a time,
 /// in 2^-40 step (the rule positioning uses to decide when to start decelerating).
@@ -123,6 +129,6 @@ void reference_tick(MotionState& s, const Profile& p);
 void reference_advance(MotionState& s, const Profile& p, Tick ticks);
 
 /// Whether the state changes on its own as time passes.
-bool motion_active(const MotionState& s);
+inline bool motion_active(const MotionState& s) { return !motor_stopped(s); }
 
 }  // namespace l6470emu

@@ -12,14 +12,20 @@ bool get(std::uint16_t word, std::int8_t bit) { return bit >= 0 && ((word >> bit
 
 }  // namespace
 
-std::uint16_t encode_status(const StatusLayout& l, const AlarmFlags& a, const LiveStatus& live) {
-  std::uint16_t w = l.unused_ones;
+std::uint16_t encode_live(const StatusLayout& l, const LiveStatus& live) {
+  std::uint16_t w = 0;
   put(w, l.hiz, live.hiz);
   put(w, l.busy, !live.busy);
   put(w, l.sw_f, live.sw_closed);
-  put(w, l.sw_evn, a.sw_evn);
   put(w, l.dir, live.forward);
   if (l.mot_status >= 0) w = static_cast<std::uint16_t>(w | (static_cast<unsigned>(live.mot) << l.mot_status));
+  put(w, l.sck_mod, live.step_clock);
+  return w;
+}
+
+std::uint16_t encode_latched(const StatusLayout& l, const AlarmFlags& a) {
+  std::uint16_t w = l.unused_ones;
+  put(w, l.sw_evn, a.sw_evn);
   put(w, l.notperf_cmd, a.notperf_cmd);
   put(w, l.wrong_cmd, a.wrong_cmd);
   put(w, l.uvlo, !a.uvlo);
@@ -30,7 +36,6 @@ std::uint16_t encode_status(const StatusLayout& l, const AlarmFlags& a, const Li
   put(w, l.ocd, !a.ocd);
   put(w, l.step_loss_a, !a.stall_a);
   put(w, l.step_loss_b, !a.stall_b);
-  put(w, l.sck_mod, live.step_clock);
   return w;
 }
 

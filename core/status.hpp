@@ -39,8 +39,16 @@ struct LiveStatus {
   MotStatus mot = MotStatus::stopped;
 };
 
+/// Encodes the latched flags of STATUS in `layout` (the live fields read as 0).
+std::uint16_t encode_latched(const StatusLayout& layout, const AlarmFlags& latched);
+
+/// Encodes the live fields of STATUS in `layout` (the latched flags read as 0).
+std::uint16_t encode_live(const StatusLayout& layout, const LiveStatus& live);
+
 /// Encodes STATUS in `layout`.
-std::uint16_t encode_status(const StatusLayout& layout, const AlarmFlags& latched, const LiveStatus& live);
+inline std::uint16_t encode_status(const StatusLayout& layout, const AlarmFlags& latched, const LiveStatus& live) {
+  return static_cast<std::uint16_t>(encode_latched(layout, latched) | encode_live(layout, live));
+}
 
 /// Names of the notable STATUS conditions, e.g. "HiZ UVLO" (for dumps and logs).
 std::string describe_status(const StatusLayout& layout, std::uint16_t status);

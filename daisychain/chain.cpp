@@ -20,7 +20,12 @@ void Chain::select() {
   if (selected_) return;
   selected_ = true;
   bytes_in_frame_ = 0;
-  standby_in_frame_ = any_in_standby();
+  if (chips_touched_) {
+    // Someone may have moved a STBY pin through chip(); look again.
+    any_standby_ = any_in_standby();
+    chips_touched_ = false;
+  }
+  standby_in_frame_ = any_standby_;
 }
 
 bool Chain::any_in_standby() const {
@@ -45,7 +50,21 @@ std::uint8_t Chain::exchange(std::uint8_t mosi) {
 }
 
 void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
+  if (!selected_ || standby_in_frame_) {
+    for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
+    return;
+  }
+  // The common case: a plain shift of the ring buffer.
+  const std::size_t n = ring_.size();
+  std::uint8_t* ring = ring_.data();
+  std::size_t head = head_;
+  for (std::size_t i = 0; i < tx.size(); ++i) {
+    rx[i] = ring[head];
+    ring[head] = tx[i];
+    if (++head == n) head = 0;
+  }
+  head_ = head;
+  bytes_in_frame_ += tx.size();
 }
 
 void Chain::deselect() {
@@ -53,13 +72,20 @@ void Chain::deselect() {
   selected_ = false;
   // A CS pulse without clocks leaves the shift registers as they are: nothing is decoded.
   if (bytes_in_frame_ == 0) return;
-  for (std::size_t i = 0; i < chips_.size(); ++i) set_shift_register(i, chips_[i].on_byte(shift_register(i)));
+  const std::size_t n = chips_.size();
+  std::size_t slot = head_;
+  for (std::size_t i = 0; i < n; ++i) {
+    Chip& c = chips_[i];
+    const std::uint8_t byte = ring_[slot];
+    // A NOP outside a command only clocks an answer on; it needs no up-to-date state.
+    if (byte != 0x00 || c.collecting_arguments()) c.advance_to(now_);
+    ring_[slot] = c.on_byte(byte);
+    slot = slot + 1 == n ? 0 : slot + 1;
+  }
 }
 
 void Chain::advance_to(Tick tick) {
-  if (tick <= now_) return;
-  for (auto& c : chips_) c.advance_to(tick);
-  now_ = tick;
+  if (tick > now_) now_ = tick;
 }
 
 void Chain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
@@ -76,7 +102,7 @@ std::vector<std::uint8_t> Chain::frame(std::span<const std::uint8_t> tx) {
 
 Tick Chain::next_event_tick() const {
   Tick t = kNever;
-  for (const auto& c : chips_) t = std::min(t, c.next_event_tick());
+  for (std::size_t i = 0; i < chips_.size(); ++i) t = std::min(t, chip(i).next_event_tick());
   return t;
 }
 

@@ -26,8 +26,13 @@ class Chain final : public SpiDevice {
   Chain(std::size_t n, const Variant& variant = l6470(), Quirks quirks = {});
 
   std::size_t size() const { return chips_.size(); }
-  Chip& chip(std::size_t i) { return chips_.at(i); }
-  const Chip& chip(std::size_t i) const { return chips_.at(i); }
+  /// Chip `i`, brought up to the chain's time first (chips advance lazily).
+  Chip& chip(std::size_t i) const {
+    Chip& c = chips_.at(i);
+    chips_touched_ = true;
+    c.advance_to(now_);
+    return c;
+  }
 
   // SpiDevice
   void select() override;
@@ -45,7 +50,7 @@ class Chain final : public SpiDevice {
 
   /// Chooses the motion engine of every chip (the event-driven one is the default).
   void set_motion_engine(MotionEngine e) {
-    for (auto& c : chips_) c.set_motion_engine(e);
+    for (std::size_t i = 0; i < chips_.size(); ++i) chip(i).set_motion_engine(e);
   }
 
   /// The earliest next_event_tick() of the chips.
@@ -59,11 +64,15 @@ class Chain final : public SpiDevice {
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
 
-  std::vector<Chip> chips_;
+  // Chips are advanced lazily: when they decode a byte that needs their state,
+  // or when someone looks at them through chip(). Hence mutable.
+  mutable std::vector<Chip> chips_;
   std::vector<std::uint8_t> ring_;  // shift registers; logical register i is ring_[(head_ + i) % N]
   std::size_t head_ = 0;
   bool selected_ = false;
   bool standby_in_frame_ = false;  // some chip was in standby at the CS falling edge
+  mutable bool chips_touched_ = true;  // chip() handed out a chip since the last look at STBY pins
+  bool any_standby_ = false;
   std::uint64_t bytes_in_frame_ = 0;
   Tick now_ = 0;
 };
