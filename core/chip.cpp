@@ -480,6 +480,8 @@ void Chip::set_adc_undervoltage(bool active) {
 
 void Chip::set_thermal(Thermal t) {
   uniform_known_ = false;
+  // Shutdown has hysteresis: it only ends once the die is back below the warning level.
+  if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
   condition_.thermal = t;
   if (!stby_level_) return;
   latched_.thermal = std::max(latched_.thermal, t);

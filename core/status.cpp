@@ -69,8 +69,8 @@ std::string describe_status(const StatusLayout& l, std::uint16_t s) {
     if (const auto t = (s >> l.th_status) & 3u; t != 0) add(kTh[t]);
   }
   if (l.ocd >= 0 && !get(s, l.ocd)) add("OCD");
-  if (l.step_loss_a >= 0 && !get(s, l.step_loss_a)) add("STALL_A");
-  if (l.step_loss_b >= 0 && !get(s, l.step_loss_b)) add("STALL_B");
+  if (l.step_loss_a >= 0 && !get(s, l.step_loss_a)) add(std::string(l.step_loss_a_name).c_str());
+  if (l.step_loss_b >= 0 && !get(s, l.step_loss_b)) add(std::string(l.step_loss_b_name).c_str());
   if (get(s, l.sck_mod)) add("SCK_MOD");
   return out;
 }

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string_view>
 
 namespace l6470emu {
 
@@ -28,6 +29,8 @@ struct StatusLayout {
   std::int8_t step_loss_b = 14;  ///< active low (STALL_B on the gate-driver parts)
   std::int8_t sck_mod = 15;      ///< SCK_MOD / STCK_MOD
   std::uint16_t unused_ones = 0; ///< bits without a field that read as 1
+  std::string_view step_loss_a_name = "STEP_LOSS_A";  ///< datasheet name of the bridge-A stall flag
+  std::string_view step_loss_b_name = "STEP_LOSS_B";  ///< datasheet name of the bridge-B stall flag
 };
 
 /// The conditions an ALARM_EN bit can enable on the FLAG pin.

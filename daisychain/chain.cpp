@@ -26,6 +26,10 @@ void Chain::select() {
     chips_touched_ = false;
   }
   standby_in_frame_ = any_standby_;
+  // A chip in standby drives 0x00 and holds nothing it could pass on.
+  if (standby_in_frame_)
+    for (std::size_t i = 0; i < chips_.size(); ++i)
+      if (!chips_[i].spi_enabled()) set_shift_register(i, 0x00);
 }
 
 bool Chain::any_in_standby() const {
