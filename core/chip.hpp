@@ -78,7 +78,8 @@ class Chip {
   void set_undervoltage(bool active);
   /// ADC input undervoltage (UVLO_ADC, gate-driver parts).
   void set_adc_undervoltage(bool active);
-  /// Die temperature class.
+  /// Die temperature class of the physical die. The chip applies the hysteresis itself: a
+  /// shutdown only ends when the die is back to `normal` (below the warning threshold).
   void set_thermal(Thermal t);
   /// Overcurrent in a power MOSFET; with CONFIG.OC_SD the bridges shut down.
   void set_overcurrent(bool active);

@@ -26,7 +26,8 @@ class Chain final : public SpiDevice {
   Chain(std::size_t n, const Variant& variant = l6470(), Quirks quirks = {});
 
   std::size_t size() const { return chips_.size(); }
-  /// Chip `i`, brought up to the chain's time first (chips advance lazily).
+  /// Chip `i`, brought up to the chain's time first (chips advance lazily). The reference
+  /// shows the chip as of this call: after the chain's time moves on, call chip(i) again.
   Chip& chip(std::size_t i) const {
     Chip& c = chips_.at(i);
     chips_touched_ = true;
