@@ -29,7 +29,7 @@ Chip::Chip(const Variant& variant, Quirks quirks) : variant_(&variant), quirks_(
 // ---------------------------------------------------------------- reset
 
 void Chip::reset_logic() {
-  uniform_known_ = false;
+  touched();
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
   const std::int32_t keep_nothing = 0;
   motion_ = MotionState{};
@@ -57,37 +57,33 @@ void Chip::come_out_of_reset() {
 
 // ---------------------------------------------------------------- SPI
 
-std::uint8_t Chip::on_byte(std::uint8_t byte) {
+std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
-  if (byte == 0x00 && !collecting_) {
-    // NOP: only clocks a pending answer on.
-  } else if (collecting_) {
+  if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
       collecting_ = false;
       execute(pending_, arg_);
     }
-  } else {
-    Opcode op = classify_opcode(byte);
-    bool valid = true;
-    if (op.command == Command::SetParam || op.command == Command::GetParam) {
-      const RegisterInfo* r = variant_->at_address(op.param);
-      if (r == nullptr) {
-        wrong_command(byte, "no register at this address");
-        valid = false;
-      } else if (op.command == Command::SetParam) {
-        if (r->access == Access::R && quirks_.read_only_write == ReadOnlyWrite::wrong_cmd_at_command_byte) {
-          wrong_command(byte, "SetParam of a read-only register");
-          valid = false;
-        } else {
-          op.arg_bytes = r->spi_bytes();
-        }
+    return next_response_byte();
+  }
+  const Opcode& op = variant_->opcodes[byte];
+  switch (op.command) {
+    case Command::Unknown:
+      wrong_command(byte, classify_opcode(byte).command == Command::Unknown ? "no such command"
+                                                                            : "no register at this address");
+      break;
+    case Command::Reserved:
+      wrong_command(byte, "reserved opcode");
+      break;
+    case Command::SetParam:
+      if (variant_->at_address(op.param)->access == Access::R &&
+          quirks_.read_only_write == ReadOnlyWrite::wrong_cmd_at_command_byte) {
+        wrong_command(byte, "SetParam of a read-only register");
+        break;
       }
-    } else if (op.command == Command::Unknown || op.command == Command::Reserved) {
-      wrong_command(byte, op.command == Command::Reserved ? "reserved opcode" : "no such command");
-      valid = false;
-    }
-    if (valid) {
+      [[fallthrough]];
+    default:
       if (op.arg_bytes > 0) {
         pending_ = op;
         collecting_ = true;
@@ -96,11 +92,9 @@ std::uint8_t Chip::on_byte(std::uint8_t byte) {
       } else {
         execute(op, 0);
       }
-    }
+      break;
   }
-  if (response_left_ == 0) return 0x00;
-  --response_left_;
-  return static_cast<std::uint8_t>(response_ >> (8 * response_left_));
+  return next_response_byte();
 }
 
 void Chip::load_response(std::uint32_t value, std::uint8_t bytes) {
@@ -111,7 +105,7 @@ void Chip::load_response(std::uint32_t value, std::uint8_t bytes) {
 void Chip::execute(const Opcode& op, std::uint32_t arg) {
   // Reading commands leave the motion as it is; everything else may change it.
   if (op.command != Command::GetStatus && op.command != Command::GetParam && op.command != Command::NOP)
-    uniform_known_ = false;
+    touched();
   switch (op.command) {
     case Command::NOP:
       return;
@@ -303,7 +297,11 @@ LiveStatus Chip::live_status() const {
 
 std::uint16_t Chip::status() const {
   if (!stby_level_) return 0;
-  return static_cast<std::uint16_t>(latched_bits_ | encode_live(variant_->status, live_status()));
+  if (!live_bits_known_) {
+    live_bits_ = encode_live(variant_->status, live_status());
+    live_bits_known_ = true;
+  }
+  return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
 }
 
 void Chip::latched_changed() { latched_bits_ = encode_latched(variant_->status, latched_); }
@@ -338,6 +336,7 @@ void Chip::advance_to(Tick tick) {
   Tick left = tick - now_;
   now_ = tick;
   if (engine_ == MotionEngine::reference) {
+    if (motion_active(motion_)) live_bits_known_ = false;
     reference_advance(motion_, profile_, left);
     return;
   }
@@ -355,7 +354,7 @@ void Chip::advance_to(Tick tick) {
     if (left == 0) break;
     reference_tick(motion_, profile_);
     --left;
-    uniform_known_ = false;
+    touched();
   }
 }
 
@@ -398,7 +397,7 @@ bool Chip::flag_pin() const {
 }
 
 void Chip::set_sw_pin(bool level) {
-  uniform_known_ = false;
+  touched();
   if (level == sw_level_) return;
   sw_level_ = level;
   if (!stby_level_) return;
@@ -437,14 +436,14 @@ void Chip::switch_release_event() {
 }
 
 void Chip::set_stck_pin(bool level) {
-  uniform_known_ = false;
+  touched();
   const bool rising = level && !stck_level_;
   stck_level_ = level;
   if (rising && stby_level_ && motion_.activity == Activity::step_clock) take_microstep(motion_, profile_);
 }
 
 void Chip::set_stby_rst_pin(bool level) {
-  uniform_known_ = false;
+  touched();
   if (level == stby_level_) return;
   stby_level_ = level;
   reset_logic();
@@ -464,7 +463,7 @@ void Chip::apply_forced_hiz() {
 }
 
 void Chip::set_undervoltage(bool active) {
-  uniform_known_ = false;
+  touched();
   condition_.uvlo = active;
   if (!stby_level_) return;
   if (active) latched_.uvlo = true;
@@ -479,7 +478,7 @@ void Chip::set_adc_undervoltage(bool active) {
 }
 
 void Chip::set_thermal(Thermal t) {
-  uniform_known_ = false;
+  touched();
   // Shutdown has hysteresis: it only ends once the die is back below the warning level.
   if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
   condition_.thermal = t;
@@ -490,7 +489,7 @@ void Chip::set_thermal(Thermal t) {
 }
 
 void Chip::set_overcurrent(bool active) {
-  uniform_known_ = false;
+  touched();
   condition_.ocd = active;
   if (!stby_level_ || !active) return;
   latched_.ocd = true;

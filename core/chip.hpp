@@ -36,7 +36,10 @@ class Chip {
   /// The byte in the chip's shift register at a CS rising edge: decode it and
   /// return the byte the chip loads for the next transfer (0x00 with no response
   /// pending). In standby the byte is ignored and 0x00 is returned.
-  std::uint8_t on_byte(std::uint8_t byte);
+  std::uint8_t on_byte(std::uint8_t byte) {
+    if (byte == 0x00 && !collecting_ && stby_level_) return next_response_byte();  // NOP
+    return decode_byte(byte);
+  }
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
   bool collecting_arguments() const { return collecting_; }
@@ -109,6 +112,12 @@ class Chip {
   void set_diagnostic_sink(DiagnosticSink sink) { sink_ = std::move(sink); }
 
  private:
+  std::uint8_t decode_byte(std::uint8_t byte);
+  std::uint8_t next_response_byte() {
+    if (response_left_ == 0) return 0x00;
+    --response_left_;
+    return static_cast<std::uint8_t>(response_ >> (8 * response_left_));
+  }
   void reset_logic();
   void come_out_of_reset();
   void execute(const Opcode& op, std::uint32_t arg);
@@ -151,6 +160,15 @@ class Chip {
   // Fast engine: uniform ticks left from now_, valid until a command, pin or fault changes things.
   Tick uniform_left_ = 0;
   bool uniform_known_ = false;
+  // The live half of STATUS, valid until the motion leaves its run of uniform ticks
+  // (MOT_STATUS, BUSY, DIR, HiZ, SW_F and SCK_MOD cannot change inside one).
+  mutable std::uint16_t live_bits_ = 0;
+  mutable bool live_bits_known_ = false;
+  /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
+  void touched() {
+    uniform_known_ = false;
+    live_bits_known_ = false;
+  }
 
   void latched_changed();
 

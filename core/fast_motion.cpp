@@ -27,8 +27,8 @@ struct Rule {
 
 Tick ceil_div(std::uint64_t a, std::uint64_t b) { return (a + b - 1) / b; }
 
-/// A ramp from v toward t as approach() does it.
-Rule ramp(std::uint64_t v, std::uint64_t t, const Profile& p) {
+/// A ramp from v toward t as approach() does it; the cap (a division) only when asked for.
+Rule ramp(std::uint64_t v, std::uint64_t t, const Profile& p, bool with_cap = true) {
   Rule r;
   r.valid = true;
   if (v == t) return r;
@@ -37,12 +37,12 @@ Rule ramp(std::uint64_t v, std::uint64_t t, const Profile& p) {
     if (p.acc == 0) return r;  // ACC = 0 would never get there: constant
     r.sign = +1;
     r.delta = p.acc;
-    r.cap = ceil_div(t - v, p.acc);
+    if (with_cap) r.cap = ceil_div(t - v, p.acc);
   } else {
     if (p.dec == 0) return r;
     r.sign = -1;
     r.delta = p.dec;
-    r.cap = ceil_div(v - t, p.dec);
+    if (with_cap) r.cap = ceil_div(v - t, p.dec);
   }
   return r;
 }
@@ -145,20 +145,20 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
   Rule r;
   switch (s.activity) {
     case Activity::stopping:
-      r = ramp(s.speed, floor, p);
+      r = ramp(s.speed, floor, p, false);
       break;
     case Activity::run:
     case Activity::go_until:
     case Activity::release_sw:
-      r = s.reversing ? ramp(s.speed, floor, p) : ramp(s.speed, constant_speed_target(s, p), p);
+      r = s.reversing ? ramp(s.speed, floor, p, false) : ramp(s.speed, constant_speed_target(s, p), p, false);
       break;
     case Activity::position:
       if (s.reversing)
-        r = ramp(s.speed, floor, p);
+        r = ramp(s.speed, floor, p, false);
       else if (s.braking)
-        r = s.speed > floor ? ramp(s.speed, floor, p) : Rule{true, 0, 0, kNever};
+        r = s.speed > floor ? ramp(s.speed, floor, p, false) : Rule{true, 0, 0, kNever};
       else
-        r = ramp(s.speed, p.max_speed, p);
+        r = ramp(s.speed, p.max_speed, p, false);
       break;
     default:
       return;

@@ -7,6 +7,7 @@
 #include <span>
 #include <string_view>
 
+#include "core/commands.hpp"
 #include "core/registers.hpp"
 #include "core/status_layout.hpp"
 
@@ -24,6 +25,9 @@ struct Variant {
   std::array<std::int8_t, 32> index_of_address{};
   /// Table index of each register id, -1 when the variant has no such register.
   std::array<std::int8_t, static_cast<std::size_t>(Reg::count)> index_of_reg{};
+  /// Every opcode byte decoded for this variant: SetParam/GetParam of an address the
+  /// variant lacks is Unknown, SetParam carries the register's SPI length.
+  std::array<Opcode, 256> opcodes{};
 
   /// The register at `address`, or nullptr when the variant has none there.
   constexpr const RegisterInfo* at_address(std::uint8_t address) const {
@@ -44,12 +48,23 @@ struct Variant {
 constexpr Variant make_variant(std::string_view name, std::span<const RegisterInfo> table,
                                StatusLayout status, AlarmLayout alarms,
                                std::uint8_t max_step_sel, bool infinite_acceleration) {
-  Variant v{name, table, status, alarms, max_step_sel, infinite_acceleration, {}, {}};
+  Variant v{name, table, status, alarms, max_step_sel, infinite_acceleration, {}, {}, {}};
   for (auto& i : v.index_of_address) i = -1;
   for (auto& i : v.index_of_reg) i = -1;
   for (std::size_t i = 0; i < table.size(); ++i) {
     v.index_of_address[table[i].address] = static_cast<std::int8_t>(i);
     v.index_of_reg[static_cast<std::size_t>(table[i].id)] = static_cast<std::int8_t>(i);
+  }
+  for (unsigned b = 0; b < 256; ++b) {
+    Opcode op = classify_opcode(static_cast<std::uint8_t>(b));
+    if (op.command == Command::SetParam || op.command == Command::GetParam) {
+      const RegisterInfo* r = v.at_address(op.param);
+      if (r == nullptr)
+        op.command = Command::Unknown;
+      else if (op.command == Command::SetParam)
+        op.arg_bytes = r->spi_bytes();
+    }
+    v.opcodes[b] = op;
   }
   return v;
 }

@@ -3,6 +3,8 @@
 // (their SDO floats; modelled as 0x00 and the bytes they receive are lost).
 #include "daisychain/chain.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -58,14 +60,18 @@ void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> r
     for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
     return;
   }
-  // The common case: a plain shift of the ring buffer.
+  // The common case: a plain shift of the ring buffer, a run of bytes at a time
+  // (what leaves the ring goes to MISO, what enters it comes from MOSI).
   const std::size_t n = ring_.size();
   std::uint8_t* ring = ring_.data();
   std::size_t head = head_;
-  for (std::size_t i = 0; i < tx.size(); ++i) {
-    rx[i] = ring[head];
-    ring[head] = tx[i];
-    if (++head == n) head = 0;
+  for (std::size_t i = 0; i < tx.size();) {
+    const std::size_t run = std::min(tx.size() - i, n - head);
+    std::memcpy(rx.data() + i, ring + head, run);
+    std::memcpy(ring + head, tx.data() + i, run);
+    i += run;
+    head += run;
+    if (head == n) head = 0;
   }
   head_ = head;
   bytes_in_frame_ += tx.size();
