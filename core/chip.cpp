@@ -59,6 +59,9 @@ void Chip::come_out_of_reset() {
 
 std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
+  // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
+  // the flags, which cannot have changed, so polling does not work the motion out.
+  if (collecting_ || byte != 0xD0 || !status_known_without_sync()) sync();
   if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
@@ -297,6 +300,7 @@ LiveStatus Chip::live_status() const {
 
 std::uint16_t Chip::status() const {
   if (!stby_level_) return 0;
+  if (!status_known_without_sync()) sync();
   if (!live_bits_known_) {
     live_bits_ = encode_live(variant_->status, live_status());
     live_bits_known_ = true;
@@ -331,12 +335,13 @@ void Chip::not_performable(const char* what) {
 
 // ---------------------------------------------------------------- time
 
-void Chip::advance_to(Tick tick) {
-  if (tick <= now_) return;
-  Tick left = tick - now_;
-  now_ = tick;
+void Chip::sync() const {
+  if (motion_now_ >= now_) return;
+  Tick left = now_ - motion_now_;
+  motion_now_ = now_;
+  if (!motion_active(motion_)) return;
   if (engine_ == MotionEngine::reference) {
-    if (motion_active(motion_)) live_bits_known_ = false;
+    live_bits_known_ = false;
     reference_advance(motion_, profile_, left);
     return;
   }
@@ -358,11 +363,12 @@ void Chip::advance_to(Tick tick) {
   }
 }
 
-Tick Chip::next_event_tick() const { return motion_active(motion_) ? now_ + 1 : kNever; }
+Tick Chip::next_event_tick() const { return motion_active(motion()) ? now_ + 1 : kNever; }
 
 // ---------------------------------------------------------------- pins
 
 bool Chip::busy_sync_pin() const {
+  sync();
   if (!stby_level_) return true;
   const std::uint32_t step_mode = regs_[variant_->find(Reg::STEP_MODE)->address];
   if ((step_mode & kStepModeSyncEn) != 0) {
@@ -397,6 +403,7 @@ bool Chip::flag_pin() const {
 }
 
 void Chip::set_sw_pin(bool level) {
+  sync();
   touched();
   if (level == sw_level_) return;
   sw_level_ = level;
@@ -436,6 +443,7 @@ void Chip::switch_release_event() {
 }
 
 void Chip::set_stck_pin(bool level) {
+  sync();
   touched();
   const bool rising = level && !stck_level_;
   stck_level_ = level;
@@ -443,6 +451,7 @@ void Chip::set_stck_pin(bool level) {
 }
 
 void Chip::set_stby_rst_pin(bool level) {
+  sync();
   touched();
   if (level == stby_level_) return;
   stby_level_ = level;
@@ -463,6 +472,7 @@ void Chip::apply_forced_hiz() {
 }
 
 void Chip::set_undervoltage(bool active) {
+  sync();
   touched();
   condition_.uvlo = active;
   if (!stby_level_) return;
@@ -478,6 +488,7 @@ void Chip::set_adc_undervoltage(bool active) {
 }
 
 void Chip::set_thermal(Thermal t) {
+  sync();
   touched();
   // Shutdown has hysteresis: it only ends once the die is back below the warning level.
   if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
@@ -489,6 +500,7 @@ void Chip::set_thermal(Thermal t) {
 }
 
 void Chip::set_overcurrent(bool active) {
+  sync();
   touched();
   condition_.ocd = active;
   if (!stby_level_ || !active) return;
@@ -508,16 +520,19 @@ void Chip::set_stall(Bridge bridge, bool active) {
 // ---------------------------------------------------------------- inspection
 
 std::uint32_t Chip::peek(Reg id) const {
+  sync();
   const RegisterInfo* r = variant_->find(id);
   return r ? register_value(*r) : 0;
 }
 
 std::uint32_t Chip::peek_address(std::uint8_t address) const {
+  sync();
   const RegisterInfo* r = variant_->at_address(address);
   return r ? register_value(*r) : 0;
 }
 
 std::string Chip::dump() const {
+  sync();
   std::string out;
   out += std::string(variant_->name) + " at tick " + std::to_string(now_) + (stby_level_ ? "" : " (in standby)") + "\n";
   for (const auto& r : variant_->registers) {

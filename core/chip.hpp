@@ -51,8 +51,11 @@ class Chip {
 
   /// The chip's current virtual time.
   Tick now() const { return now_; }
-  /// Runs the chip up to `tick` (never backwards; an earlier tick is ignored).
-  void advance_to(Tick tick);
+  /// Runs the chip up to `tick` (never backwards; an earlier tick is ignored). The motion
+  /// itself is worked out lazily, when something looks at it or a command needs it.
+  void advance_to(Tick tick) {
+    if (tick > now_) now_ = tick;
+  }
   /// The next tick at which the chip changes on its own (kNever when idle).
   Tick next_event_tick() const;
   /// Chooses the motion engine: the event-driven one (default) or the tick-by-tick reference.
@@ -98,13 +101,16 @@ class Chip {
   /// STATUS as GetParam(STATUS) reads it, without clearing anything.
   std::uint16_t status() const;
   /// ABS_POS as a signed number of (micro)steps.
-  std::int32_t position() const { return motion_.abs_pos; }
+  std::int32_t position() const { return motion().abs_pos; }
   /// The motion engine's state (speed in 2^-40 step/tick and so on).
-  const MotionState& motion() const { return motion_; }
+  const MotionState& motion() const {
+    sync();
+    return motion_;
+  }
   /// The profile the registers currently define.
   const Profile& profile() const { return profile_; }
   /// Whether the bridges are in high impedance.
-  bool hiz() const { return motion_.hiz; }
+  bool hiz() const { return motion().hiz; }
   /// Text dump of every register, STATUS decoded.
   std::string dump() const;
 
@@ -155,17 +161,25 @@ class Chip {
   std::uint32_t response_ = 0;
   std::uint8_t response_left_ = 0;
 
-  MotionState motion_{};
+  // Motion state as of motion_now_ (<= now_); sync() brings it up to now_.
+  mutable MotionState motion_{};
+  mutable Tick motion_now_ = 0;
   Profile profile_{};
-  // Fast engine: uniform ticks left from now_, valid until a command, pin or fault changes things.
-  Tick uniform_left_ = 0;
-  bool uniform_known_ = false;
+  // Fast engine: uniform ticks left from motion_now_, valid until a command, pin or fault changes things.
+  mutable Tick uniform_left_ = 0;
+  mutable bool uniform_known_ = false;
   // The live half of STATUS, valid until the motion leaves its run of uniform ticks
   // (MOT_STATUS, BUSY, DIR, HiZ, SW_F and SCK_MOD cannot change inside one).
   mutable std::uint16_t live_bits_ = 0;
   mutable bool live_bits_known_ = false;
+  /// Works the motion out up to now_.
+  void sync() const;
+  /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
+  bool status_known_without_sync() const {
+    return live_bits_known_ && (!motion_active(motion_) || (uniform_known_ && now_ - motion_now_ <= uniform_left_));
+  }
   /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
-  void touched() {
+  void touched() const {
     uniform_known_ = false;
     live_bits_known_ = false;
   }
