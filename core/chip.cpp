@@ -61,7 +61,13 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
   // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
   // the flags, which cannot have changed, so polling does not work the motion out.
-  if (collecting_ || byte != 0xD0 || !status_known_without_sync()) sync();
+  if (byte == 0xD0 && !collecting_) {
+    // GetStatus, the polling command, straight through.
+    load_response(status(), 2);
+    clear_status_on_get_status();
+    return next_response_byte();
+  }
+  sync();
   if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
@@ -308,14 +314,20 @@ std::uint16_t Chip::status() const {
   return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
 }
 
-void Chip::latched_changed() { latched_bits_ = encode_latched(variant_->status, latched_); }
+void Chip::latched_changed() {
+  latched_bits_ = encode_latched(variant_->status, latched_);
+  latched_clean_ = false;
+}
 
 
 
 void Chip::clear_status_on_get_status() {
-  if (!(latched_ == condition_)) {
-    latched_ = condition_;
-    latched_changed();
+  if (!latched_clean_) {
+    if (!(latched_ == condition_)) {
+      latched_ = condition_;
+      latched_changed();
+    }
+    latched_clean_ = true;
   }
   // GetStatus also lets the bridges be enabled again once the overcurrent is gone.
   if (!condition_.ocd) ocd_shutdown_ = false;
@@ -475,6 +487,7 @@ void Chip::set_undervoltage(bool active) {
   sync();
   touched();
   condition_.uvlo = active;
+  latched_clean_ = false;
   if (!stby_level_) return;
   if (active) latched_.uvlo = true;
   latched_changed();
@@ -483,6 +496,7 @@ void Chip::set_undervoltage(bool active) {
 
 void Chip::set_adc_undervoltage(bool active) {
   condition_.uvlo_adc = active;
+  latched_clean_ = false;
   if (stby_level_ && active) latched_.uvlo_adc = true;
   latched_changed();
 }
@@ -493,6 +507,7 @@ void Chip::set_thermal(Thermal t) {
   // Shutdown has hysteresis: it only ends once the die is back below the warning level.
   if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
   condition_.thermal = t;
+  latched_clean_ = false;
   if (!stby_level_) return;
   latched_.thermal = std::max(latched_.thermal, t);
   latched_changed();
@@ -503,6 +518,7 @@ void Chip::set_overcurrent(bool active) {
   sync();
   touched();
   condition_.ocd = active;
+  latched_clean_ = false;
   if (!stby_level_ || !active) return;
   latched_.ocd = true;
   latched_changed();
@@ -512,6 +528,7 @@ void Chip::set_overcurrent(bool active) {
 
 void Chip::set_stall(Bridge bridge, bool active) {
   (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
+  latched_clean_ = false;
   if (!stby_level_ || !active) return;
   (bridge == Bridge::A ? latched_.stall_a : latched_.stall_b) = true;
   latched_changed();

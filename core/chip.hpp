@@ -188,6 +188,7 @@ class Chip {
 
   AlarmFlags latched_{};   // what STATUS shows
   std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
+  bool latched_clean_ = false;      // latched_ == condition_ is known (GetStatus has nothing to clear)
   AlarmFlags condition_{}; // what is physically going on (events are never conditions)
   bool ocd_shutdown_ = false;  // bridges held off by OCD until GetStatus releases it
   bool switch_act_ = false;    // ACT of the GoUntil/ReleaseSW in progress
