@@ -106,11 +106,6 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   return next_response_byte();
 }
 
-void Chip::load_response(std::uint32_t value, std::uint8_t bytes) {
-  response_ = value;
-  response_left_ = bytes;
-}
-
 void Chip::execute(const Opcode& op, std::uint32_t arg) {
   // Reading commands leave the motion as it is; everything else may change it.
   if (op.command != Command::GetStatus && op.command != Command::GetParam && op.command != Command::NOP)
@@ -304,9 +299,8 @@ LiveStatus Chip::live_status() const {
   return l;
 }
 
-std::uint16_t Chip::status() const {
-  if (!stby_level_) return 0;
-  if (!status_known_without_sync()) sync();
+std::uint16_t Chip::status_slow() const {
+  sync();
   if (!live_bits_known_) {
     live_bits_ = encode_live(variant_->status, live_status());
     live_bits_known_ = true;
@@ -321,14 +315,12 @@ void Chip::latched_changed() {
 
 
 
-void Chip::clear_status_on_get_status() {
-  if (!latched_clean_) {
-    if (!(latched_ == condition_)) {
-      latched_ = condition_;
-      latched_changed();
-    }
-    latched_clean_ = true;
+void Chip::clear_latches() {
+  if (!(latched_ == condition_)) {
+    latched_ = condition_;
+    latched_changed();
   }
+  latched_clean_ = true;
   // GetStatus also lets the bridges be enabled again once the overcurrent is gone.
   if (!condition_.ocd) ocd_shutdown_ = false;
 }

@@ -99,7 +99,11 @@ class Chip {
   /// The value GetParam would return now for `address` (0 for a hole).
   std::uint32_t peek_address(std::uint8_t address) const;
   /// STATUS as GetParam(STATUS) reads it, without clearing anything.
-  std::uint16_t status() const;
+  std::uint16_t status() const {
+    if (!stby_level_) return 0;
+    if (!status_known_without_sync()) return status_slow();
+    return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+  }
   /// ABS_POS as a signed number of (micro)steps.
   std::int32_t position() const { return motion().abs_pos; }
   /// The motion engine's state (speed in 2^-40 step/tick and so on).
@@ -124,14 +128,21 @@ class Chip {
     --response_left_;
     return static_cast<std::uint8_t>(response_ >> (8 * response_left_));
   }
+  std::uint16_t status_slow() const;
   void reset_logic();
   void come_out_of_reset();
   void execute(const Opcode& op, std::uint32_t arg);
   void exec_set_param(std::uint8_t address, std::uint32_t value);
   void write_register(const RegisterInfo& r, std::uint32_t value);
-  void load_response(std::uint32_t value, std::uint8_t bytes);
+  void load_response(std::uint32_t value, std::uint8_t bytes) {
+    response_ = value;
+    response_left_ = bytes;
+  }
   void refresh_profile();
-  void clear_status_on_get_status();
+  void clear_status_on_get_status() {
+    if (!latched_clean_) clear_latches();
+  }
+  void clear_latches();
   bool hiz_forced() const;
   void apply_forced_hiz();
   void switch_turn_on_event();
@@ -144,8 +155,20 @@ class Chip {
   std::uint32_t register_value(const RegisterInfo& r) const;
 
   const Variant* variant_;
-  Quirks quirks_;
+  // Fields every SPI byte or GetStatus touches come first, to share cache lines.
   Tick now_ = 0;
+  std::uint32_t response_ = 0;
+  std::uint8_t response_left_ = 0;
+  bool collecting_ = false;
+  bool stby_level_ = true;
+  mutable bool live_bits_known_ = false;
+  mutable std::uint16_t live_bits_ = 0;
+  std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
+  bool latched_clean_ = false;      // latched_ == condition_ is known (GetStatus has nothing to clear)
+  mutable bool uniform_known_ = false;
+  mutable Tick uniform_left_ = 0;
+  mutable Tick motion_now_ = 0;
+  Quirks quirks_;
   MotionEngine engine_ = MotionEngine::fast;
 
   // register storage by address (live registers are computed)
@@ -153,25 +176,17 @@ class Chip {
 
   // decoder: opcode being collected and its argument bytes
   Opcode pending_{};
-  bool collecting_ = false;
   std::uint8_t args_seen_ = 0;
   std::uint32_t arg_ = 0;
 
   // response being shifted out, MSB first
-  std::uint32_t response_ = 0;
-  std::uint8_t response_left_ = 0;
 
   // Motion state as of motion_now_ (<= now_); sync() brings it up to now_.
   mutable MotionState motion_{};
-  mutable Tick motion_now_ = 0;
   Profile profile_{};
   // Fast engine: uniform ticks left from motion_now_, valid until a command, pin or fault changes things.
-  mutable Tick uniform_left_ = 0;
-  mutable bool uniform_known_ = false;
   // The live half of STATUS, valid until the motion leaves its run of uniform ticks
   // (MOT_STATUS, BUSY, DIR, HiZ, SW_F and SCK_MOD cannot change inside one).
-  mutable std::uint16_t live_bits_ = 0;
-  mutable bool live_bits_known_ = false;
   /// Works the motion out up to now_.
   void sync() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
@@ -187,15 +202,12 @@ class Chip {
   void latched_changed();
 
   AlarmFlags latched_{};   // what STATUS shows
-  std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
-  bool latched_clean_ = false;      // latched_ == condition_ is known (GetStatus has nothing to clear)
   AlarmFlags condition_{}; // what is physically going on (events are never conditions)
   bool ocd_shutdown_ = false;  // bridges held off by OCD until GetStatus releases it
   bool switch_act_ = false;    // ACT of the GoUntil/ReleaseSW in progress
 
   bool sw_level_ = true;
   bool stck_level_ = false;
-  bool stby_level_ = true;
   std::uint8_t adc_code_ = 0;
 
   DiagnosticSink sink_;
