@@ -21,7 +21,9 @@ std::string hex(std::uint32_t v, int digits) {
 
 }  // namespace
 
-Chip::Chip(const Variant& variant, Quirks quirks) : variant_(&variant), quirks_(quirks) {
+Chip::Chip(const Variant& variant, Quirks quirks)
+    : variant_(&variant), table_(&variant), quirks_(quirks), layout_(variant.status) {
+  if (quirks.stall_bits == StallBitOrder::a_on_15) std::swap(layout_.step_loss_a, layout_.step_loss_b);
   reset_logic();
   come_out_of_reset();
 }
@@ -30,6 +32,7 @@ Chip::Chip(const Variant& variant, Quirks quirks) : variant_(&variant), quirks_(
 
 void Chip::reset_logic() {
   touched();
+  table_ = variant_;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
   const std::int32_t keep_nothing = 0;
   motion_ = MotionState{};
@@ -86,7 +89,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
       wrong_command(byte, "reserved opcode");
       break;
     case Command::SetParam:
-      if (variant_->at_address(op.param)->access == Access::R &&
+      if (table_->at_address(op.param)->access == Access::R &&
           quirks_.read_only_write == ReadOnlyWrite::wrong_cmd_at_command_byte) {
         wrong_command(byte, "SetParam of a read-only register");
         break;
@@ -117,7 +120,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       exec_set_param(op.param, arg);
       return;
     case Command::GetParam: {
-      const RegisterInfo& r = *variant_->at_address(op.param);
+      const RegisterInfo& r = *table_->at_address(op.param);
       load_response(register_value(r), r.spi_bytes());
       return;
     }
@@ -163,7 +166,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       if (op.command == Command::GoTo || op.command == Command::GoTo_DIR)
         target = sign_extend(arg & kPosMask, 22);
       else if (op.command == Command::GoMark)
-        target = sign_extend(regs_[variant_->find(Reg::MARK)->address], 22);
+        target = sign_extend(reg(Reg::MARK), 22);
       if (op.command == Command::GoTo_DIR) {
         start_positioning(motion_, profile_, op.dir, target, directed_distance(motion_.abs_pos, target, op.dir));
       } else {
@@ -176,6 +179,8 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       motion_.abs_pos = 0;
       return;
     case Command::ResetDevice:
+      if (!motion_.hiz && reset_device_refused_when_enabled())
+        return not_performable("ResetDevice while the bridges are enabled");
       reset_logic();
       come_out_of_reset();
       return;
@@ -203,6 +208,15 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
   }
 }
 
+bool Chip::reset_device_refused_when_enabled() const {
+  switch (quirks_.reset_device) {
+    case ResetDeviceWhenEnabled::variant_default: return variant_->reset_device_needs_hiz;
+    case ResetDeviceWhenEnabled::performed: return false;
+    case ResetDeviceWhenEnabled::refused: return true;
+  }
+  return false;
+}
+
 bool Chip::motion_command_allowed(const char* what) {
   if (!hiz_forced()) return true;
   std::string why = what;
@@ -212,7 +226,7 @@ bool Chip::motion_command_allowed(const char* what) {
 }
 
 void Chip::exec_set_param(std::uint8_t address, std::uint32_t value) {
-  const RegisterInfo& r = *variant_->at_address(address);
+  const RegisterInfo& r = *table_->at_address(address);
   if (r.access == Access::R) {
     std::string why = "SetParam of read-only ";
     why += r.name;
@@ -250,6 +264,8 @@ void Chip::write_register(const RegisterInfo& r, std::uint32_t value) {
         motion_.el_pos &= 0x180;
         motion_.frac = 0;
       }
+      // powerSTEP01: CM_VM (bit 3) chooses the voltage- or current-mode reading of 0x09-0x10.
+      if (variant_->current_mode) table_ = (value & 0x08u) ? variant_->current_mode : variant_;
       break;
     default:
       break;
@@ -260,7 +276,7 @@ void Chip::write_register(const RegisterInfo& r, std::uint32_t value) {
 
 void Chip::refresh_profile() {
   auto reg = [&](Reg id) -> std::uint32_t {
-    const RegisterInfo* r = variant_->find(id);
+    const RegisterInfo* r = table_->find(id);
     return r ? regs_[r->address] : 0;
   };
   const std::uint32_t acc = reg(Reg::ACC);
@@ -271,7 +287,8 @@ void Chip::refresh_profile() {
   profile_.min_speed = std::uint64_t{min & 0xFFF} << 16;
   profile_.lspd_opt = (min & 0x1000) != 0;
   profile_.infinite = variant_->infinite_acceleration && acc == 0xFFF;
-  profile_.step_sel = static_cast<std::uint8_t>(reg(Reg::STEP_MODE) & 7u);
+  // Parts that stop at 1/16 run the finer STEP_SEL codes as 1/16 (UNCONFIRMED).
+  profile_.step_sel = static_cast<std::uint8_t>(std::min<std::uint32_t>(reg(Reg::STEP_MODE) & 7u, variant_->max_step_sel));
 }
 
 std::uint32_t Chip::register_value(const RegisterInfo& r) const {
@@ -281,7 +298,7 @@ std::uint32_t Chip::register_value(const RegisterInfo& r) const {
     case Reg::SPEED: return static_cast<std::uint32_t>(motion_.speed >> 12) & r.mask();
     case Reg::ADC_OUT: return adc_code_;
     case Reg::STATUS: return status();
-    default: return regs_[r.address];
+    default: return regs_[r.address] & r.mask();  // shared storage read at the width in force
   }
 }
 
@@ -302,14 +319,14 @@ LiveStatus Chip::live_status() const {
 std::uint16_t Chip::status_slow() const {
   sync();
   if (!live_bits_known_) {
-    live_bits_ = encode_live(variant_->status, live_status());
+    live_bits_ = encode_live(layout_, live_status());
     live_bits_known_ = true;
   }
   return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
 }
 
 void Chip::latched_changed() {
-  latched_bits_ = encode_latched(variant_->status, latched_);
+  latched_bits_ = encode_latched(layout_, latched_);
   latched_clean_ = false;
 }
 
@@ -374,7 +391,7 @@ Tick Chip::next_event_tick() const { return motion_active(motion()) ? now_ + 1 :
 bool Chip::busy_sync_pin() const {
   sync();
   if (!stby_level_) return true;
-  const std::uint32_t step_mode = regs_[variant_->find(Reg::STEP_MODE)->address];
+  const std::uint32_t step_mode = reg(Reg::STEP_MODE);
   if ((step_mode & kStepModeSyncEn) != 0) {
     const unsigned sync_sel = (step_mode >> 4) & 7u;
     return ((motion_.el_pos >> (7 - sync_sel)) & 1u) != 0;
@@ -383,7 +400,7 @@ bool Chip::busy_sync_pin() const {
 }
 
 bool Chip::flag_pin() const {
-  const std::uint32_t enabled = regs_[variant_->find(Reg::ALARM_EN)->address];
+  const std::uint32_t enabled = reg(Reg::ALARM_EN);
   const AlarmFlags& a = latched_;
   for (unsigned bit = 0; bit < 8; ++bit) {
     if (((enabled >> bit) & 1u) == 0) continue;
@@ -421,10 +438,10 @@ void Chip::set_sw_pin(bool level) {
 void Chip::switch_turn_on_event() {
   latched_.sw_evn = true;
   latched_changed();
-  const bool sw_mode = (regs_[variant_->find(Reg::CONFIG)->address] & kConfigSwMode) != 0;
+  const bool sw_mode = (reg(Reg::CONFIG) & kConfigSwMode) != 0;
   if (motion_.activity == Activity::go_until) {
     if (switch_act_)
-      regs_[variant_->find(Reg::MARK)->address] = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
+      reg(Reg::MARK) = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
     else
       motion_.abs_pos = 0;
     if (sw_mode)
@@ -440,7 +457,7 @@ void Chip::switch_turn_on_event() {
 void Chip::switch_release_event() {
   if (motion_.activity != Activity::release_sw) return;
   if (switch_act_)
-    regs_[variant_->find(Reg::MARK)->address] = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
+    reg(Reg::MARK) = static_cast<std::uint32_t>(motion_.abs_pos) & kPosMask;
   else
     motion_.abs_pos = 0;
   hard_stop(motion_);
@@ -514,7 +531,7 @@ void Chip::set_overcurrent(bool active) {
   if (!stby_level_ || !active) return;
   latched_.ocd = true;
   latched_changed();
-  if ((regs_[variant_->find(Reg::CONFIG)->address] & kConfigOcSd) != 0) ocd_shutdown_ = true;
+  if ((reg(Reg::CONFIG) & kConfigOcSd) != 0) ocd_shutdown_ = true;
   apply_forced_hiz();
 }
 
@@ -530,13 +547,13 @@ void Chip::set_stall(Bridge bridge, bool active) {
 
 std::uint32_t Chip::peek(Reg id) const {
   sync();
-  const RegisterInfo* r = variant_->find(id);
+  const RegisterInfo* r = table_->find(id);
   return r ? register_value(*r) : 0;
 }
 
 std::uint32_t Chip::peek_address(std::uint8_t address) const {
   sync();
-  const RegisterInfo* r = variant_->at_address(address);
+  const RegisterInfo* r = table_->at_address(address);
   return r ? register_value(*r) : 0;
 }
 
@@ -544,14 +561,14 @@ std::string Chip::dump() const {
   sync();
   std::string out;
   out += std::string(variant_->name) + " at tick " + std::to_string(now_) + (stby_level_ ? "" : " (in standby)") + "\n";
-  for (const auto& r : variant_->registers) {
+  for (const auto& r : table_->registers) {
     const std::uint32_t v = register_value(r);
     char line[96];
     std::snprintf(line, sizeof line, "  0x%02X %-10s = 0x%0*X", r.address, std::string(r.name).c_str(),
                   r.spi_bytes() * 2, v);
     out += line;
     if (r.is_signed()) out += "  (" + std::to_string(sign_extend(v, r.bits)) + ")";
-    if (r.id == Reg::STATUS) out += "  [" + describe_status(variant_->status, static_cast<std::uint16_t>(v)) + "]";
+    if (r.id == Reg::STATUS) out += "  [" + describe_status(layout_, static_cast<std::uint16_t>(v)) + "]";
     out += '\n';
   }
   return out;

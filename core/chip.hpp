@@ -28,7 +28,13 @@ class Chip {
   /// A chip just out of power-up: registers at reset, bridges HiZ, UVLO latched, FLAG low.
   explicit Chip(const Variant& variant = l6470(), Quirks quirks = {});
 
+  /// Which family member this is.
   const Variant& variant() const { return *variant_; }
+  /// The register table in force: the variant's, or on a powerSTEP01 with STEP_MODE.CM_VM = 1
+  /// its current-mode reading (TVAL_* and so on at 0x09-0x10).
+  const Variant& registers() const { return *table_; }
+  /// The STATUS layout in force (the variant's, with the stall-bit quirk applied).
+  const StatusLayout& status_layout() const { return layout_; }
   const Quirks& quirks() const { return quirks_; }
 
   // ---- SPI face -----------------------------------------------------------
@@ -152,9 +158,13 @@ class Chip {
   AlarmFlags live_alarms() const;
   LiveStatus live_status() const;
   bool motion_command_allowed(const char* what);
+  bool reset_device_refused_when_enabled() const;
   std::uint32_t register_value(const RegisterInfo& r) const;
+  std::uint32_t& reg(Reg id) { return regs_[table_->find(id)->address]; }
+  std::uint32_t reg(Reg id) const { return regs_[table_->find(id)->address]; }
 
   const Variant* variant_;
+  const Variant* table_;  // variant_ or variant_->current_mode
   // Fields every SPI byte or GetStatus touches come first, to share cache lines.
   Tick now_ = 0;
   std::uint32_t response_ = 0;
@@ -169,6 +179,7 @@ class Chip {
   mutable Tick uniform_left_ = 0;
   mutable Tick motion_now_ = 0;
   Quirks quirks_;
+  StatusLayout layout_;
   MotionEngine engine_ = MotionEngine::fast;
 
   // register storage by address (live registers are computed)

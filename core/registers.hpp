@@ -33,6 +33,7 @@ enum RegFlag : std::uint8_t {
   kSigned = 1 << 0,         ///< 22-bit two's complement position (ABS_POS, MARK)
   kLive = 1 << 1,           ///< value produced by the model, not stored (SPEED, STATUS...)
   kWriteConflict = 1 << 2,  ///< WH in the table, "not while running" in the text (quirk)
+  kUnconfirmed = 1 << 3,    ///< width, reset value or presence from a single non-datasheet source
 };
 
 /// One row of a variant's register table.

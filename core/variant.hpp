@@ -21,6 +21,13 @@ struct Variant {
   AlarmLayout alarms;                      ///< ALARM_EN bit meanings
   std::uint8_t max_step_sel = 7;           ///< finest STEP_SEL (7 = 1/128)
   bool infinite_acceleration = true;       ///< ACC = 0xFFF skips the ramps
+  /// The powerSTEP01's reading of the same registers when STEP_MODE.CM_VM = 1 (current
+  /// mode), or nullptr. Storage is shared: only names, widths and meanings change.
+  const Variant* current_mode = nullptr;
+  /// ResetDevice is refused (CMD_ERROR) while the bridges are enabled (community report).
+  bool reset_device_needs_hiz = false;
+  /// The choices made where the sources are single or silent (UNCONFIRMED), in words.
+  std::span<const std::string_view> unconfirmed{};
   /// Table index of each address (0..31), -1 for a hole or a reserved address.
   std::array<std::int8_t, 32> index_of_address{};
   /// Table index of each register id, -1 when the variant has no such register.
@@ -48,7 +55,7 @@ struct Variant {
 constexpr Variant make_variant(std::string_view name, std::span<const RegisterInfo> table,
                                StatusLayout status, AlarmLayout alarms,
                                std::uint8_t max_step_sel, bool infinite_acceleration) {
-  Variant v{name, table, status, alarms, max_step_sel, infinite_acceleration, {}, {}, {}};
+  Variant v{name, table, status, alarms, max_step_sel, infinite_acceleration, nullptr, false, {}, {}, {}, {}};
   for (auto& i : v.index_of_address) i = -1;
   for (auto& i : v.index_of_reg) i = -1;
   for (std::size_t i = 0; i < table.size(); ++i) {
@@ -85,5 +92,20 @@ constexpr bool register_table_is_consistent(std::span<const RegisterInfo> table)
 
 /// The L6470 (dSPIN, voltage mode, integrated bridges).
 const Variant& l6470();
+/// The L6472 (dSPIN, current mode, integrated bridges).
+const Variant& l6472();
+/// The L6480 (cSPIN, voltage mode, gate driver).
+const Variant& l6480();
+/// The L6482 (cSPIN, current mode, gate driver).
+const Variant& l6482();
+/// The powerSTEP01 (voltage or current mode by STEP_MODE.CM_VM, power stage in package),
+/// in its power-up voltage mode; current_mode points at its current-mode reading.
+const Variant& powerstep01();
+
+/// Every family member, in the order above.
+std::span<const Variant* const> all_variants();
+
+/// The variant called `name` (case-insensitive: "L6470", "l6480", "powerSTEP01", "powerstep01"), or nullptr.
+const Variant* find_variant(std::string_view name);
 
 }  // namespace l6470emu

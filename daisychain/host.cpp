@@ -57,13 +57,13 @@ std::uint32_t ChainHost::read_answer(std::size_t k, std::uint8_t opcode, unsigne
 void ChainHost::nop(std::size_t k) { frame_byte(k, 0x00); }
 
 void ChainHost::set_param(std::size_t k, Reg reg, std::uint32_t value) {
-  const RegisterInfo* r = chain_.chip(k).variant().find(reg);
+  const RegisterInfo* r = chain_.chip(k).registers().find(reg);
   if (!r) throw std::invalid_argument("the chip has no such register");
   send_value(k, r->address, value, r->spi_bytes());
 }
 
 std::uint32_t ChainHost::get_param(std::size_t k, Reg reg) {
-  const RegisterInfo* r = chain_.chip(k).variant().find(reg);
+  const RegisterInfo* r = chain_.chip(k).registers().find(reg);
   if (!r) throw std::invalid_argument("the chip has no such register");
   return read_answer(k, static_cast<std::uint8_t>(0x20 | r->address), r->spi_bytes());
 }

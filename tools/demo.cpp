@@ -71,7 +71,7 @@ int run_demo(std::size_t chips, unsigned seconds, std::ostream& out) {
   }
   out << '\n';
   for (std::size_t k = 0; k < n; ++k)
-    out << "chip " << k << ": " << describe_status(chain.chip(k).variant().status, chain.chip(k).status()) << '\n';
+    out << "chip " << k << ": " << describe_status(chain.chip(k).status_layout(), chain.chip(k).status()) << '\n';
   return 0;
 }
 

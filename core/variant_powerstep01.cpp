@@ -1,0 +1,64 @@
+// The powerSTEP01: the L6480 map in voltage mode; with STEP_MODE.CM_VM = 1 the
+// addresses 0x09-0x10 read as TVAL_*, T_FAST, TON_MIN and TOFF_MIN (current mode).
+#include <algorithm>
+
+#include "core/variant.hpp"
+#include "core/variant_gate_driver.hpp"
+
+namespace l6470emu {
+namespace {
+
+using enum Access;
+using enum Reg;
+
+/// The voltage-mode rows with 0x09-0x0C, 0x0E-0x10 read in current mode.
+constexpr std::array<RegisterInfo, 27> kCurrentModeRegisters = [] {
+  auto t = kVoltageModeGateDriverRegisters;
+  constexpr RegisterInfo kAliases[] = {
+      {0x09, TVAL_HOLD, "TVAL_HOLD", 7, 0x29, WR, kNoFlags},
+      {0x0A, TVAL_RUN, "TVAL_RUN", 7, 0x29, WR, kNoFlags},
+      {0x0B, TVAL_ACC, "TVAL_ACC", 7, 0x29, WR, kNoFlags},
+      {0x0C, TVAL_DEC, "TVAL_DEC", 7, 0x29, WR, kNoFlags},
+      {0x0E, T_FAST, "T_FAST", 8, 0x19, WH, kNoFlags},
+      {0x0F, TON_MIN, "TON_MIN", 7, 0x29, WH, kNoFlags},
+      {0x10, TOFF_MIN, "TOFF_MIN", 7, 0x29, WH, kNoFlags},
+  };
+  for (const auto& a : kAliases)
+    for (auto& r : t)
+      if (r.address == a.address) r = a;
+  return t;
+}();
+static_assert(register_table_is_consistent(kCurrentModeRegisters));
+
+constexpr std::string_view kUnconfirmedChoices[] = {
+    "reset values: assumed equal to the L6480's (the powerSTEP01 table was not retrieved)",
+    "voltage and current mode share the storage of 0x09-0x10; reads and writes use the width of the mode in force "
+    "(so a TVAL read masks bit 7 of a KVAL written in voltage mode)",
+    "ResetDevice while the bridges are enabled is refused with CMD_ERROR (community report); switchable quirk",
+    "STALL_A on STATUS bit 14 and STALL_B on bit 15: quirk",
+    "1/128 microstepping in both modes",
+};
+
+constexpr Variant kCurrentMode = [] {
+  Variant v = make_variant("powerSTEP01", kCurrentModeRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
+  v.reset_device_needs_hiz = true;
+  v.unconfirmed = kUnconfirmedChoices;
+  return v;
+}();
+
+constexpr Variant kVoltageMode = [] {
+  Variant v = make_variant("powerSTEP01", kVoltageModeGateDriverRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
+  v.current_mode = &kCurrentMode;
+  v.reset_device_needs_hiz = true;
+  v.unconfirmed = kUnconfirmedChoices;
+  return v;
+}();
+
+static_assert(kCurrentMode.find(Reg::TVAL_HOLD)->address == 0x09 && !kCurrentMode.has(Reg::KVAL_HOLD));
+static_assert(kCurrentMode.find(Reg::INT_SPEED) != nullptr, "0x0D keeps its name in current mode");
+
+}  // namespace
+
+const Variant& powerstep01() { return kVoltageMode; }
+
+}  // namespace l6470emu
