@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
   std::string readme;
   auto* tables = app.add_subcommand("tables", "print the tables the model uses, as Markdown");
   tables->add_option("--table", table, "which table")
-      ->check(CLI::IsMember({"l6470-registers", "l6470-status", "commands"}));
+      ->check(CLI::IsMember({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
+                             "variant-differences"}));
   tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
 
   CLI11_PARSE(app, argc, argv);

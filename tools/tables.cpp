@@ -4,11 +4,19 @@
 #include <array>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/commands.hpp"
 
 namespace l6470emu {
 namespace {
+
+std::string hex2(unsigned v) {
+  char b[8];
+  std::snprintf(b, sizeof b, "0x%02X", v);
+  return b;
+}
 
 std::string flags_text(const RegisterInfo& r) {
   std::string s;
@@ -119,7 +127,141 @@ std::string command_table_markdown() {
   return out;
 }
 
+namespace {
+
+/// The columns of the variant tables: every variant, plus the powerSTEP01's current mode.
+std::vector<std::pair<std::string, const Variant*>> variant_columns() {
+  std::vector<std::pair<std::string, const Variant*>> cols;
+  for (const Variant* v : all_variants()) {
+    cols.emplace_back(std::string(v->name) + (v->current_mode ? " (voltage mode)" : ""), v);
+    if (v->current_mode) cols.emplace_back(std::string(v->name) + " (current mode)", v->current_mode);
+  }
+  return cols;
+}
+
+std::string header_row(const std::vector<std::pair<std::string, const Variant*>>& cols, const char* first) {
+  std::string out = std::string("| ") + first + " |";
+  std::string rule = "|---|";
+  for (const auto& c : cols) {
+    out += " " + c.first + " |";
+    rule += "---|";
+  }
+  return out + "\n" + rule + "\n";
+}
+
+/// Names of the STATUS fields on `bit` in layout `l`.
+std::string status_bit_name(const StatusLayout& l, int bit) {
+  std::string n;
+  auto add = [&](bool here, std::string_view name) {
+    if (!here) return;
+    if (!n.empty()) n += "/";
+    n += name;
+  };
+  add(l.hiz == bit, "HiZ");
+  add(l.busy == bit, "BUSY");
+  add(l.sw_f == bit, "SW_F");
+  add(l.sw_evn == bit, "SW_EVN");
+  add(l.dir == bit, "DIR");
+  add(l.mot_status >= 0 && (bit == l.mot_status || bit == l.mot_status + 1), "MOT_STATUS");
+  if (l.notperf_cmd == l.wrong_cmd) {
+    add(l.wrong_cmd == bit, "CMD_ERROR");
+  } else {
+    add(l.notperf_cmd == bit, "NOTPERF_CMD");
+    add(l.wrong_cmd == bit, "WRONG_CMD");
+  }
+  add(l.uvlo == bit, "UVLO");
+  add(l.uvlo_adc == bit, "UVLO_ADC");
+  add(l.th_wrn == bit, "TH_WRN");
+  add(l.th_sd == bit, "TH_SD");
+  add(l.th_status >= 0 && (bit == l.th_status || bit == l.th_status + 1), "TH_STATUS");
+  add(l.ocd == bit, "OCD");
+  add(l.step_loss_a == bit, l.step_loss_a_name);
+  add(l.step_loss_b == bit, l.step_loss_b_name);
+  add(l.sck_mod == bit, l.sck_mod == 8 ? "STCK_MOD" : "SCK_MOD");
+  return n.empty() ? "–" : n;
+}
+
+}  // namespace
+
+std::string variant_registers_markdown() {
+  const auto cols = variant_columns();
+  std::string out = header_row(cols, "Addr");
+  for (unsigned a = 1; a < 32; ++a) {
+    bool any = false;
+    std::string row = "| " + hex2(a) + " |";
+    for (const auto& c : cols) {
+      const RegisterInfo* r = c.second->at_address(static_cast<std::uint8_t>(a));
+      if (!r) {
+        row += " – |";
+        continue;
+      }
+      any = true;
+      char cell[96];
+      std::snprintf(cell, sizeof cell, " %s %u/0x%0*X/%s%s |", std::string(r->name).c_str(), r->bits, (r->bits + 3) / 4,
+                    r->reset, std::string(to_string(r->access)).c_str(), (r->flags & kUnconfirmed) ? " †" : "");
+      row += cell;
+    }
+    if (any) out += row + "\n";
+  }
+  out += "\nCells read NAME bits/reset/write condition; – is no register (an unknown command); "
+         "† marks an UNCONFIRMED row (see the list below).\n";
+  return out;
+}
+
+std::string variant_status_markdown() {
+  std::vector<const Variant*> vs(all_variants().begin(), all_variants().end());
+  std::string out = "| Bit |";
+  std::string rule = "|---|";
+  for (const Variant* v : vs) {
+    out += " " + std::string(v->name) + " |";
+    rule += "---|";
+  }
+  out += "\n" + rule + "\n";
+  for (int bit = 15; bit >= 0; --bit) {
+    out += "| " + std::to_string(bit) + " |";
+    for (const Variant* v : vs) out += " " + status_bit_name(v->status, bit) + " |";
+    out += "\n";
+  }
+  return out;
+}
+
+std::string variant_differences_markdown() {
+  std::string out = "| | ";
+  std::string rule = "|---|";
+  for (const Variant* v : all_variants()) {
+    out += std::string(v->name) + " | ";
+    rule += "---|";
+  }
+  out.pop_back();
+  out += "\n" + rule + "\n";
+  auto row = [&](const char* what, auto cell) {
+    out += std::string("| ") + what + " |";
+    for (const Variant* v : all_variants()) out += " " + cell(*v) + " |";
+    out += "\n";
+  };
+  row("finest microstep", [](const Variant& v) { return "1/" + std::to_string(1 << v.max_step_sel); });
+  row("ACC = 0xFFF", [](const Variant& v) { return std::string(v.infinite_acceleration ? "infinite acceleration" : "ordinary value"); });
+  row("CONFIG / STATUS at", [](const Variant& v) { return hex2(v.find(Reg::CONFIG)->address) + " / " + hex2(v.find(Reg::STATUS)->address); });
+  row("command errors", [](const Variant& v) {
+    return std::string(v.status.wrong_cmd == v.status.notperf_cmd ? "CMD_ERROR (bit 7)" : "WRONG_CMD (8), NOTPERF_CMD (7)");
+  });
+  row("OCD_TH / STALL_TH bits", [](const Variant& v) {
+    const RegisterInfo* s = v.find(Reg::STALL_TH);
+    return std::to_string(v.find(Reg::OCD_TH)->bits) + " / " + (s ? std::to_string(s->bits) : std::string("–"));
+  });
+  row("ResetDevice with bridges on", [](const Variant& v) {
+    return std::string(v.reset_device_needs_hiz ? "refused (CMD_ERROR) †" : "performed");
+  });
+  out += "\n**UNCONFIRMED choices** (each is covered by a test):\n\n";
+  for (const Variant* v : all_variants())
+    for (std::string_view u : v->unconfirmed) out += "* " + std::string(v->name) + ": " + std::string(u) + "\n";
+  return out;
+}
+
 std::string generated_block(std::string_view name) {
+  if (name == "variant-registers") return variant_registers_markdown();
+  if (name == "variant-status") return variant_status_markdown();
+  if (name == "variant-differences") return variant_differences_markdown();
   if (name == "l6470-registers") return register_table_markdown(l6470());
   if (name == "l6470-status") return status_table_markdown(l6470());
   if (name == "commands") return command_table_markdown();

@@ -18,7 +18,19 @@ std::string status_table_markdown(const Variant& v);
 /// The opcodes the decoder accepts and their argument bytes.
 std::string command_table_markdown();
 
-/// The generated block called `name` ("l6470-registers", "l6470-status", "commands"), or "" if unknown.
+/// One table of every variant's registers: a row per address, a column per variant (and the
+/// powerSTEP01's current-mode reading), each cell "NAME bits/reset/access".
+std::string variant_registers_markdown();
+
+/// Every variant's STATUS layout side by side, bit 15 first.
+std::string variant_status_markdown();
+
+/// The capabilities that differ (microstepping, ACC = 0xFFF, error bits ...) and every
+/// UNCONFIRMED choice, per variant.
+std::string variant_differences_markdown();
+
+/// The generated block called `name` ("l6470-registers", "l6470-status", "commands", "variant-registers",
+/// "variant-status", "variant-differences"), or "" if unknown.
 std::string generated_block(std::string_view name);
 
 /// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of
