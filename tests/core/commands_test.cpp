@@ -16,18 +16,11 @@
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 // ---------------------------------------------------------------- helpers
 
-constexpr std::uint16_t kHiZ = 1u << 0;
-constexpr std::uint16_t kBusyHigh = 1u << 1;  // BUSY is active low: set = not busy
-constexpr std::uint16_t kSwF = 1u << 2;
-constexpr std::uint16_t kSwEvn = 1u << 3;
-constexpr std::uint16_t kDir = 1u << 4;
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kWrongCmd = 1u << 8;
-constexpr std::uint16_t kSckMod = 1u << 15;
 
-unsigned mot_status(std::uint16_t s) { return (s >> 5) & 3u; }
 constexpr unsigned kStopped = 0, kAcceleration = 1, kDeceleration = 2, kConstantSpeed = 3;
 
 const std::uint32_t kSpd300 = test::spd_from_steps_per_s(300);  // Run/GoUntil SPD for 300 step/s
@@ -166,7 +159,7 @@ void start_running(Twin& t) {
   t.both(cmd3(0x51, kSpd300));
   t.wait_ms(20);
   t.clear_flags();
-  ASSERT_EQ(t.probe.chip().status() & kBusyHigh, 0) << "motor should still be accelerating";
+  ASSERT_EQ(t.probe.chip().status() & kBusyN, 0) << "motor should still be accelerating";
 }
 
 // ---------------------------------------------------------------- classification
@@ -376,13 +369,13 @@ TEST(Run, AcceleratesToSpdInTheGivenDirectionAndReleasesBusyThere) {
   send(rig, cmd3(0x51, kSpd300));
   std::uint16_t s = read_status(rig);
   EXPECT_EQ(s & kHiZ, 0) << "Run takes the bridges out of HiZ";
-  EXPECT_EQ(s & kBusyHigh, 0) << "BUSY low until the target speed is reached";
+  EXPECT_EQ(s & kBusyN, 0) << "BUSY low until the target speed is reached";
   EXPECT_NE(s & kDir, 0) << "forward";
-  EXPECT_EQ(mot_status(s), kAcceleration);
+  EXPECT_EQ(mot(s), kAcceleration);
   rig.host.wait_ms(300);
   s = read_status(rig);
-  EXPECT_NE(s & kBusyHigh, 0);
-  EXPECT_EQ(mot_status(s), kConstantSpeed);
+  EXPECT_NE(s & kBusyN, 0);
+  EXPECT_EQ(mot(s), kConstantSpeed);
   EXPECT_EQ(get_param(rig, 0x04, 3), kSpd300) << "SPEED has the unit of SPD";
   EXPECT_GT(static_cast<std::int32_t>(rig.chip().position()), 0);
 }
@@ -411,8 +404,8 @@ TEST(StepClock, EntersStepClockModeAndEachStckRisingEdgeMakesOneMicrostep) {
   std::uint16_t s = read_status(rig);
   EXPECT_NE(s & kSckMod, 0);
   EXPECT_NE(s & kDir, 0);
-  EXPECT_NE(s & kBusyHigh, 0) << "StepClock does not pull BUSY low";
-  EXPECT_EQ(mot_status(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0) << "StepClock does not pull BUSY low";
+  EXPECT_EQ(mot(s), kStopped);
   for (int i = 0; i < 3; ++i) {
     rig.chip().set_stck_pin(true);
     rig.chip().set_stck_pin(false);
@@ -436,12 +429,12 @@ TEST(Move, MakesNStepMicrostepsAndReleasesBusy) {
   test::OneChip rig;
   send(rig, cmd3(0x41, 1000));
   std::uint16_t s = read_status(rig);
-  EXPECT_EQ(s & kBusyHigh, 0);
+  EXPECT_EQ(s & kBusyN, 0);
   EXPECT_EQ(s & kHiZ, 0);
   rig.host.wait_ms(500);
   s = read_status(rig);
-  EXPECT_NE(s & kBusyHigh, 0);
-  EXPECT_EQ(mot_status(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
+  EXPECT_EQ(mot(s), kStopped);
   EXPECT_EQ(abs_pos(rig), 1000u);
   EXPECT_EQ(get_param(rig, 0x02, 2), 1000u % 512) << "EL_POS counts 1/128 steps modulo 4 full steps";
 }
@@ -463,7 +456,7 @@ TEST(GoTo, TakesTheShortestPathToTheAbsolutePosition) {
   EXPECT_NE(read_status(rig) & kDir, 0) << "forward is shorter";
   rig.host.wait_ms(300);
   EXPECT_EQ(abs_pos(rig), 70u);
-  EXPECT_NE(read_status(rig) & kBusyHigh, 0);
+  EXPECT_NE(read_status(rig) & kBusyN, 0);
 }
 
 TEST(GoToDir, ForcesTheDirectionEvenTheLongWayRound) {
@@ -472,7 +465,7 @@ TEST(GoToDir, ForcesTheDirectionEvenTheLongWayRound) {
   rig.host.wait_ms(50);
   std::uint16_t s = read_status(rig);
   EXPECT_EQ(s & kDir, 0);
-  EXPECT_EQ(s & kBusyHigh, 0);
+  EXPECT_EQ(s & kBusyN, 0);
   EXPECT_LT(rig.chip().position(), 0);
 
   test::OneChip fwd;
@@ -497,7 +490,7 @@ TEST(GoHome, GoesToPositionZero) {
   EXPECT_EQ(read_status(rig) & kDir, 0);
   rig.host.wait_ms(500);
   EXPECT_EQ(abs_pos(rig), 0u);
-  EXPECT_NE(read_status(rig) & kBusyHigh, 0);
+  EXPECT_NE(read_status(rig) & kBusyN, 0);
 }
 
 TEST(GoMark, GoesToTheMarkPosition) {
@@ -515,17 +508,17 @@ TEST(GoUntil, WithActZeroResetsAbsPosAtTheSwitchTurnOnEventThenStops) {
   send(rig, cmd3(0x83, kSpd300));
   rig.host.wait_ms(50);
   ASSERT_GT(rig.chip().position(), 0);
-  EXPECT_EQ(read_status(rig) & kBusyHigh, 0);
+  EXPECT_EQ(read_status(rig) & kBusyN, 0);
   rig.chip().set_sw_pin(false);
   EXPECT_EQ(rig.chip().peek(Reg::ABS_POS), 0u) << "ABS_POS reset at the edge";
   std::uint16_t s = read_status(rig);
   EXPECT_NE(s & kSwEvn, 0);
-  EXPECT_EQ(mot_status(s), kDeceleration) << "SoftStop with SW_MODE = 1";
-  EXPECT_EQ(s & kBusyHigh, 0) << "BUSY low until the motor is stopped";
+  EXPECT_EQ(mot(s), kDeceleration) << "SoftStop with SW_MODE = 1";
+  EXPECT_EQ(s & kBusyN, 0) << "BUSY low until the motor is stopped";
   rig.host.wait_ms(500);
   s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
   EXPECT_EQ(s & kHiZ, 0);
 }
 
@@ -539,8 +532,8 @@ TEST(GoUntil, WithActOneCopiesAbsPosIntoMarkAndWithSwModeZeroStopsHard) {
   EXPECT_EQ(get_param(rig, 0x03, 3), p) << "MARK";
   EXPECT_EQ(abs_pos(rig), p) << "ABS_POS kept";
   const std::uint16_t s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped) << "HardStop interrupt";
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped) << "HardStop interrupt";
+  EXPECT_NE(s & kBusyN, 0);
   EXPECT_EQ(get_param(rig, 0x04, 3), 0u);
 }
 
@@ -550,15 +543,15 @@ TEST(ReleaseSW, RunsAtFiveStepsPerSecondUntilTheSwitchOpensThenResetsAbsPosAndSt
   send(rig, {0x93});  // ReleaseSW ACT = 0 forward
   rig.host.wait_ms(100);
   std::uint16_t s = read_status(rig);
-  EXPECT_EQ(s & kBusyHigh, 0);
+  EXPECT_EQ(s & kBusyN, 0);
   EXPECT_NEAR(test::steps_per_s_from_speed(get_param(rig, 0x04, 3)), 5.0, 0.02)
       << "MIN_SPEED below 5 step/s: 5 step/s";
   EXPECT_GT(rig.chip().position(), 0);
   rig.chip().set_sw_pin(true);
   EXPECT_EQ(abs_pos(rig), 0u);
   s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
   EXPECT_EQ(s & kHiZ, 0) << "HardStop keeps the bridges enabled";
 }
 
@@ -593,7 +586,7 @@ TEST(ResetPos, WorksWhileTheMotorRuns) {
   send(rig, {0xD8});
   EXPECT_EQ(rig.chip().peek(Reg::ABS_POS), 0u);
   EXPECT_EQ(rig.chip().status() & kNotPerf, 0);
-  EXPECT_NE(mot_status(rig.chip().status()), kStopped) << "the motor keeps running";
+  EXPECT_NE(mot(rig.chip().status()), kStopped) << "the motor keeps running";
 }
 
 TEST(ResetDevice, ReturnsARunningChipToThePowerUpState) {
@@ -628,13 +621,13 @@ TEST(SoftStop, DeceleratesThenHoldsWithTheBridgesEnabled) {
   rig.host.wait_ms(200);
   send(rig, {0xB0});
   std::uint16_t s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kDeceleration);
-  EXPECT_EQ(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kDeceleration);
+  EXPECT_EQ(s & kBusyN, 0);
   EXPECT_GT(get_param(rig, 0x04, 3), 0u);
   rig.host.wait_ms(500);
   s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
   EXPECT_EQ(s & kHiZ, 0);
   EXPECT_EQ(get_param(rig, 0x04, 3), 0u);
 }
@@ -645,8 +638,8 @@ TEST(HardStop, StopsAtOnceWithTheBridgesEnabled) {
   rig.host.wait_ms(200);
   send(rig, {0xB8});
   const std::uint16_t s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
   EXPECT_EQ(s & kHiZ, 0);
   EXPECT_EQ(get_param(rig, 0x04, 3), 0u);
 }
@@ -657,13 +650,13 @@ TEST(SoftHiZ, DeceleratesThenDisablesTheBridges) {
   rig.host.wait_ms(200);
   send(rig, {0xA0});
   std::uint16_t s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kDeceleration);
+  EXPECT_EQ(mot(s), kDeceleration);
   EXPECT_EQ(s & kHiZ, 0) << "bridges stay on while decelerating";
   rig.host.wait_ms(500);
   s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
+  EXPECT_EQ(mot(s), kStopped);
   EXPECT_NE(s & kHiZ, 0);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_NE(s & kBusyN, 0);
 }
 
 TEST(HardHiZ, DisablesTheBridgesAtOnce) {
@@ -672,7 +665,7 @@ TEST(HardHiZ, DisablesTheBridgesAtOnce) {
   rig.host.wait_ms(200);
   send(rig, {0xA8});
   const std::uint16_t s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
+  EXPECT_EQ(mot(s), kStopped);
   EXPECT_NE(s & kHiZ, 0);
   EXPECT_EQ(get_param(rig, 0x04, 3), 0u);
 }
@@ -683,8 +676,8 @@ TEST(SoftStopAndHardStop, TakeTheBridgesOutOfHiZWithoutMotion) {
     send(rig, {op});
     const std::uint16_t s = read_status(rig);
     EXPECT_EQ(s & kHiZ, 0) << hex(op);
-    EXPECT_EQ(mot_status(s), kStopped) << hex(op);
-    EXPECT_NE(s & kBusyHigh, 0) << hex(op);
+    EXPECT_EQ(mot(s), kStopped) << hex(op);
+    EXPECT_NE(s & kBusyN, 0) << hex(op);
     EXPECT_EQ(rig.chip().position(), 0) << hex(op);
   }
 }
@@ -772,17 +765,17 @@ TEST(GoTo, IsAcceptedWhileARunCruisesAtItsTargetSpeedBecauseBusyIsReleased) {
   send(rig, cmd3(0x51, kSpd300));
   rig.host.wait_ms(300);
   std::uint16_t s = get_status(rig);
-  ASSERT_NE(s & kBusyHigh, 0) << "the Run has reached its speed";
+  ASSERT_NE(s & kBusyN, 0) << "the Run has reached its speed";
   const std::int32_t target = rig.chip().position() + 20000;
   send(rig, cmd3(0x60, pos22(target)));
   s = read_status(rig);
   EXPECT_EQ(s & kNotPerf, 0);
-  EXPECT_EQ(s & kBusyHigh, 0) << "GoTo keeps BUSY low until the target";
+  EXPECT_EQ(s & kBusyN, 0) << "GoTo keeps BUSY low until the target";
   rig.host.wait_ms(1500);
   EXPECT_EQ(abs_pos(rig), pos22(target));
   s = read_status(rig);
-  EXPECT_EQ(mot_status(s), kStopped);
-  EXPECT_NE(s & kBusyHigh, 0);
+  EXPECT_EQ(mot(s), kStopped);
+  EXPECT_NE(s & kBusyN, 0);
 }
 
 TEST(StepClock, WhileTheMotorRunsRaisesNotPerfAndChangesNothing) {

@@ -13,12 +13,8 @@
 namespace l6470emu {
 namespace {
 
-constexpr std::uint16_t kHiZ = 1u << 0;
-constexpr std::uint16_t kBusyN = 1u << 1;
-constexpr std::uint16_t kSwF = 1u << 2;
-constexpr std::uint16_t kSwEvn = 1u << 3;
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kWrongCmd = 1u << 8;
+using namespace test::status_bits;
+
 
 constexpr std::uint32_t kConfigReset = 0x2E88;
 constexpr std::uint32_t kSwMode = 1u << 4;

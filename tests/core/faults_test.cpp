@@ -15,18 +15,8 @@
 namespace l6470emu {
 namespace {
 
-constexpr std::uint16_t kHiZ = 1u << 0;
-constexpr std::uint16_t kBusyN = 1u << 1;
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kUvloN = 1u << 9;
-constexpr std::uint16_t kThWrnN = 1u << 10;
-constexpr std::uint16_t kThSdN = 1u << 11;
-constexpr std::uint16_t kOcdN = 1u << 12;
-constexpr std::uint16_t kStepLossAN = 1u << 13;
-constexpr std::uint16_t kStepLossBN = 1u << 14;
-constexpr std::uint16_t kSckMod = 1u << 15;
-constexpr unsigned kStopped = 0;
-unsigned mot(std::uint16_t status) { return (status >> 5) & 3u; }
+using namespace test::status_bits;
+
 
 constexpr std::uint32_t kConfigReset = 0x2E88;  // OC_SD = 1
 constexpr std::uint32_t kOcSd = 1u << 7;

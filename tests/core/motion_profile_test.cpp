@@ -15,14 +15,10 @@
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 // STATUS bits of the L6470 (spec §4.1).
-constexpr std::uint16_t kHiZ = 1u << 0;
-constexpr std::uint16_t kBusyN = 1u << 1;  // 0 = busy
-constexpr std::uint16_t kDir = 1u << 4;    // 1 = forward
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kSckMod = 1u << 15;
 constexpr unsigned kStopped = 0, kAcc = 1, kDec = 2, kConst = 3;
-unsigned mot(std::uint16_t status) { return (status >> 5) & 3u; }
 
 constexpr std::int32_t k2p21 = 1 << 21;
 constexpr std::uint32_t kPosMask = 0x3FFFFF;

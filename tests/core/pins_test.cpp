@@ -14,11 +14,8 @@
 namespace l6470emu {
 namespace {
 
-constexpr std::uint16_t kHiZ = 1u << 0;
-constexpr std::uint16_t kBusyN = 1u << 1;
-constexpr std::uint16_t kWrongCmd = 1u << 8;
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kUvloN = 1u << 9;
+using namespace test::status_bits;
+
 constexpr std::uint16_t kPowerUpStatus = 0x7C03;
 
 struct Rig : test::OneChip {

@@ -14,8 +14,8 @@
 namespace l6470emu {
 namespace {
 
-constexpr std::uint16_t kNotPerf = 1u << 7;
-constexpr std::uint16_t kWrongCmd = 1u << 8;
+using namespace test::status_bits;
+
 
 const std::uint32_t kSpd300 = test::spd_from_steps_per_s(300);
 

@@ -16,6 +16,8 @@
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 // ---------------------------------------------------------------- the spec's table
 
 struct Row {
@@ -93,7 +95,6 @@ std::vector<std::uint8_t> answer_bytes(std::uint32_t value, unsigned bytes) {
 std::uint32_t all_ones(unsigned bytes) { return bytes >= 4 ? 0xFFFF'FFFFu : (1u << (8 * bytes)) - 1u; }
 std::uint32_t mask_of(unsigned bits) { return (1u << bits) - 1u; }
 
-constexpr std::uint16_t kWrongCmd = 1u << 8;
 constexpr std::uint16_t kNotPerfCmd = 1u << 7;
 
 // ---------------------------------------------------------------- the table itself

@@ -14,14 +14,16 @@
 #include <vector>
 
 #include "daisychain/chain.hpp"
+#include "support/test_support.hpp"
 #include "daisychain/host.hpp"
 
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 using Bytes = std::vector<std::uint8_t>;
 
-constexpr std::uint16_t kWrongCmd = 1u << 8;
 
 std::uint8_t value_for(std::size_t k) { return static_cast<std::uint8_t>(k * 37 + 11); }
 

@@ -7,13 +7,15 @@
 #include <vector>
 
 #include "daisychain/chain.hpp"
+#include "support/test_support.hpp"
 
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 using Bytes = std::vector<std::uint8_t>;
 
-constexpr std::uint16_t kWrongCmd = 1u << 8;
 
 /// One L6470 behind its own chip-select.
 struct Single {

@@ -16,11 +16,9 @@
 namespace l6470emu {
 namespace {
 
-constexpr std::uint16_t kBusyN = 1u << 1;
-constexpr std::uint16_t kDir = 1u << 4;
-constexpr std::uint16_t kNotPerf = 1u << 7;
+using namespace test::status_bits;
+
 constexpr unsigned kDec = 2;
-unsigned mot(std::uint16_t status) { return (status >> 5) & 3u; }
 
 constexpr std::uint32_t kConfigReset = 0x2E88;
 constexpr std::uint32_t kSwMode = 1u << 4;

@@ -7,14 +7,16 @@
 #include <vector>
 
 #include "daisychain/chain.hpp"
+#include "support/test_support.hpp"
 #include "spi/message.hpp"
 
 namespace l6470emu {
 namespace {
 
+using namespace test::status_bits;
+
 using Bytes = std::vector<std::uint8_t>;
 
-constexpr std::uint16_t kWrongCmd = 1u << 8;
 
 /// A transfer whose buffers live in the test: tx bytes and an rx buffer of the same length.
 struct Xfer {
