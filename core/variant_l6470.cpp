@@ -1,41 +1,17 @@
 // The L6470 register table (datasheet Table 9), STATUS layout (Table 34) and
 // ALARM_EN bits (Table 21). Other variants live in files of their own.
+#include "core/register_rows.hpp"
 #include "core/variant.hpp"
 
 namespace l6470emu {
 namespace {
 
-using enum Access;
-using enum Reg;
-
-constexpr RegisterInfo kL6470Registers[] = {
-    // address, id, name, bits, reset, access, flags
-    {0x01, ABS_POS, "ABS_POS", 22, 0x000000, WS, kSigned | kLive},
-    {0x02, EL_POS, "EL_POS", 9, 0x000, WS, kLive},
-    {0x03, MARK, "MARK", 22, 0x000000, WR, kSigned},
-    {0x04, SPEED, "SPEED", 20, 0x00000, R, kLive},
-    {0x05, ACC, "ACC", 12, 0x08A, WS, kNoFlags},
-    {0x06, DEC, "DEC", 12, 0x08A, WS, kNoFlags},
-    {0x07, MAX_SPEED, "MAX_SPEED", 10, 0x041, WR, kNoFlags},
-    {0x08, MIN_SPEED, "MIN_SPEED", 13, 0x000, WS, kNoFlags},
-    {0x09, KVAL_HOLD, "KVAL_HOLD", 8, 0x29, WR, kNoFlags},
-    {0x0A, KVAL_RUN, "KVAL_RUN", 8, 0x29, WR, kNoFlags},
-    {0x0B, KVAL_ACC, "KVAL_ACC", 8, 0x29, WR, kNoFlags},
-    {0x0C, KVAL_DEC, "KVAL_DEC", 8, 0x29, WR, kNoFlags},
-    {0x0D, INT_SPEED, "INT_SPEED", 14, 0x0408, WH, kWriteConflict},
-    {0x0E, ST_SLP, "ST_SLP", 8, 0x19, WH, kWriteConflict},
-    {0x0F, FN_SLP_ACC, "FN_SLP_ACC", 8, 0x29, WH, kWriteConflict},
-    {0x10, FN_SLP_DEC, "FN_SLP_DEC", 8, 0x29, WH, kWriteConflict},
-    {0x11, K_THERM, "K_THERM", 4, 0x0, WR, kNoFlags},
-    {0x12, ADC_OUT, "ADC_OUT", 5, 0x00, R, kLive},
-    {0x13, OCD_TH, "OCD_TH", 4, 0x8, WR, kNoFlags},
-    {0x14, STALL_TH, "STALL_TH", 7, 0x40, WR, kNoFlags},
-    {0x15, FS_SPD, "FS_SPD", 10, 0x027, WR, kNoFlags},
-    {0x16, STEP_MODE, "STEP_MODE", 8, 0x07, WH, kNoFlags},
-    {0x17, ALARM_EN, "ALARM_EN", 8, 0xFF, WS, kNoFlags},
-    {0x18, CONFIG, "CONFIG", 16, 0x2E88, WH, kWriteConflict},
-    {0x19, STATUS, "STATUS", 16, 0x0000, R, kLive},
-};
+constexpr auto kL6470Registers = rows::concat(
+    rows::kMotion, rows::kVoltageMode, rows::row(rows::kAdcOut),
+    rows::row({0x13, Reg::OCD_TH, "OCD_TH", 4, 0x8, Access::WR, kNoFlags}),
+    rows::row({0x14, Reg::STALL_TH, "STALL_TH", 7, 0x40, Access::WR, kNoFlags}),
+    rows::row({0x15, Reg::FS_SPD, "FS_SPD", 10, 0x027, Access::WR, kNoFlags}), rows::row(rows::kStepMode),
+    rows::row(rows::kAlarmEn), rows::config_and_status(0x18, 0x2E88, kWriteConflict));
 
 static_assert(register_table_is_consistent(kL6470Registers));
 static_assert(std::size(kL6470Registers) == 25, "0x01..0x19, 0x1A/0x1B reserved");

@@ -8,22 +8,10 @@
 namespace l6470emu {
 namespace {
 
-using enum Access;
-using enum Reg;
-
 /// The voltage-mode rows with 0x09-0x0C, 0x0E-0x10 read in current mode.
-constexpr std::array<RegisterInfo, 27> kCurrentModeRegisters = [] {
+constexpr auto kCurrentModeRegisters = [] {
   auto t = kVoltageModeGateDriverRegisters;
-  constexpr RegisterInfo kAliases[] = {
-      {0x09, TVAL_HOLD, "TVAL_HOLD", 7, 0x29, WR, kNoFlags},
-      {0x0A, TVAL_RUN, "TVAL_RUN", 7, 0x29, WR, kNoFlags},
-      {0x0B, TVAL_ACC, "TVAL_ACC", 7, 0x29, WR, kNoFlags},
-      {0x0C, TVAL_DEC, "TVAL_DEC", 7, 0x29, WR, kNoFlags},
-      {0x0E, T_FAST, "T_FAST", 8, 0x19, WH, kNoFlags},
-      {0x0F, TON_MIN, "TON_MIN", 7, 0x29, WH, kNoFlags},
-      {0x10, TOFF_MIN, "TOFF_MIN", 7, 0x29, WH, kNoFlags},
-  };
-  for (const auto& a : kAliases)
+  for (const auto& a : rows::kCurrentMode)
     for (auto& r : t)
       if (r.address == a.address) r = a;
   return t;
