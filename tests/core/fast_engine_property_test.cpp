@@ -134,7 +134,7 @@ void random_command(Pair& p, Gen& g) {
 }
 
 TEST(FastEngine, AgreesWithTheReferenceOnRandomProfilesAndCommandSequences) {
-  for (std::uint64_t seed = 1; seed <= 1500; ++seed) {
+  for (std::uint64_t seed = 1; seed <= 2000; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     Gen g(seed);
     Pair p;
