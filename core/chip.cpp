@@ -23,7 +23,9 @@ std::string hex(std::uint32_t v, int digits) {
 
 Chip::Chip(const Variant& variant, Quirks quirks)
     : variant_(&variant), table_(&variant), quirks_(quirks), layout_(variant.status) {
-  if (quirks.stall_bits == StallBitOrder::a_on_15) std::swap(layout_.step_loss_a, layout_.step_loss_b);
+  // The stall-bit conflict concerns the gate-driver layout (stall flags on bits 14/15) only.
+  if (quirks.stall_bits == StallBitOrder::a_on_15 && layout_.step_loss_a == 14 && layout_.step_loss_b == 15)
+    std::swap(layout_.step_loss_a, layout_.step_loss_b);
   reset_logic();
   come_out_of_reset();
 }

@@ -10,7 +10,7 @@ constexpr auto kRegisters = rows::concat(
     rows::kMotion, rows::kCurrentMode, rows::row(rows::kAdcOut),
     rows::row({0x13, Reg::OCD_TH, "OCD_TH", 4, 0x8, Access::WR, kNoFlags}),
     rows::row({0x15, Reg::FS_SPD, "FS_SPD", 10, 0x027, Access::WR, kNoFlags}), rows::row(rows::kStepMode),
-    rows::row(rows::kAlarmEn), rows::config_and_status(0x18, 0x2E88, kUnconfirmed));
+    rows::row(rows::kAlarmEn), rows::config_and_status(0x18, 0x2E88, kWriteConflict | kUnconfirmed));
 
 static_assert(register_table_is_consistent(kRegisters));
 

@@ -12,7 +12,7 @@ constexpr auto kRegisters = rows::concat(
     rows::row({0x13, Reg::OCD_TH, "OCD_TH", 5, 0x08, Access::WR, kNoFlags}),
     rows::row({0x15, Reg::FS_SPD, "FS_SPD", 11, 0x027, Access::WR, kNoFlags}),
     rows::row({0x16, Reg::STEP_MODE, "STEP_MODE", 8, 0x07, Access::WH, kUnconfirmed}), rows::row(rows::kAlarmEn),
-    rows::kGateConfig, rows::config_and_status(0x1A, 0x2C88, kUnconfirmed));
+    rows::kGateConfig, rows::config_and_status(0x1A, 0x2C88, kWriteConflict | kUnconfirmed));
 
 static_assert(register_table_is_consistent(kRegisters));
 
