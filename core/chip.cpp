@@ -36,9 +36,7 @@ void Chip::reset_logic() {
   touched();
   table_ = variant_;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
-  const std::int32_t keep_nothing = 0;
   motion_ = MotionState{};
-  motion_.abs_pos = keep_nothing;
   refresh_profile();
   collecting_ = false;
   args_seen_ = 0;
@@ -368,22 +366,7 @@ void Chip::sync() const {
     reference_advance(motion_, profile_, left);
     return;
   }
-  // fast_advance(), remembering the length of the current run of uniform ticks
-  // between calls so that frequent polling does not search for it again.
-  while (left > 0 && motion_active(motion_)) {
-    if (!uniform_known_) {
-      uniform_left_ = uniform_ticks(motion_, profile_, kNever - 1);
-      uniform_known_ = true;
-    }
-    const Tick n = std::min(uniform_left_, left);
-    apply_uniform_ticks(motion_, profile_, n);
-    uniform_left_ -= n;
-    left -= n;
-    if (left == 0) break;
-    reference_tick(motion_, profile_);
-    --left;
-    touched();
-  }
+  if (fast_advance(motion_, profile_, left, run_)) live_bits_known_ = false;
 }
 
 Tick Chip::next_event_tick() const { return motion_active(motion()) ? now_ + 1 : kNever; }

@@ -175,8 +175,7 @@ class Chip {
   mutable std::uint16_t live_bits_ = 0;
   std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
   bool latched_clean_ = false;      // latched_ == condition_ is known (GetStatus has nothing to clear)
-  mutable bool uniform_known_ = false;
-  mutable Tick uniform_left_ = 0;
+  mutable UniformRun run_;  // fast engine: uniform ticks left from motion_now_
   mutable Tick motion_now_ = 0;
   Quirks quirks_;
   StatusLayout layout_;
@@ -195,18 +194,17 @@ class Chip {
   // Motion state as of motion_now_ (<= now_); sync() brings it up to now_.
   mutable MotionState motion_{};
   Profile profile_{};
-  // Fast engine: uniform ticks left from motion_now_, valid until a command, pin or fault changes things.
   // The live half of STATUS, valid until the motion leaves its run of uniform ticks
   // (MOT_STATUS, BUSY, DIR, HiZ, SW_F and SCK_MOD cannot change inside one).
   /// Works the motion out up to now_.
   void sync() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
   bool status_known_without_sync() const {
-    return live_bits_known_ && (!motion_active(motion_) || (uniform_known_ && now_ - motion_now_ <= uniform_left_));
+    return live_bits_known_ && (!motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left));
   }
   /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
   void touched() const {
-    uniform_known_ = false;
+    run_.known = false;
     live_bits_known_ = false;
   }
 

@@ -178,15 +178,24 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
   if (s.activity == Activity::position && !s.reversing) s.steps_left -= static_cast<std::uint32_t>(steps);
 }
 
-void fast_advance(MotionState& s, const Profile& p, Tick ticks) {
+bool fast_advance(MotionState& s, const Profile& p, Tick ticks, UniformRun& run) {
+  bool boundary = false;
   while (ticks > 0 && motion_active(s)) {
-    const Tick n = uniform_ticks(s, p, ticks);
+    if (!run.known) {
+      run.left = uniform_ticks(s, p, kNever - 1);
+      run.known = true;
+    }
+    const Tick n = std::min(run.left, ticks);
     apply_uniform_ticks(s, p, n);
+    run.left -= n;
     ticks -= n;
     if (ticks == 0) break;
     reference_tick(s, p);
     --ticks;
+    run.known = false;
+    boundary = true;
   }
+  return boundary;
 }
 
 }  // namespace l6470emu

@@ -24,15 +24,22 @@ Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit);
 /// Applies `n` uniform ticks (n <= uniform_ticks()) in closed form.
 void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n);
 
-/// Advances by `ticks` ticks with the event-driven engine; identical to reference_advance().
-void fast_advance(MotionState& s, const Profile& p, Tick ticks);
+/// What the event-driven engine remembers between calls: how many uniform ticks are left
+/// from the current state. Forget it (known = false) whenever the state or the profile is
+/// changed by anything but the passage of time.
+struct UniformRun {
+  Tick left = 0;
+  bool known = false;
+};
 
-/// Advances with the chosen engine.
-inline void motion_advance(MotionEngine e, MotionState& s, const Profile& p, Tick ticks) {
-  if (e == MotionEngine::fast)
-    fast_advance(s, p, ticks);
-  else
-    reference_advance(s, p, ticks);
+/// Advances by `ticks` ticks with the event-driven engine; identical to reference_advance().
+/// Returns true when a boundary tick was crossed (MOT_STATUS, BUSY and the like may have changed).
+bool fast_advance(MotionState& s, const Profile& p, Tick ticks, UniformRun& run);
+
+/// The same without remembering anything between calls.
+inline void fast_advance(MotionState& s, const Profile& p, Tick ticks) {
+  UniformRun run;
+  fast_advance(s, p, ticks, run);
 }
 
 }  // namespace l6470emu
