@@ -6,6 +6,10 @@
 namespace l6470emu {
 namespace {
 
+// A copy with internal linkage: constant evaluation (and UBSan's null checks) only
+// accept addresses of this translation unit's own constexpr objects here.
+constexpr auto kRegisters = kVoltageModeGateDriverRegisters;
+
 
 constexpr std::string_view kUnconfirmedChoices[] = {
     "write conditions (WS/WH/WR) mirror the L6470 table plus WH for GATECFG1/2 and CONFIG: one third-party driver",
@@ -15,7 +19,7 @@ constexpr std::string_view kUnconfirmedChoices[] = {
 };
 
 constexpr Variant kVariant = [] {
-  Variant v = make_variant("L6480", kVoltageModeGateDriverRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
+  Variant v = make_variant("L6480", kRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
   v.unconfirmed = kUnconfirmedChoices;
   return v;
 }();

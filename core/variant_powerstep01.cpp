@@ -8,9 +8,13 @@
 namespace l6470emu {
 namespace {
 
+// A copy with internal linkage: constant evaluation (and UBSan's null checks) only
+// accept addresses of this translation unit's own constexpr objects here.
+constexpr auto kRegisters = kVoltageModeGateDriverRegisters;
+
 /// The voltage-mode rows with 0x09-0x0C, 0x0E-0x10 read in current mode.
 constexpr auto kCurrentModeRegisters = [] {
-  auto t = kVoltageModeGateDriverRegisters;
+  auto t = kRegisters;
   for (const auto& a : rows::kCurrentMode)
     for (auto& r : t)
       if (r.address == a.address) r = a;
@@ -35,7 +39,7 @@ constexpr Variant kCurrentMode = [] {
 }();
 
 constexpr Variant kVoltageMode = [] {
-  Variant v = make_variant("powerSTEP01", kVoltageModeGateDriverRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
+  Variant v = make_variant("powerSTEP01", kRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
   v.current_mode = &kCurrentMode;
   v.reset_device_needs_hiz = true;
   v.unconfirmed = kUnconfirmedChoices;
