@@ -60,8 +60,11 @@ class Chain final : public SpiDevice {
   /// Bytes clocked since the last CS falling edge.
   std::uint64_t bytes_in_frame() const { return bytes_in_frame_; }
 
- private:
+  /// The byte in chip `i`'s shift register, without side effects: inside a frame, the byte the
+  /// chip will decode at the CS rising edge; between frames, the byte it will shift out next.
   std::uint8_t shift_register(std::size_t i) const { return ring_[(head_ + i) % ring_.size()]; }
+
+ private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
 

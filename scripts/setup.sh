@@ -8,6 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
+  gcc python3 python3-spidev python3-libgpiod gpiod libgpiod-dev umockdev
+  sigrok-cli
 )
 
 missing=()

@@ -4,8 +4,10 @@
 #include <iostream>
 #include <sstream>
 
+#include "tools/cmd_serve.hpp"
 #include "tools/demo.hpp"
 #include "tools/tables.hpp"
+#include "tools/trace_commands.hpp"
 
 namespace {
 
@@ -49,7 +51,11 @@ int main(int argc, char** argv) {
                              "variant-differences"}));
   tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
 
+  l6470emu::ServeCommands serve_commands(app);  // serve, ctl
+  l6470emu::add_trace_commands(app);             // replay, decode, convert
+
   CLI11_PARSE(app, argc, argv);
+  if (auto status = serve_commands.run()) return *status;
   if (*demo) return l6470emu::run_demo(chips, seconds, std::cout);
   if (*tables) {
     if (!readme.empty()) return update_readme(readme);

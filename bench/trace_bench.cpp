@@ -1,0 +1,119 @@
+// Trace benchmarks: replaying a native trace of 10 million frames from disk (parse, drive
+// the emulated chain, compare every MISO byte; goal >= 2 M frames/s) and importing a Saleae
+// Logic 2 CSV export (goal >= 50 MB/s). The inputs are generated here, in /tmp, not committed.
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <random>
+#include <string>
+#include <unistd.h>
+
+#include "daisychain/recording_chain.hpp"
+#include "daisychain/replay.hpp"
+#include "spi/trace_import.hpp"
+#include "spi/trace_native.hpp"
+
+namespace {
+
+using namespace l6470emu;
+
+constexpr std::size_t kChips = 3;
+
+/// Records `frames` CS frames of a 3-chip chain into a native trace at `path`: a host polling
+/// every chip's STATUS (3 frames) and ABS_POS (4 frames) every 100 µs and, every 10 ms, giving
+/// each chip a Move or a Run at random. The MISO bytes are the emulator's own, so a replay
+/// must match everywhere.
+void record_trace(const std::string& path, std::uint64_t frames) {
+  Chain chain(kChips);
+  NativeTraceWriter writer(path, /*flush_each_event=*/false);
+  RecordingChain rec(chain, writer, RecordOptions{false});
+  std::mt19937 rng(6470);
+  std::vector<std::uint8_t> tx(kChips), rx(kChips);
+  auto frame = [&](std::uint8_t b0, std::uint8_t b1, std::uint8_t b2) {
+    rec.advance_to(rec.now() + 4);
+    rec.select();
+    tx = {b0, b1, b2};
+    rec.advance_to(rec.now() + 3 * 7);
+    rec.exchange(tx, rx);
+    rec.deselect();
+  };
+  std::uint64_t n = 0, cycle = 0;
+  while (n < frames) {
+    frame(0xD0, 0xD0, 0xD0);
+    frame(0, 0, 0);
+    frame(0, 0, 0);
+    frame(0x21, 0x21, 0x21);
+    frame(0, 0, 0);
+    frame(0, 0, 0);
+    frame(0, 0, 0);
+    n += 7;
+    if (++cycle % 100 == 0) {
+      const std::uint32_t steps = std::uniform_int_distribution<std::uint32_t>(100, 20000)(rng);
+      const std::uint8_t op = (rng() & 1) ? 0x41 : 0x51;
+      frame(op, op ^ 1, op);
+      frame(0, 0, 0);
+      frame(static_cast<std::uint8_t>(steps >> 8), static_cast<std::uint8_t>(steps >> 8), 0x10);
+      frame(static_cast<std::uint8_t>(steps), static_cast<std::uint8_t>(steps), 0x00);
+      n += 4;
+    }
+    rec.advance_to(rec.now() + ticks_from_us(100));
+  }
+}
+
+std::string temp_path(const char* name) { return "/tmp/l6470emu-bench-" + std::to_string(getpid()) + "-" + name; }
+
+void BM_ReplayNativeTrace(benchmark::State& state) {
+  const auto frames = static_cast<std::uint64_t>(state.range(0));
+  const std::string path = temp_path("replay.trace");
+  record_trace(path, frames);
+  ReplayResult r;
+  for (auto _ : state) {
+    NativeTraceReader reader(path);
+    Chain chain(kChips);
+    r = replay_trace(reader, chain);
+  }
+  std::remove(path.c_str());
+  if (!r.matched()) {
+    state.SkipWithError("the replay diverged from its own recording");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(r.frames) * state.iterations());  // items/s = frames/s
+  state.counters["frames"] = static_cast<double>(r.frames);
+}
+BENCHMARK(BM_ReplayNativeTrace)->Arg(10'000'000)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// A Logic 2 analyzer export of about `bytes` bytes: 1-byte frames (enable, result, disable).
+std::string saleae_csv(std::size_t bytes) {
+  std::string s = "name,type,start_time,duration,\"mosi\",\"miso\"\n";
+  s.reserve(bytes + 256);
+  char line[160];
+  double t = 0.4118532;
+  std::uint8_t v = 0;
+  while (s.size() < bytes) {
+    const int n = std::snprintf(line, sizeof line,
+                                "\"SPI\",\"enable\",%.9f,2e-08,,\n\"SPI\",\"result\",%.9f,0.000001520,0x%02X,0x%02X\n"
+                                "\"SPI\",\"disable\",%.9f,2e-08,,\n",
+                                t, t + 2.5e-7, v, static_cast<std::uint8_t>(v * 7), t + 1.9e-6);
+    s.append(line, static_cast<std::size_t>(n));
+    t += 4e-6;
+    ++v;
+  }
+  return s;
+}
+
+void BM_ImportSaleaeCsv(benchmark::State& state) {
+  const std::string csv = saleae_csv(static_cast<std::size_t>(state.range(0)) << 20);
+  std::size_t frames = 0;
+  for (auto _ : state) {
+    const Trace t = import_saleae_csv(csv, "bench.csv");
+    frames = t.frame_count();
+    benchmark::DoNotOptimize(frames);
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(csv.size()) * state.iterations());  // bytes/s = MB/s
+  state.counters["frames"] = static_cast<double>(frames);
+}
+BENCHMARK(BM_ImportSaleaeCsv)->Arg(100)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

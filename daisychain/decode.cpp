@@ -1,0 +1,187 @@
+// decode_trace: formats ProtocolTracker events, one line each, and rate-limits repeated
+// diagnostics so a host that always sends the wrong frame length does not drown the log.
+#include "daisychain/decode.hpp"
+
+#include <cstdio>
+#include <deque>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "daisychain/explain.hpp"
+#include "daisychain/protocol_tracker.hpp"
+
+namespace l6470emu {
+namespace {
+
+std::string stamp(double seconds) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "t=%.6f s  ", seconds);
+  return buf;
+}
+
+std::string chip_column(std::size_t chip) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "chip %-3zu ", chip);
+  return buf;
+}
+
+const char* issue_name(ProtocolEvent::Issue i) {
+  switch (i) {
+    case ProtocolEvent::Issue::wrong_cmd: return "WRONG_CMD";
+    case ProtocolEvent::Issue::notperf_cmd: return "NOTPERF_CMD";
+    case ProtocolEvent::Issue::chain_length: return "frame length";
+    case ProtocolEvent::Issue::standby: return "standby";
+    case ProtocolEvent::Issue::answer_lost: return "answer lost";
+    case ProtocolEvent::Issue::none: break;
+  }
+  return "diagnostic";
+}
+
+class Decoder {
+ public:
+  Decoder(std::ostream& out, const DecodeOptions& options, const std::string& name)
+      : out_(out), options_(options), name_(name) {}
+
+  void on_event(const ProtocolEvent& e) {
+    if (!shown(e.chip)) return;
+    const double t = display_seconds(e.tick, e.source_time);
+    switch (e.kind) {
+      case ProtocolEvent::Kind::command: {
+        const Command c = e.op.command;
+        if (c == Command::GetParam || c == Command::GetStatus) return;  // shown with the answer
+        if (c == Command::NOP && !options_.show_nops) return;
+        if (c != Command::NOP) ++summary.commands;
+        line_ = stamp(t) + chip_column(e.chip) + describe_command(e.opcode, e.arg, *e.table, *e.layout);
+        break;
+      }
+      case ProtocolEvent::Kind::answer: {
+        ++summary.answers;
+        if (!e.complete) {
+          diagnostic(e, t, opcode_name(e.opcode, *e.table) + " answer lost: " + e.text);
+          return;
+        }
+        line_ = stamp(t) + chip_column(e.chip) + describe_answer(e.opcode, e.value, *e.table, *e.layout);
+        if (!e.captured) {
+          line_ += "  (MISO not captured: the emulator's answer)";
+        } else if (e.value != e.emulated) {
+          ++summary.answer_mismatches;
+          line_ += "  (the emulator answers " + hex_value(e.emulated, 8u * e.answer_bytes) + ")";
+        }
+        break;
+      }
+      case ProtocolEvent::Kind::diagnostic:
+        // WRONG_CMD and NOTPERF_CMD texts start with the flag's name already.
+        diagnostic(e, t,
+                   e.issue == ProtocolEvent::Issue::wrong_cmd || e.issue == ProtocolEvent::Issue::notperf_cmd
+                       ? e.text
+                       : std::string(issue_name(e.issue)) + ": " + e.text);
+        return;
+    }
+    put(t, std::move(line_));
+  }
+
+  bool shown(std::size_t chip) const {
+    return options_.only_chip < 0 || chip == ProtocolEvent::kNoChip || chip == static_cast<std::size_t>(options_.only_chip);
+  }
+
+  void pin(const TraceEvent& e, double t) {
+    if (!shown(e.chip)) return;
+    std::string what;
+    const bool level = e.value != 0;
+    if (e.kind == TraceEventKind::pin) {
+      switch (e.pin) {
+        case TracePin::SW: what = level ? "SW pin high (switch open)" : "SW pin low (switch closed)"; break;
+        case TracePin::STCK: what = level ? "STCK pin high" : "STCK pin low"; break;
+        case TracePin::STBY: what = level ? "STBY\\RST high (out of standby: power-up state)" : "STBY\\RST low (standby)"; break;
+        case TracePin::BUSY: what = level ? "BUSY output high (released)" : "BUSY output low (busy)"; break;
+        case TracePin::FLAG: what = level ? "FLAG output high (no alarm)" : "FLAG output low (alarm)"; break;
+      }
+      // STCK edges are as frequent as the steps: show them only with --nops.
+      if (e.pin == TracePin::STCK && !options_.show_nops) return;
+    } else {
+      what = "fault " + std::string(to_string(e.fault)) + " ";
+      if (e.fault == TraceFault::THERMAL) what += thermal_name(e.value);
+      else if (e.fault == TraceFault::ADCIN) what = "ADCIN level: ADC_OUT code " + std::to_string(e.value);
+      else what += level ? "on" : "off";
+    }
+    put(t, stamp(t) + chip_column(e.chip) + what);
+  }
+
+  /// Writes the lines earlier than `watermark` (the start of the oldest answer still being
+  /// shifted out, whose line comes later), so the log stays in time order.
+  void flush(double watermark) {
+    while (!pending_.empty() && pending_.front().first < watermark) {
+      out_ << pending_.front().second << '\n';
+      pending_.pop_front();
+    }
+  }
+
+  DecodeSummary summary;
+
+ private:
+  void diagnostic(const ProtocolEvent& e, double t, const std::string& text) {
+    ++summary.diagnostics;
+    const auto key = std::make_pair(e.chip, static_cast<int>(e.issue));
+    std::size_t& count = seen_[key];
+    ++count;
+    if (options_.max_repeats != 0 && count > options_.max_repeats) {
+      ++summary.suppressed;
+      return;
+    }
+    std::string where = e.chip == ProtocolEvent::kNoChip ? "frame " + std::to_string(e.frame + 1) + " " : chip_column(e.chip);
+    std::string l = stamp(t) + where + "! " + text + "  [" + name_;
+    if (e.line) l += ":" + std::to_string(e.line);
+    l += ']';
+    if (options_.max_repeats != 0 && count == options_.max_repeats) l += "  (further ones of this kind not shown)";
+    put(t, std::move(l));
+  }
+
+  /// Queues a line at time `t`, after the queued lines of the same or earlier times.
+  void put(double t, std::string line) {
+    auto at = pending_.end();
+    while (at != pending_.begin() && std::prev(at)->first > t) --at;
+    pending_.insert(at, {t, std::move(line)});
+  }
+
+  std::ostream& out_;
+  const DecodeOptions& options_;
+  const std::string& name_;
+  std::string line_;
+  std::deque<std::pair<double, std::string>> pending_;
+  std::map<std::pair<std::size_t, int>, std::size_t> seen_;
+};
+
+}  // namespace
+
+DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, const DecodeOptions& options) {
+  const std::string name = in.header().name;
+  Decoder decoder(out, options, name);
+  ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); });
+  TraceEvent e;
+  std::vector<std::uint8_t> rx;
+  while (in.next(e)) {
+    if (e.kind == TraceEventKind::frame) {
+      ++decoder.summary.frames;
+      rx.resize(e.mosi.size());
+      tracker.begin_frame(e, rx);
+      tracker.end_frame();
+      decoder.flush(tracker.pending_answer_seconds());
+      continue;
+    }
+    if (e.chip >= chain.size())
+      throw TraceError(name, e.line, "event for chip " + std::to_string(e.chip) + ", but the chain has " +
+                                         std::to_string(chain.size()) + " chips (see --chain)");
+    tracker.apply(e);
+    decoder.pin(e, display_seconds(e.tick, e.source_time));
+    decoder.flush(tracker.pending_answer_seconds());
+  }
+  tracker.finish();
+  decoder.flush(std::numeric_limits<double>::infinity());
+  return decoder.summary;
+}
+
+}  // namespace l6470emu

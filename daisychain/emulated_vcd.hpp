@@ -1,0 +1,24 @@
+// VCD export of a trace run through an emulated chain: the SPI wires bit by bit (mode 3)
+// plus, per chip, BUSY and FLAG as the emulator drives them, SW, STCK and STBY as the
+// trace drives them, and ABS_POS as a value. Levels between events are sampled, not exact.
+#pragma once
+
+#include <iosfwd>
+
+#include "core/tick.hpp"
+#include "daisychain/chain.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// Choices for export_emulated_vcd.
+struct EmulatedVcdOptions {
+  unsigned timescale_ns = 10;               ///< VCD time unit (1, 10 or 100 ns)
+  Tick sample_ticks = ticks_from_us(10);    ///< while a chip moves, look at it this often
+};
+
+/// Writes `trace`, replayed through `chain` (fresh), as VCD to `out`. Throws TraceError
+/// for events naming chips outside the chain.
+void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, const EmulatedVcdOptions& options = {});
+
+}  // namespace l6470emu

@@ -1,0 +1,142 @@
+// RecordingChain: forwards to the Chain and writes trace events at the CS rising edge.
+#include "daisychain/recording_chain.hpp"
+
+#include "daisychain/chain_spec.hpp"
+
+namespace l6470emu {
+
+RecordingChain::RecordingChain(Chain& chain, TraceSink& sink, RecordOptions options)
+    : chain_(chain), sink_(sink), options_(options) {
+  TraceHeader h;
+  h.format = "native";
+  h.chain = chain_spec_of(chain_);
+  sink_.write_header(h);
+  if (options_.observe_outputs) {
+    busy_.assign(chain_.size(), 2);  // 2 = not seen yet: the first look records the level
+    flag_.assign(chain_.size(), 2);
+    observe_outputs();
+  }
+}
+
+void RecordingChain::emit(const TraceEvent& e) { sink_.write(e); }
+
+void RecordingChain::select() {
+  if (chain_.selected()) return;
+  frame_start_ = chain_.now();
+  tx_.clear();
+  rx_.clear();
+  chain_.select();
+}
+
+std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
+  const std::uint8_t miso = chain_.exchange(mosi);
+  if (chain_.selected()) {
+    tx_.push_back(mosi);
+    rx_.push_back(miso);
+  }
+  return miso;
+}
+
+void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  chain_.exchange(tx, rx);
+  if (chain_.selected()) {
+    tx_.insert(tx_.end(), tx.begin(), tx.end());
+    rx_.insert(rx_.end(), rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()));
+  }
+}
+
+void RecordingChain::deselect() {
+  if (!chain_.selected()) return;
+  chain_.deselect();
+  TraceEvent e;
+  e.kind = TraceEventKind::frame;
+  e.tick = frame_start_;
+  e.duration = chain_.now() - frame_start_;
+  e.mosi = tx_;
+  e.miso = rx_;
+  // A frame of no bytes keeps no MISO list (nothing to compare).
+  if (tx_.empty()) e.miso = {};
+  emit(e);
+  ++frames_;
+  for (const TraceEvent& d : deferred_) emit(d);
+  deferred_.clear();
+  observe_outputs();
+}
+
+void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value) {
+  TraceEvent e;
+  e.kind = kind;
+  e.tick = chain_.now();
+  e.chip = static_cast<std::uint16_t>(chip);
+  e.value = value;
+  if (kind == TraceEventKind::pin)
+    e.pin = static_cast<TracePin>(what);
+  else
+    e.fault = static_cast<TraceFault>(what);
+  if (kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+    emit(e);  // an observation, made between frames
+    return;
+  }
+  if (chain_.selected()) {
+    deferred_.push_back(e);
+    return;
+  }
+  emit(e);
+  observe_outputs();
+}
+
+void RecordingChain::set_sw_pin(std::size_t chip, bool level) {
+  chain_.chip(chip).set_sw_pin(level);
+  backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW), level);
+}
+void RecordingChain::set_stck_pin(std::size_t chip, bool level) {
+  chain_.chip(chip).set_stck_pin(level);
+  backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STCK), level);
+}
+void RecordingChain::set_stby_rst_pin(std::size_t chip, bool level) {
+  chain_.chip(chip).set_stby_rst_pin(level);
+  backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STBY), level);
+}
+void RecordingChain::set_adc_input(std::size_t chip, std::uint8_t code) {
+  chain_.chip(chip).set_adc_input(code);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::ADCIN), code > 31 ? 31 : code);
+}
+void RecordingChain::set_undervoltage(std::size_t chip, bool active) {
+  chain_.chip(chip).set_undervoltage(active);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::UVLO), active);
+}
+void RecordingChain::set_adc_undervoltage(std::size_t chip, bool active) {
+  chain_.chip(chip).set_adc_undervoltage(active);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::UVLO_ADC), active);
+}
+void RecordingChain::set_thermal(std::size_t chip, Thermal t) {
+  chain_.chip(chip).set_thermal(t);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::THERMAL), static_cast<std::uint8_t>(t));
+}
+void RecordingChain::set_overcurrent(std::size_t chip, bool active) {
+  chain_.chip(chip).set_overcurrent(active);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::OCD), active);
+}
+void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
+  chain_.chip(chip).set_stall(bridge, active);
+  backdoor(chip, TraceEventKind::fault,
+           static_cast<std::uint8_t>(bridge == Bridge::A ? TraceFault::STALL_A : TraceFault::STALL_B), active);
+}
+
+void RecordingChain::observe_outputs() {
+  if (!options_.observe_outputs || chain_.selected()) return;
+  for (std::size_t k = 0; k < chain_.size(); ++k) {
+    const Chip& c = chain_.chip(k);
+    const std::uint8_t busy = c.busy_sync_pin(), flag = c.flag_pin();
+    if (busy != busy_[k]) {
+      busy_[k] = busy;
+      backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::BUSY), busy);
+    }
+    if (flag != flag_[k]) {
+      flag_[k] = flag;
+      backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::FLAG), flag);
+    }
+  }
+}
+
+}  // namespace l6470emu

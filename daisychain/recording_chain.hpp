@@ -1,0 +1,74 @@
+// A chain that records itself: every CS frame (with its times, MOSI and MISO), every
+// backdoor pin or fault change, and the BUSY/FLAG levels it sees change, go to a
+// TraceSink (a native trace file is flushed event by event). Any transport — in-process
+// tests, spidev messages, the preload or daemon — records by talking to this instead of
+// the Chain. It adds no behaviour of its own and is not thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "daisychain/chain.hpp"
+#include "spi/spi_device.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// Choices for a recording.
+struct RecordOptions {
+  /// Look at every chip's BUSY and FLAG after each frame and event, and record changes
+  /// (replay then checks them). Costs a motion update per chip per frame.
+  bool observe_outputs = true;
+};
+
+/// Records what happens to a Chain through it.
+class RecordingChain final : public SpiDevice {
+ public:
+  /// Records `chain` into `sink` (the header, with the chain's description, is written now,
+  /// followed by the chips' BUSY and FLAG levels). Both must outlive the recorder.
+  RecordingChain(Chain& chain, TraceSink& sink, RecordOptions options = {});
+
+  // SpiDevice: forwarded to the chain; a frame is recorded at its CS rising edge.
+  void select() override;
+  std::uint8_t exchange(std::uint8_t mosi) override;
+  void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override;
+  void deselect() override;
+  bool selected() const override { return chain_.selected(); }
+  Tick now() const override { return chain_.now(); }
+  void advance_to(Tick tick) override { chain_.advance_to(tick); }
+
+  // The physical world, recorded (chip k of the chain). Changes made while CS is low are
+  // written after the frame's line (a trace line's time never goes back).
+  void set_sw_pin(std::size_t chip, bool level);
+  void set_stck_pin(std::size_t chip, bool level);
+  void set_stby_rst_pin(std::size_t chip, bool level);
+  void set_adc_input(std::size_t chip, std::uint8_t code);
+  void set_undervoltage(std::size_t chip, bool active);
+  void set_adc_undervoltage(std::size_t chip, bool active);
+  void set_thermal(std::size_t chip, Thermal t);
+  void set_overcurrent(std::size_t chip, bool active);
+  void set_stall(std::size_t chip, Bridge bridge, bool active);
+
+  /// Records BUSY/FLAG levels that changed since they were last seen (done after every
+  /// frame and event; call it to catch a change between frames, e.g. a move ending).
+  void observe_outputs();
+
+  Chain& chain() { return chain_; }
+  std::uint64_t frames_recorded() const { return frames_; }
+
+ private:
+  void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
+  void emit(const TraceEvent& e);
+
+  Chain& chain_;
+  TraceSink& sink_;
+  RecordOptions options_;
+  Tick frame_start_ = 0;
+  std::vector<std::uint8_t> tx_, rx_;
+  std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
+  std::vector<std::uint8_t> busy_, flag_;
+  std::uint64_t frames_ = 0;
+};
+
+}  // namespace l6470emu

@@ -1,0 +1,184 @@
+// The emulated board a transport serves: one daisy chain per spidev node, one gpiochip per
+// chain carrying its chips' pins, the clock, and the open files / line requests of the host
+// programs, with the kernel's semantics (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
+// Every open file or line request is a handle backed by a SOCK_SEQPACKET socketpair: the
+// host program gets one end as its file descriptor (poll/read see edge events natively),
+// the board keeps the other, and a handle lives until every copy of the host's end is closed.
+// Used in process by the preload library and, behind a Unix socket, by `l6470emu serve`.
+#pragma once
+
+#include <linux/spi/spidev.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <span>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "daisychain/chain.hpp"
+#include "linux/clock.hpp"
+#include "linux/config.hpp"
+#include "linux/gpio_lines.hpp"
+#include "linux/log.hpp"
+#include "linux/spidev_rules.hpp"
+
+namespace l6470emu {
+
+/// What kind of open file a handle is.
+enum class HandleKind : std::uint8_t {
+  spidev = 1,           ///< an open /dev/spidevB.C
+  gpiochip = 2,         ///< an open /dev/gpiochipN
+  line_handle_v1 = 3,   ///< GPIO_GET_LINEHANDLE_IOCTL result
+  line_event_v1 = 4,    ///< GPIO_GET_LINEEVENT_IOCTL result (reads struct gpioevent_data)
+  line_request_v2 = 5,  ///< GPIO_V2_GET_LINE_IOCTL result (reads struct gpio_v2_line_event)
+};
+
+/// A device node the board provides.
+struct DeviceNode {
+  enum class Type : std::uint8_t { spidev, gpiochip } type;
+  std::string path;      ///< "/dev/spidev0.0", "/dev/gpiochip0"
+  std::string name;      ///< "spidev0.0", "gpiochip0" (sysfs name)
+  unsigned major = 0;
+  unsigned minor = 0;
+  std::uint32_t bufsiz = 0;  ///< spidev: the bufsiz module parameter (EMSGSIZE limit)
+};
+
+/// A file the board created for a host program: result < 0 is -errno.
+struct NewFile {
+  long result = 0;
+  std::uint64_t handle = 0;
+  int fd = -1;  ///< the host's end; the caller owns it
+  HandleKind kind = HandleKind::spidev;
+};
+
+/// Called after every SPI message with the chain index, the message and the bytes: the place
+/// where a trace recorder attaches (see linux/serve/control.cpp, `ctl trace`).
+using MessageObserver = std::function<void(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
+                                           std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx,
+                                           Tick end_tick)>;
+
+/// The emulated hardware and the kernel-side state of its device nodes. Thread-safe.
+class Board {
+ public:
+  /// Builds the chains and gpiochips of `config`; diagnostics go to `log`.
+  Board(const BoardConfig& config, DiagnosticLog& log);
+  ~Board();
+  Board(const Board&) = delete;
+  Board& operator=(const Board&) = delete;
+
+  /// The device nodes, in a fixed order (index = device index for open()).
+  const std::vector<DeviceNode>& nodes() const { return nodes_; }
+
+  // ---- the host programs' side: what the kernel would do ---------------------
+
+  /// open() of node `device`; `cloexec` makes the host's end close-on-exec.
+  NewFile open(std::size_t device, bool cloexec);
+  /// A host program closed a descriptor of `handle`: if no copy of it is left anywhere,
+  /// the handle is released now (spidev's last-close reset, gpio lines freed).
+  void closed(std::uint64_t handle);
+  /// ioctl other than SPI_IOC_MESSAGE on `handle`. `arg` holds the _IOC_SIZE(cmd) argument bytes
+  /// (copied in for _IOC_WRITE, copied out for _IOC_READ by the caller). A line request fills
+  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno.
+  long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
+  /// SPI_IOC_MESSAGE(n): `tx` holds the tx data of the transfers with a tx_buf, concatenated;
+  /// `rx` (spidev_rx_bytes long) receives the rx data. Returns the total length or -errno.
+  long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                   std::span<std::uint8_t> rx);
+  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx);
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx);
+
+  // ---- the physical world (ctl, tests) ----------------------------------------
+
+  std::size_t chain_count() const { return chains_.size(); }
+  /// "spidev0.0 (3 x L6470, gpiochip0)".
+  std::string chain_summary(std::size_t chain) const;
+  /// Index of the chain on node path or name ("spidev0.0", "/dev/spidev0.0", "0.0"), or -1.
+  int find_chain(const std::string& name) const;
+  /// Runs `f` on chain `chain` brought up to the clock, then reports the pin edges it caused.
+  void with_chain(std::size_t chain, const std::function<void(Chain&)>& f);
+  /// Drives an input pin of chip `chip` (SW, STCK, STBY_RST) as the physical world would.
+  /// Returns false for an output pin or a bad index.
+  bool drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level);
+  /// Level of a pin of a chip (what a host reading the line would see before active-low).
+  bool pin_level(std::size_t chain, std::size_t chip, Pin pin);
+  /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
+  bool advance(Tick ticks);
+  /// Current tick of chain `chain`.
+  Tick now(std::size_t chain);
+  const BoardClock& clock() const { return clock_; }
+  /// Attaches (or with an empty function detaches) the SPI message observer.
+  void set_message_observer(MessageObserver observer);
+  /// Open handles, by kind, as text (for `ctl dump`).
+  std::string describe_handles();
+
+  /// Starts the thread that delivers BUSY/FLAG edges on time in wall mode and notices host
+  /// ends closed in other processes. Started on demand; the daemon starts it at once.
+  void start_pump();
+  /// Stops it (also done by the destructor).
+  void stop_pump();
+  /// After fork() in the child: the pump thread did not survive; forget it (restarted on demand).
+  void forget_pump_after_fork();
+  /// The lock of the whole board (for fork handlers).
+  std::mutex& mutex() { return m_; }
+
+ private:
+  struct ChainDev;
+  struct LineDev;
+  struct GpioDev;
+  struct Handle;
+
+  Handle* find(std::uint64_t id, HandleKind kind);
+  Handle* find_any(std::uint64_t id);
+  NewFile make_handle(HandleKind kind, std::size_t dev, bool cloexec, std::unique_ptr<Handle>& out);
+  void release(Handle& h);
+  void release_if_closed(std::uint64_t id);
+
+  // time and edges
+  void catch_up(ChainDev& c);
+  void advance_chain(ChainDev& c, Tick target);
+  Tick first_change(ChainDev& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
+  Tick predict_next_edge(ChainDev& c);
+  void emit_changes(ChainDev& c, Tick tick);
+  void refresh_watch_list(GpioDev& g);
+  bool physical_level(GpioDev& g, unsigned offset);
+  void set_chip_input(GpioDev& g, unsigned offset, bool level);
+  void send_line_event(Handle& h, unsigned index, bool rising, Tick tick);
+  void notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_type);
+  void wake_pump();
+  void pump_loop();
+
+  // gpio ioctls (board_gpio.cpp)
+  long gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
+  long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg);
+  void fill_v2_info(GpioDev& g, unsigned offset, void* info);
+  long request_lines(Handle& chip, HandleKind kind, const std::vector<unsigned>& offsets,
+                     const std::vector<std::uint64_t>& flags, const std::vector<int>& values, const char* consumer,
+                     std::uint32_t event_buffer_size, const std::vector<std::uint32_t>& debounce, NewFile* created);
+  long reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
+                         const std::vector<std::uint32_t>& debounce);
+  bool logical_value(Handle& h, unsigned index);
+
+  DiagnosticLog& log_;
+  BoardClock clock_;
+  std::vector<DeviceNode> nodes_;
+  std::vector<std::unique_ptr<ChainDev>> chains_;
+  std::vector<std::unique_ptr<GpioDev>> gpios_;
+  std::vector<int> node_target_;  // node index -> chain or gpio index
+  std::unordered_map<std::uint64_t, std::unique_ptr<Handle>> handles_;
+  std::uint64_t next_handle_ = 1;
+  MessageObserver observer_;
+
+  std::mutex m_;
+  std::thread pump_;
+  bool pump_running_ = false;
+  bool pump_stop_ = false;
+  int wake_fd_ = -1;
+};
+
+}  // namespace l6470emu

@@ -1,0 +1,91 @@
+// Board: the pump thread. In wall-clock mode it sleeps until the next BUSY/FLAG edge a
+// watched line will see and delivers it on time; in every mode it notices host ends of
+// handles closed elsewhere (a killed client, a forked child's last close) and releases them.
+#include <poll.h>
+#include <unistd.h>
+
+#include <climits>
+#include <new>
+
+#include "linux/board_internal.hpp"
+
+namespace l6470emu {
+
+void Board::start_pump() {
+  std::lock_guard lock(m_);
+  if (pump_running_) return;
+  pump_stop_ = false;
+  pump_running_ = true;
+  pump_ = std::thread([this] { pump_loop(); });
+}
+
+void Board::stop_pump() {
+  {
+    std::lock_guard lock(m_);
+    if (!pump_running_) return;
+    pump_stop_ = true;
+  }
+  wake_pump();
+  if (pump_.joinable()) pump_.join();
+  std::lock_guard lock(m_);
+  pump_running_ = false;
+}
+
+void Board::forget_pump_after_fork() {
+  // The thread does not exist in the child; drop the handle without touching it.
+  new (&pump_) std::thread();
+  pump_running_ = false;
+}
+
+void Board::wake_pump() {
+  if (!pump_running_ || wake_fd_ < 0) return;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] const ssize_t n = ::write(wake_fd_, &one, sizeof one);
+}
+
+void Board::pump_loop() {
+  std::vector<pollfd> fds;
+  std::vector<std::uint64_t> ids;
+  for (;;) {
+    std::int64_t deadline = INT64_MAX;
+    fds.clear();
+    ids.clear();
+    {
+      std::lock_guard lock(m_);
+      if (pump_stop_) return;
+      for (auto& c : chains_) {
+        if (c->gpio < 0 || gpios_[static_cast<std::size_t>(c->gpio)]->watched.empty()) continue;
+        catch_up(*c);
+        if (clock_.is_virtual()) continue;
+        const Tick t = predict_next_edge(*c);
+        if (t != kNever) deadline = std::min(deadline, clock_.wall_ns_of(t));
+      }
+      fds.push_back({wake_fd_, POLLIN, 0});
+      for (auto& [id, h] : handles_) {
+        fds.push_back({h->fd, 0, 0});  // POLLHUP is always reported
+        ids.push_back(id);
+      }
+    }
+    timespec ts{};
+    timespec* tsp = nullptr;
+    if (deadline != INT64_MAX) {
+      std::int64_t wait = deadline - monotonic_ns();
+      if (wait < 0) wait = 0;
+      ts.tv_sec = wait / 1'000'000'000;
+      ts.tv_nsec = wait % 1'000'000'000;
+      tsp = &ts;
+    }
+    const int n = ppoll(fds.data(), fds.size(), tsp, nullptr);
+    if (n <= 0) continue;
+    if (fds[0].revents & POLLIN) {
+      std::uint64_t v;
+      while (::read(wake_fd_, &v, sizeof v) == sizeof v) {
+      }
+    }
+    std::lock_guard lock(m_);
+    for (std::size_t i = 1; i < fds.size(); ++i)
+      if (fds[i].revents & (POLLHUP | POLLERR)) release_if_closed(ids[i - 1]);
+  }
+}
+
+}  // namespace l6470emu

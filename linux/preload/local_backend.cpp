@@ -1,0 +1,41 @@
+// Backend with the Board inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG).
+#include "linux/preload/backend.hpp"
+
+namespace l6470emu::preload {
+namespace {
+
+class LocalBackend final : public Backend {
+ public:
+  explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_) {}
+
+  const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
+  NewFile open(std::size_t device, bool cloexec) override { return board_.open(device, cloexec); }
+  void closed(std::uint64_t handle) override { board_.closed(handle); }
+  long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created, bool) override {
+    return board_.ioctl(handle, cmd, arg, created);
+  }
+  long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                   std::span<std::uint8_t> rx) override {
+    return board_.spi_message(handle, xfers, tx, rx);
+  }
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override { return board_.spi_read(handle, rx); }
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override { return board_.spi_write(handle, tx); }
+  void before_fork() override { board_.mutex().lock(); }
+  void after_fork_parent() override { board_.mutex().unlock(); }
+  void after_fork_child() override {
+    board_.mutex().unlock();
+    board_.forget_pump_after_fork();
+  }
+
+ private:
+  DiagnosticLog log_;
+  Board board_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_local_backend(const BoardConfig& config) {
+  return std::make_unique<LocalBackend>(config);
+}
+
+}  // namespace l6470emu::preload

@@ -1,0 +1,193 @@
+// Backend forwarding to `l6470emu serve` over its Unix socket (L6470EMU_SOCKET): one
+// connection per process, re-opened after fork(); new files arrive with SCM_RIGHTS.
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <mutex>
+
+#include "linux/preload/backend.hpp"
+#include "linux/preload/state.hpp"
+#include "linux/protocol.hpp"
+
+namespace l6470emu::preload {
+namespace {
+
+class RemoteBackend final : public Backend {
+ public:
+  RemoteBackend(std::string path, const std::string& log) : path_(std::move(path)), log_(log) {
+    std::lock_guard lock(m_);
+    if (!connect_locked()) {
+      log_.line("cannot reach the daemon at " + path_ + " (" + std::strerror(errno) +
+                "): no emulated devices; start it with `l6470emu serve`");
+      return;
+    }
+    RequestHeader req{static_cast<std::uint32_t>(Op::hello), 0, 0, kProtocolVersion};
+    ReplyHeader rep;
+    std::vector<std::uint8_t> payload;
+    int fd = -1;
+    if (!roundtrip_locked(req, {}, {}, rep, payload, fd, true) || rep.result < 0) {
+      log_.line("the daemon at " + path_ + " did not answer the hello (protocol " + std::to_string(kProtocolVersion) +
+                ")");
+      return;
+    }
+    nodes_ = decode_catalogue(std::string(payload.begin(), payload.end()));
+  }
+
+  ~RemoteBackend() override {
+    if (sock_ >= 0) real_close_protected(sock_);
+  }
+
+  const std::vector<DeviceNode>& nodes() override { return nodes_; }
+
+  NewFile open(std::size_t device, bool cloexec) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::open), 0, 0, device | kOpenCloexec};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, {}, {}, rep, scratch_, fd, cloexec)) return {-ENODEV, 0, -1, HandleKind::spidev};
+    if (rep.result < 0 || fd < 0) {
+      if (fd >= 0) real_close_protected(fd);
+      return {rep.result < 0 ? rep.result : -EIO, 0, -1, HandleKind::spidev};
+    }
+    return {0, rep.handle, fd, static_cast<HandleKind>(rep.kind)};
+  }
+
+  void closed(std::uint64_t handle) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::closed), 0, handle, 0};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    roundtrip_locked(req, {}, {}, rep, scratch_, fd, true);
+  }
+
+  long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created,
+             bool cloexec_created) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::ioctl), static_cast<std::uint32_t>(arg.size()), handle, cmd};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, arg, {}, rep, scratch_, fd, cloexec_created)) return -ENODEV;
+    if (rep.result >= 0) std::memcpy(arg.data(), scratch_.data(), std::min(arg.size(), scratch_.size()));
+    if (fd >= 0) {
+      if (created && rep.result >= 0) {
+        *created = {0, rep.handle, fd, static_cast<HandleKind>(rep.kind)};
+      } else {
+        real_close_protected(fd);
+      }
+    }
+    return static_cast<long>(rep.result);
+  }
+
+  long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                   std::span<std::uint8_t> rx) override {
+    const std::size_t head = xfers.size() * sizeof(spi_ioc_transfer);
+    RequestHeader req{static_cast<std::uint32_t>(Op::spi_message), static_cast<std::uint32_t>(head + tx.size()), handle,
+                      xfers.size()};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, {reinterpret_cast<const std::uint8_t*>(xfers.data()), head}, tx, rep, scratch_, fd, true))
+      return -ENODEV;
+    if (rep.result >= 0) std::memcpy(rx.data(), scratch_.data(), std::min(rx.size(), scratch_.size()));
+    return static_cast<long>(rep.result);
+  }
+
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::spi_read), 0, handle, rx.size()};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, {}, {}, rep, scratch_, fd, true)) return -ENODEV;
+    if (rep.result >= 0) std::memcpy(rx.data(), scratch_.data(), std::min(rx.size(), scratch_.size()));
+    return static_cast<long>(rep.result);
+  }
+
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::spi_write), static_cast<std::uint32_t>(tx.size()), handle, 0};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, tx, {}, rep, scratch_, fd, true)) return -ENODEV;
+    return static_cast<long>(rep.result);
+  }
+
+  void before_fork() override { m_.lock(); }
+  void after_fork_parent() override { m_.unlock(); }
+  void after_fork_child() override {
+    // The connection is shared with the parent now: leave it to the parent, open our own on demand.
+    if (sock_ >= 0) real_close_protected(sock_);
+    sock_ = -1;
+    m_.unlock();
+  }
+
+ private:
+  bool connect_locked() {
+    sock_ = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+    if (sock_ < 0) return false;
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    if (path_.size() >= sizeof addr.sun_path) {
+      real_close_protected(sock_);
+      sock_ = -1;
+      errno = ENAMETOOLONG;
+      return false;
+    }
+    std::memcpy(addr.sun_path, path_.c_str(), path_.size() + 1);
+    if (::connect(sock_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      const int e = errno;
+      real_close_protected(sock_);
+      sock_ = -1;
+      errno = e;
+      return false;
+    }
+    protect_fd(sock_);
+    return true;
+  }
+
+  // One request, one reply; reconnects once if the connection was lost (fork, host closed it).
+  bool roundtrip_locked(const RequestHeader& req, std::span<const std::uint8_t> a, std::span<const std::uint8_t> b,
+                        ReplyHeader& rep, std::vector<std::uint8_t>& payload, int& fd, bool cloexec) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      if (sock_ < 0 && !connect_locked()) return false;
+      if (!protected_fd_is(sock_)) {  // the host closed our socket behind our back
+        sock_ = -1;
+        continue;
+      }
+      packet_.resize(sizeof req + a.size() + b.size());
+      std::memcpy(packet_.data(), &req, sizeof req);
+      if (!a.empty()) std::memcpy(packet_.data() + sizeof req, a.data(), a.size());
+      if (!b.empty()) std::memcpy(packet_.data() + sizeof req + a.size(), b.data(), b.size());
+      if (!send_packet(sock_, packet_.data(), packet_.size(), {}, -1) || !recv_packet(sock_, reply_, fd, cloexec, kReplySpinNs) ||
+          reply_.size < sizeof rep) {
+        real_close_protected(sock_);
+        sock_ = -1;
+        if (req.op != static_cast<std::uint32_t>(Op::hello) && attempt == 0 && errno != EINTR) continue;
+        return false;
+      }
+      std::memcpy(&rep, reply_.data.get(), sizeof rep);
+      payload.assign(reply_.data.get() + sizeof rep, reply_.data.get() + reply_.size);
+      return true;
+    }
+    return false;
+  }
+
+  std::string path_;
+  DiagnosticLog log_;
+  std::mutex m_;
+  int sock_ = -1;
+  std::vector<DeviceNode> nodes_;
+  std::vector<std::uint8_t> packet_, scratch_;
+  Packet reply_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> make_remote_backend(const std::string& socket_path, const std::string& log) {
+  return std::make_unique<RemoteBackend>(socket_path, log);
+}
+
+}  // namespace l6470emu::preload

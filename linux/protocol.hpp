@@ -1,0 +1,82 @@
+// The wire protocol between the preload library and `l6470emu serve`: one SOCK_SEQPACKET
+// connection per host process, strictly request/reply. A request is a RequestHeader and a
+// payload; a reply is a ReplyHeader, a payload and, for new files, one descriptor passed
+// with SCM_RIGHTS. Both ends are built from this one header (same machine, same build).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "linux/board.hpp"
+
+namespace l6470emu {
+
+/// Protocol version; the daemon refuses a hello of another version.
+inline constexpr std::uint32_t kProtocolVersion = 1;
+
+/// What a request asks for.
+enum class Op : std::uint32_t {
+  hello = 1,        ///< arg = version; reply payload = the catalogue of device nodes
+  open = 2,         ///< arg = device index | kOpenCloexec; reply: handle, kind, fd
+  closed = 3,       ///< handle: a descriptor of it was closed
+  ioctl = 4,        ///< handle, arg = cmd, payload = argument bytes; reply payload = argument bytes
+  spi_message = 5,  ///< handle, payload = spi_ioc_transfer[n] then tx data; reply payload = rx data
+  spi_read = 6,     ///< handle, arg = count; reply payload = rx data
+  spi_write = 7,    ///< handle, payload = tx data
+  control = 8,      ///< payload = a ctl command line; reply: exit status and text
+};
+
+inline constexpr std::uint64_t kOpenCloexec = std::uint64_t{1} << 63;
+
+struct RequestHeader {
+  std::uint32_t op = 0;
+  std::uint32_t payload = 0;  ///< bytes following the header
+  std::uint64_t handle = 0;
+  std::uint64_t arg = 0;
+};
+
+struct ReplyHeader {
+  std::int64_t result = 0;    ///< >= 0, or -errno
+  std::uint32_t payload = 0;  ///< bytes following the header
+  std::uint32_t kind = 0;     ///< HandleKind of a new file
+  std::uint64_t handle = 0;   ///< handle of a new file (its descriptor rides along with SCM_RIGHTS)
+};
+
+/// Largest data of a message: bufsiz is at most 4 MiB (config), tx and rx each.
+inline constexpr std::size_t kMaxMessage = std::size_t{4} << 20;
+/// Largest packet: a header, 511 transfers (_IOC_SIZE is 14 bits) and the tx data.
+inline constexpr std::size_t kMaxPacket = kMaxMessage + 16384 + 64;
+
+/// The catalogue as text ("spidev PATH NAME MAJOR MINOR BUFSIZ" lines) and back.
+std::string encode_catalogue(const std::vector<DeviceNode>& nodes);
+std::vector<DeviceNode> decode_catalogue(const std::string& text);
+
+/// Sends `header` + `payload` (+ `fd` if >= 0) as one packet. Returns false on error (errno set).
+bool send_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload, int fd);
+/// A receive buffer as large as the largest packet (allocated, not touched: pages are used on demand).
+struct Packet {
+  std::unique_ptr<std::uint8_t[]> data{new std::uint8_t[kMaxPacket]};
+  std::size_t size = 0;
+  std::span<const std::uint8_t> bytes() const { return {data.get(), size}; }
+};
+
+/// Receives one packet; `fd` gets a passed descriptor or -1 (`cloexec` sets close-on-exec on it).
+/// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error.
+bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t spin_ns = 0);
+
+/// How long the preload waits for a reply, and the daemon for a client's next request, before sleeping.
+inline constexpr std::int64_t kReplySpinNs = 30'000;
+inline constexpr std::int64_t kRequestSpinNs = 20'000;
+
+/// A control command handler: text in, exit status and text out (the daemon's `ctl`).
+using ControlHandler = std::function<int(const std::string& command, std::string& output)>;
+
+/// Serves one request on `board` (the daemon side). Fills `reply` and its payload;
+/// `pass_fd` gets a descriptor to send along (the caller closes its copy after sending).
+void serve_request(Board& board, const ControlHandler& control, std::span<const std::uint8_t> packet,
+                   ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload, int& pass_fd);
+
+}  // namespace l6470emu

@@ -1,0 +1,284 @@
+// `ctl` commands: status, get, sw, pin, fault, adc, dump, chains, time, advance, trace.
+#include "linux/serve/control.hpp"
+
+#include <cstdio>
+#include <sstream>
+#include <vector>
+
+#include "core/status.hpp"
+
+namespace l6470emu {
+namespace {
+
+struct Args {
+  std::vector<std::string> words;   // positional words after the command
+  std::string chain;                // --chain NAME ("" = the first chain)
+  long chip = -1;                   // --chip K (-1 = not given)
+  std::string error;
+};
+
+Args parse_args(const std::vector<std::string>& all) {
+  Args a;
+  for (std::size_t i = 1; i < all.size(); ++i) {
+    const std::string& w = all[i];
+    if (w == "--chain" || w == "--chip") {
+      if (i + 1 >= all.size()) {
+        a.error = w + " needs a value";
+        return a;
+      }
+      const std::string& v = all[++i];
+      if (w == "--chain") {
+        a.chain = v;
+      } else {
+        char* end = nullptr;
+        a.chip = std::strtol(v.c_str(), &end, 10);
+        if (v.empty() || *end || a.chip < 0) a.error = "--chip needs a chip number, not '" + v + "'";
+      }
+    } else {
+      a.words.push_back(w);
+    }
+  }
+  return a;
+}
+
+std::string hex(std::uint32_t v, int digits) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%0*X", digits, v);
+  return b;
+}
+
+const RegisterInfo* register_named(const Variant& v, const std::string& name) {
+  for (const RegisterInfo& r : v.registers)
+    if (r.name == name) return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string control_help() {
+  return "l6470emu ctl commands (chip numbers: chip 0 drives MISO; --chain NAME picks a chain, default the first):\n"
+         "  chains                              the emulated chains and their gpiochips\n"
+         "  status [--chip K]                   STATUS of each chip, read without clearing anything\n"
+         "  get REGISTER [--chip K]             a register as GetParam would return it, without side effects\n"
+         "  dump                                every register of every chip, STATUS decoded, open files\n"
+         "  sw open|closed --chip K             the limit switch on the SW pin (closed = pulled low)\n"
+         "  pin SW|STCK|STBY_RST 0|1 --chip K   drive an input pin of a chip\n"
+         "  fault uvlo|uvlo-adc|ocd|stall-a|stall-b on|off --chip K\n"
+         "  fault thermal normal|warning|bridge-shutdown|device-shutdown --chip K\n"
+         "  adc CODE --chip K                   ADCIN conversion result, 0..31\n"
+         "  time                                virtual time of each chain\n"
+         "  advance MS                          virtual-time daemons: let MS milliseconds pass\n"
+         "  trace start FILE | trace stop       record the SPI traffic (not available yet)\n";
+}
+
+int run_control(Board& board, const std::string& command, std::string& out) {
+  std::vector<std::string> all;
+  {
+    std::istringstream in(command);
+    std::string w;
+    while (in >> w) all.push_back(w);
+  }
+  std::ostringstream o;
+  if (all.empty() || all[0] == "help" || all[0] == "--help") {
+    out = control_help();
+    return all.empty() ? 2 : 0;
+  }
+  const std::string& cmd = all[0];
+  Args a = parse_args(all);
+  if (!a.error.empty()) {
+    out = "ctl: " + a.error + "\n";
+    return 2;
+  }
+  if (board.chain_count() == 0) {
+    out = "ctl: the daemon has no chain\n";
+    return 1;
+  }
+  const int chain = a.chain.empty() ? 0 : board.find_chain(a.chain);
+  if (chain < 0) {
+    out = "ctl: no chain called '" + a.chain + "' (see `ctl chains`)\n";
+    return 1;
+  }
+  const std::size_t ci = static_cast<std::size_t>(chain);
+  std::size_t chips = 0;
+  board.with_chain(ci, [&](Chain& c) { chips = c.size(); });
+  if (a.chip >= static_cast<long>(chips)) {
+    out = "ctl: chip " + std::to_string(a.chip) + " does not exist (the chain has " + std::to_string(chips) + ")\n";
+    return 1;
+  }
+  // Writes need a chip unless the chain has only one.
+  auto target_chip = [&](std::size_t& k) {
+    if (a.chip >= 0) {
+      k = static_cast<std::size_t>(a.chip);
+      return true;
+    }
+    if (chips == 1) {
+      k = 0;
+      return true;
+    }
+    out = "ctl: the chain has " + std::to_string(chips) + " chips: say which with --chip K\n";
+    return false;
+  };
+  auto for_chips = [&](auto&& f) {
+    const std::size_t lo = a.chip >= 0 ? static_cast<std::size_t>(a.chip) : 0;
+    const std::size_t hi = a.chip >= 0 ? lo + 1 : chips;
+    for (std::size_t k = lo; k < hi; ++k) f(k);
+  };
+
+  if (cmd == "chains") {
+    for (std::size_t i = 0; i < board.chain_count(); ++i) o << board.chain_summary(i) << "\n";
+  } else if (cmd == "status") {
+    board.with_chain(ci, [&](Chain& c) {
+      for_chips([&](std::size_t k) {
+        const Chip& chip = c.chip(k);
+        o << "chip " << k << " (" << chip.variant().name << "): STATUS " << hex(chip.status(), 4) << "  "
+          << describe_status(chip.variant().status, chip.status()) << "\n";
+      });
+    });
+  } else if (cmd == "get") {
+    if (a.words.size() != 1) {
+      out = "ctl: usage: get REGISTER [--chip K]\n";
+      return 2;
+    }
+    bool ok = true;
+    board.with_chain(ci, [&](Chain& c) {
+      for_chips([&](std::size_t k) {
+        const Chip& chip = c.chip(k);
+        const RegisterInfo* r = register_named(chip.variant(), a.words[0]);
+        if (!r) {
+          ok = false;
+          return;
+        }
+        const std::uint32_t v = chip.peek(r->id);
+        o << "chip " << k << ": " << r->name << " = " << hex(v, (r->bits + 3) / 4);
+        if (r->is_signed()) o << " (" << sign_extend(v, r->bits) << ")";
+        o << "\n";
+      });
+    });
+    if (!ok) {
+      out = "ctl: no register '" + a.words[0] + "' on this variant (use the datasheet name, e.g. ABS_POS)\n";
+      return 1;
+    }
+  } else if (cmd == "dump") {
+    board.with_chain(ci, [&](Chain& c) {
+      for_chips([&](std::size_t k) { o << "== chip " << k << " ==\n" << c.chip(k).dump() << "\n"; });
+    });
+    o << board.describe_handles();
+  } else if (cmd == "sw" || cmd == "pin") {
+    std::size_t k = 0;
+    if (!target_chip(k)) return 2;
+    Pin pin = Pin::SW;
+    bool level = true;
+    if (cmd == "sw") {
+      if (a.words.size() != 1 || (a.words[0] != "open" && a.words[0] != "closed")) {
+        out = "ctl: usage: sw open|closed --chip K\n";
+        return 2;
+      }
+      level = a.words[0] == "open";
+    } else {
+      if (a.words.size() != 2 || (a.words[1] != "0" && a.words[1] != "1")) {
+        out = "ctl: usage: pin SW|STCK|STBY_RST 0|1 --chip K\n";
+        return 2;
+      }
+      if (a.words[0] == "SW")
+        pin = Pin::SW;
+      else if (a.words[0] == "STCK")
+        pin = Pin::STCK;
+      else if (a.words[0] == "STBY_RST" || a.words[0] == "STBY" || a.words[0] == "RST")
+        pin = Pin::STBY_RST;
+      else {
+        out = "ctl: pin must be SW, STCK or STBY_RST (BUSY and FLAG are the chip's outputs)\n";
+        return 2;
+      }
+      level = a.words[1] == "1";
+    }
+    board.drive_pin(ci, k, pin, level);
+    o << "chip " << k << ": " << pin_name(pin) << " " << (level ? "high" : "low") << "\n";
+  } else if (cmd == "fault") {
+    std::size_t k = 0;
+    if (!target_chip(k)) return 2;
+    if (a.words.size() != 2) {
+      out = "ctl: usage: fault NAME on|off --chip K (or: fault thermal LEVEL)\n";
+      return 2;
+    }
+    const std::string& f = a.words[0];
+    const std::string& v = a.words[1];
+    if (f == "thermal") {
+      Thermal t;
+      if (v == "normal") t = Thermal::normal;
+      else if (v == "warning") t = Thermal::warning;
+      else if (v == "bridge-shutdown" || v == "shutdown") t = Thermal::bridge_shutdown;
+      else if (v == "device-shutdown") t = Thermal::device_shutdown;
+      else {
+        out = "ctl: thermal level must be normal, warning, bridge-shutdown or device-shutdown\n";
+        return 2;
+      }
+      board.with_chain(ci, [&](Chain& c) { c.chip(k).set_thermal(t); });
+    } else {
+      if (v != "on" && v != "off") {
+        out = "ctl: fault state must be on or off\n";
+        return 2;
+      }
+      const bool on = v == "on";
+      bool known = true;
+      board.with_chain(ci, [&](Chain& c) {
+        Chip& chip = c.chip(k);
+        if (f == "uvlo") chip.set_undervoltage(on);
+        else if (f == "uvlo-adc") chip.set_adc_undervoltage(on);
+        else if (f == "ocd") chip.set_overcurrent(on);
+        else if (f == "stall-a") chip.set_stall(Bridge::A, on);
+        else if (f == "stall-b") chip.set_stall(Bridge::B, on);
+        else known = false;
+      });
+      if (!known) {
+        out = "ctl: unknown fault '" + f + "' (uvlo, uvlo-adc, ocd, stall-a, stall-b, thermal)\n";
+        return 2;
+      }
+    }
+    o << "chip " << k << ": " << f << " " << v << "\n";
+  } else if (cmd == "adc") {
+    std::size_t k = 0;
+    if (!target_chip(k)) return 2;
+    char* end = nullptr;
+    const long code = a.words.size() == 1 ? std::strtol(a.words[0].c_str(), &end, 10) : -1;
+    if (a.words.size() != 1 || *end || code < 0 || code > 31) {
+      out = "ctl: usage: adc CODE --chip K (CODE 0..31)\n";
+      return 2;
+    }
+    board.with_chain(ci, [&](Chain& c) { c.chip(k).set_adc_input(static_cast<std::uint8_t>(code)); });
+    o << "chip " << k << ": ADC_OUT " << code << "\n";
+  } else if (cmd == "time") {
+    for (std::size_t i = 0; i < board.chain_count(); ++i) {
+      const Tick t = board.now(i);
+      char b[96];
+      std::snprintf(b, sizeof b, "%llu ticks = %.6f s", static_cast<unsigned long long>(t),
+                    static_cast<double>(t) / static_cast<double>(kTicksPerSecond));
+      o << board.chain_summary(i) << ": " << b << "\n";
+    }
+    o << (board.clock().is_virtual() ? "virtual time (moves with bus traffic and `advance`)\n"
+                                     : "wall clock x " + std::to_string(board.clock().scale()) + "\n");
+  } else if (cmd == "advance") {
+    char* end = nullptr;
+    const double ms = a.words.size() == 1 ? std::strtod(a.words[0].c_str(), &end) : -1;
+    if (a.words.size() != 1 || *end || !(ms >= 0)) {
+      out = "ctl: usage: advance MS\n";
+      return 2;
+    }
+    if (!board.advance(static_cast<Tick>(ms * 1000.0 * kTicksPerMicrosecond))) {
+      out = "ctl: the daemon runs on the wall clock; `advance` needs `serve --virtual-time`\n";
+      return 1;
+    }
+    o << "advanced " << ms << " ms\n";
+  } else if (cmd == "trace") {
+    // Extension point: the trace recorder (spi/trace*, daisychain/recording_chain*) attaches here
+    // through Board::set_message_observer, which sees every SPI message with its bytes and tick.
+    out = "ctl: trace recording is not available yet (it arrives with the trace recorder)\n";
+    return 1;
+  } else {
+    out = "ctl: unknown command '" + cmd + "'\n" + control_help();
+    return 2;
+  }
+  out = o.str();
+  return 0;
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,210 @@
+// The serve daemon: socket set-up, accept loop, one thread per connection, clean shutdown.
+#include "linux/serve/daemon.hpp"
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/signalfd.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <list>
+#include <mutex>
+#include <thread>
+
+#include "linux/board.hpp"
+#include "linux/protocol.hpp"
+#include "linux/serve/control.hpp"
+
+namespace l6470emu {
+namespace {
+
+bool fill_address(const std::string& path, sockaddr_un& addr) {
+  addr = {};
+  addr.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof addr.sun_path) return false;
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  return true;
+}
+
+int connect_to(const std::string& path) {
+  sockaddr_un addr;
+  if (!fill_address(path, addr)) {
+    errno = ENAMETOOLONG;
+    return -1;
+  }
+  const int s = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  if (s < 0) return -1;
+  if (connect(s, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    const int e = errno;
+    close(s);
+    errno = e;
+    return -1;
+  }
+  return s;
+}
+
+struct Connection {
+  int fd = -1;
+  std::thread thread;
+  bool done = false;
+};
+
+void serve_connection(Board& board, const ControlHandler& control, Connection& c) {
+  Packet packet;
+  std::vector<std::uint8_t> payload;
+  ReplyHeader reply;
+  for (;;) {
+    int passed = -1;
+    if (!recv_packet(c.fd, packet, passed, true, kRequestSpinNs)) break;
+    if (passed >= 0) close(passed);  // clients never send descriptors
+    int pass_fd = -1;
+    try {
+      serve_request(board, control, packet.bytes(), reply, payload, pass_fd);
+    } catch (const std::exception&) {
+      reply = {};
+      reply.result = -ENOMEM;
+      payload.clear();
+    }
+    reply.payload = static_cast<std::uint32_t>(payload.size());
+    const bool sent = send_packet(c.fd, &reply, sizeof reply, payload, pass_fd);
+    if (pass_fd >= 0) close(pass_fd);  // the client has its copy now (or is gone)
+    if (!sent) break;                  // client killed mid-request: drop it, keep serving others
+  }
+}
+
+}  // namespace
+
+std::string default_socket_path() {
+  if (const char* s = std::getenv("L6470EMU_SOCKET"); s && *s) return s;
+  if (const char* r = std::getenv("XDG_RUNTIME_DIR"); r && *r) return std::string(r) + "/l6470emu.sock";
+  return "/tmp/l6470emu-" + std::to_string(getuid()) + ".sock";
+}
+
+int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err) {
+  sockaddr_un addr;
+  if (!fill_address(socket_path, addr)) {
+    err << "l6470emu serve: socket path too long or empty: " << socket_path << "\n";
+    return 1;
+  }
+  // A socket file nobody answers on is a leftover of a killed daemon: replace it.
+  if (const int probe = connect_to(socket_path); probe >= 0) {
+    close(probe);
+    err << "l6470emu serve: another daemon is already serving " << socket_path << "\n";
+    return 1;
+  }
+  unlink(socket_path.c_str());
+
+  // Signals arrive through a signalfd; every thread started from here on has them blocked.
+  sigset_t mask;
+  sigemptyset(&mask);
+  sigaddset(&mask, SIGINT);
+  sigaddset(&mask, SIGTERM);
+  sigaddset(&mask, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &mask, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  const int sfd = signalfd(-1, &mask, SFD_CLOEXEC);
+
+  const int listener = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
+  if (listener < 0 || bind(listener, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 || listen(listener, 64) != 0) {
+    err << "l6470emu serve: cannot listen on " << socket_path << ": " << std::strerror(errno) << "\n";
+    if (listener >= 0) close(listener);
+    return 1;
+  }
+
+  DiagnosticLog log(config.log);
+  Board board(config, log);
+  board.start_pump();
+  std::mutex control_mutex;  // ctl commands one at a time
+  const ControlHandler control = [&](const std::string& command, std::string& text) {
+    std::lock_guard lock(control_mutex);
+    return run_control(board, command, text);
+  };
+
+  out << "l6470emu serve: listening on " << socket_path << "\n";
+  for (std::size_t i = 0; i < board.chain_count(); ++i) out << "  " << board.chain_summary(i) << "\n";
+  out << "  " << (config.time.virtual_time ? std::string("virtual time") : "wall clock x " + std::to_string(config.time.scale))
+      << "\n";
+  out << "run programs with: LD_PRELOAD=<path>/libl6470emu-preload.so L6470EMU_SOCKET=" << socket_path << " <program>\n";
+  out.flush();
+
+  std::list<Connection> connections;
+  std::mutex connections_mutex;
+  for (;;) {
+    pollfd fds[2] = {{listener, POLLIN, 0}, {sfd, POLLIN, 0}};
+    const int n = poll(fds, 2, 1000);
+    if (n < 0 && errno != EINTR) break;
+    if (fds[1].revents & POLLIN) break;
+    {
+      // Reap finished connection threads.
+      std::lock_guard lock(connections_mutex);
+      for (auto it = connections.begin(); it != connections.end();) {
+        if (it->done) {
+          it->thread.join();
+          close(it->fd);
+          it = connections.erase(it);
+        } else {
+          ++it;
+        }
+      }
+    }
+    if (!(fds[0].revents & POLLIN)) continue;
+    const int c = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
+    if (c < 0) continue;
+    std::lock_guard lock(connections_mutex);
+    Connection& conn = connections.emplace_back();
+    conn.fd = c;
+    conn.thread = std::thread([&board, &control, &conn, &connections_mutex] {
+      serve_connection(board, control, conn);
+      std::lock_guard l(connections_mutex);
+      conn.done = true;
+    });
+  }
+
+  out << "l6470emu serve: stopping\n";
+  out.flush();
+  close(listener);
+  unlink(socket_path.c_str());
+  {
+    std::lock_guard lock(connections_mutex);
+    for (auto& c : connections) shutdown(c.fd, SHUT_RDWR);
+  }
+  for (auto& c : connections) {
+    if (c.thread.joinable()) c.thread.join();
+    close(c.fd);
+  }
+  board.stop_pump();
+  if (sfd >= 0) close(sfd);
+  return 0;
+}
+
+int run_ctl(const std::string& socket_path, const std::string& command, std::ostream& out, std::ostream& err) {
+  const int s = connect_to(socket_path);
+  if (s < 0) {
+    err << "l6470emu ctl: no daemon at " << socket_path << " (" << std::strerror(errno) << "); start one with `l6470emu serve`\n";
+    return 1;
+  }
+  RequestHeader req{static_cast<std::uint32_t>(Op::control), static_cast<std::uint32_t>(command.size()), 0, 0};
+  std::vector<std::uint8_t> packet(sizeof req + command.size());
+  std::memcpy(packet.data(), &req, sizeof req);
+  std::memcpy(packet.data() + sizeof req, command.data(), command.size());
+  Packet reply;
+  int fd = -1;
+  if (!send_packet(s, packet.data(), packet.size(), {}, -1) || !recv_packet(s, reply, fd, true) ||
+      reply.size < sizeof(ReplyHeader)) {
+    err << "l6470emu ctl: the daemon at " << socket_path << " did not answer\n";
+    close(s);
+    return 1;
+  }
+  close(s);
+  ReplyHeader rep;
+  std::memcpy(&rep, reply.data.get(), sizeof rep);
+  const std::string text(reinterpret_cast<const char*>(reply.data.get()) + sizeof rep, reply.size - sizeof rep);
+  (rep.result == 0 ? out : err) << text;
+  return static_cast<int>(rep.result);
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,23 @@
+// `l6470emu serve`: owns a Board and serves host programs (through the preload library)
+// and `ctl` over one Unix SOCK_SEQPACKET socket, a thread per connection.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "linux/config.hpp"
+
+namespace l6470emu {
+
+/// The socket path used when none is given: $L6470EMU_SOCKET, else $XDG_RUNTIME_DIR/l6470emu.sock,
+/// else /tmp/l6470emu-<uid>.sock.
+std::string default_socket_path();
+
+/// Serves `config` on `socket_path` until SIGINT or SIGTERM. Prints one line when ready.
+/// Returns the exit status (non-zero when the socket cannot be set up).
+int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err);
+
+/// Sends one control command to the daemon at `socket_path`; prints its answer.
+int run_ctl(const std::string& socket_path, const std::string& command, std::ostream& out, std::ostream& err);
+
+}  // namespace l6470emu

@@ -1,0 +1,84 @@
+// The Linux spidev driver's rules (drivers/spi/spidev.c and spi_setup/__spi_validate in
+// drivers/spi/spi.c, Linux 6.1), applied to an emulated device: settings ioctls, message
+// validation with the kernel's error codes, and word/bit order on the wire. No OS calls;
+// user memory has already been copied in by the transport.
+#pragma once
+
+#include <linux/spi/spidev.h>
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+
+#include "spi/spi_device.hpp"
+
+namespace l6470emu {
+
+/// Character-device major of spidev (what stat reports for /dev/spidevB.C).
+inline constexpr unsigned kSpidevMajor = 153;
+
+/// spidev's SPI_MODE_MASK: the mode bits user space may read and write.
+inline constexpr std::uint32_t kSpidevModeMask =
+    SPI_CPHA | SPI_CPOL | SPI_CS_HIGH | SPI_LSB_FIRST | SPI_3WIRE | SPI_LOOP | SPI_NO_CS | SPI_READY |
+    SPI_TX_DUAL | SPI_TX_QUAD | SPI_TX_OCTAL | SPI_RX_DUAL | SPI_RX_QUAD | SPI_RX_OCTAL | SPI_RX_CPHA_FLIP;
+
+/// Mode bits the emulated controller supports (others: EINVAL from spi_setup, except the
+/// dual/quad/octal ones, which spi_setup drops silently).
+inline constexpr std::uint32_t kControllerModeBits = SPI_CPHA | SPI_CPOL | SPI_CS_HIGH | SPI_LSB_FIRST;
+
+/// Fastest SCK of the emulated controller; faster requests are clamped to it, as spi.c does.
+inline constexpr std::uint32_t kControllerMaxSpeedHz = 125'000'000;
+
+/// Fastest SCK the L6470 family accepts (datasheet: 5 MHz).
+inline constexpr std::uint32_t kChipMaxSpeedHz = 5'000'000;
+
+/// The settings the kernel keeps per spidev device (shared by every open file).
+struct SpidevSettings {
+  std::uint32_t mode = 0;           ///< spi->mode (SPI_MODE_USER_MASK bits)
+  std::uint8_t bits_per_word = 8;   ///< spi->bits_per_word
+  std::uint32_t max_speed_hz = 0;   ///< spi->max_speed_hz, from the device tree (config speed=)
+  std::uint32_t speed_hz = 0;       ///< spidev->speed_hz: default speed of transfers, reset at last close
+  std::uint32_t bufsiz = 4096;      ///< spidev bufsiz module parameter
+};
+
+/// Result of an ioctl: the return value (>= 0) or -errno.
+using IoctlResult = long;
+
+/// Whether `bits` is a word size the emulated controller supports (8, 16, 32).
+constexpr bool controller_supports_bits(unsigned bits) { return bits == 8 || bits == 16 || bits == 32; }
+
+/// SPI_IOC_RD_* / SPI_IOC_WR_* except SPI_IOC_MESSAGE: reads or changes `s` as spidev does.
+/// `value` is the (already copied) argument; reads store into it. Returns 0 or -errno
+/// (-ENOTTY for a command that is not a spidev settings ioctl).
+IoctlResult spidev_settings_ioctl(SpidevSettings& s, unsigned long cmd, std::uint32_t& value);
+
+/// Whether `cmd` is SPI_IOC_MESSAGE(n) for some n (n may be 0); sets n.
+bool is_spi_message_ioctl(unsigned long cmd, std::size_t& n);
+
+/// spidev_message's and __spi_validate's checks on a message, before anything is clocked:
+/// -EMSGSIZE past bufsiz (or past INT_MAX in total), -EINVAL for word sizes, lengths and
+/// nbits the controller cannot do. Returns the total length in bytes or -errno.
+IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers);
+
+/// Bytes of tx data the transport must copy for `xfers` (sum of len over transfers with a tx_buf).
+std::size_t spidev_tx_bytes(std::span<const spi_ioc_transfer> xfers);
+/// Bytes of rx data a message produces (sum of len over transfers with an rx_buf).
+std::size_t spidev_rx_bytes(std::span<const spi_ioc_transfer> xfers);
+
+/// Runs a validated message on `dev` with spi_sync's chip-select rules (run_message), charging
+/// word_delay_usecs, delay_usecs and a 10 us CS-high time between cs_change transfers like the
+/// kernel. `tx` holds the tx data of the transfers that have a tx_buf, concatenated; `rx`
+/// receives the rx data of those with an rx_buf. Word order (bits_per_word 16/32, little-endian
+/// host) and LSB-first bit order are turned into the bytes the chip sees on the wire. With
+/// SPI_CS_HIGH the chip's active-low CS never selects it: nothing reaches it and MISO reads 0.
+void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
+                        std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+
+/// Settings of `s` (and of the transfers) the chip cannot work with, as one line each:
+/// SPI mode other than 3, LSB first, CS active high, SCK above 5 MHz. `report` is called once
+/// per distinct problem; `already` is a bit set of the problems reported before (updated).
+void check_spidev_settings_for_chip(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
+                                    std::uint32_t& already, const std::function<void(const std::string&)>& report);
+
+}  // namespace l6470emu

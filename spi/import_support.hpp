@@ -1,0 +1,117 @@
+// Shared pieces of the importers (internal to spi/): lines with their numbers, and a
+// builder that turns capture times into ticks while checking that time goes forward.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "spi/trace.hpp"
+
+namespace l6470emu::detail {
+
+/// Walks a text line by line, counting lines from 1; '\r' before '\n' is dropped.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text) : rest_(text) {}
+  bool next(std::string_view& line) {
+    if (rest_.empty()) return false;
+    const void* nl = std::memchr(rest_.data(), '\n', rest_.size());
+    std::size_t len;
+    if (nl == nullptr) {
+      len = rest_.size();
+      unterminated_ = true;
+      line = rest_;
+      rest_ = {};
+    } else {
+      len = static_cast<std::size_t>(static_cast<const char*>(nl) - rest_.data());
+      line = rest_.substr(0, len);
+      rest_.remove_prefix(len + 1);
+    }
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    ++number_;
+    return true;
+  }
+  std::uint64_t number() const { return number_; }
+  /// Whether the line just read ended the file without a newline.
+  bool unterminated() const { return unterminated_; }
+
+ private:
+  std::string_view rest_;
+  std::uint64_t number_ = 0;
+  bool unterminated_ = false;
+};
+
+/// `s` in double quotes, cut at 40 characters, for messages.
+inline std::string quote(std::string_view s) {
+  std::string q = "\"";
+  q.append(s.substr(0, 40));
+  if (s.size() > 40) q += "...";
+  q += '"';
+  return q;
+}
+
+/// Appends frames to a Trace in capture order: times become ticks counted from the first
+/// frame's start (rounded to nearest); going backwards or overlapping frames is an error.
+class FrameBuilder {
+ public:
+  FrameBuilder(Trace& trace, const std::string& name) : trace_(trace), name_(name) {}
+
+  void frame(const SourceTime& start, const SourceTime& end, std::span<const std::uint8_t> mosi,
+             std::span<const std::uint8_t> miso, std::span<const std::uint8_t> known, std::uint64_t line) {
+    if (!started_) {
+      origin_ = start;
+      started_ = true;
+    } else {
+      if (start < last_start_)
+        throw TraceError(name_, line, "time " + seconds(start) + " s goes backwards (the previous frame began at " +
+                                          seconds(last_start_) + " s)");
+      if (start < last_end_)
+        throw TraceError(name_, line, "frame at " + seconds(start) + " s begins before the previous one ended (" +
+                                          seconds(last_end_) + " s)");
+    }
+    if (end < start)
+      throw TraceError(name_, line, "frame ends (" + seconds(end) + " s) before it begins (" + seconds(start) + " s)");
+    TraceEvent e;
+    e.kind = TraceEventKind::frame;
+    if (!ticks_between(origin_, start, e.tick))
+      throw TraceError(name_, line, "time " + seconds(start) + " s is too far from the first frame");
+    Tick end_tick = 0;
+    if (!ticks_between(origin_, end, end_tick))
+      throw TraceError(name_, line, "time " + seconds(end) + " s is too far from the first frame");
+    e.duration = end_tick - e.tick;
+    e.mosi = mosi;
+    e.miso = miso;
+    e.miso_known = known;
+    e.line = line;
+    e.source_time = start.to_double();
+    trace_.write(e);
+    last_start_ = start;
+    last_end_ = end;
+  }
+
+  static std::string seconds(const SourceTime& t) {
+    char buf[48];
+    if (t.seconds < 0 && t.picoseconds != 0)
+      std::snprintf(buf, sizeof buf, "-%lld.%012lld", static_cast<long long>(-t.seconds - 1),
+                    static_cast<long long>(1'000'000'000'000 - t.picoseconds));
+    else
+      std::snprintf(buf, sizeof buf, "%lld.%012lld", static_cast<long long>(t.seconds),
+                    static_cast<long long>(t.picoseconds));
+    // Trim trailing zeros, keep at least one decimal.
+    std::string s = buf;
+    while (s.size() > 2 && s.back() == '0' && s[s.size() - 2] != '.') s.pop_back();
+    return s;
+  }
+
+ private:
+  Trace& trace_;
+  const std::string& name_;
+  bool started_ = false;
+  SourceTime origin_, last_start_, last_end_;
+};
+
+}  // namespace l6470emu::detail

@@ -1,0 +1,239 @@
+// Trace: the in-memory trace, exact decimal time parsing and the names used by every format.
+#include "spi/trace.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace l6470emu {
+
+std::string_view to_string(TracePin pin) {
+  switch (pin) {
+    case TracePin::SW: return "SW";
+    case TracePin::STCK: return "STCK";
+    case TracePin::STBY: return "STBY";
+    case TracePin::BUSY: return "BUSY";
+    case TracePin::FLAG: return "FLAG";
+  }
+  return "?";
+}
+
+std::string_view to_string(TraceFault fault) {
+  switch (fault) {
+    case TraceFault::UVLO: return "UVLO";
+    case TraceFault::UVLO_ADC: return "UVLO_ADC";
+    case TraceFault::OCD: return "OCD";
+    case TraceFault::STALL_A: return "STALL_A";
+    case TraceFault::STALL_B: return "STALL_B";
+    case TraceFault::THERMAL: return "THERMAL";
+    case TraceFault::ADCIN: return "ADCIN";
+  }
+  return "?";
+}
+
+std::string_view thermal_name(std::uint8_t value) {
+  static constexpr std::string_view kNames[] = {"normal", "warning", "bridge_shutdown", "device_shutdown"};
+  return value < 4 ? kNames[value] : "?";
+}
+
+TraceError::TraceError(std::string file, std::uint64_t line, const std::string& message)
+    : std::runtime_error((line ? file + ":" + std::to_string(line) : file) + ": " + message),
+      file_(std::move(file)),
+      line_(line) {}
+
+// ---------------------------------------------------------------- Trace
+
+void Trace::write(const TraceEvent& e) {
+  Stored s{};
+  s.tick = e.tick;
+  s.duration = e.duration;
+  s.source_time = e.source_time;
+  s.line = e.line;
+  s.chip = e.chip;
+  s.kind = e.kind;
+  s.value = e.value;
+  s.what = e.kind == TraceEventKind::pin ? static_cast<std::uint8_t>(e.pin) : static_cast<std::uint8_t>(e.fault);
+  if (e.kind == TraceEventKind::frame) {
+    if ((!e.miso.empty() && e.miso.size() != e.mosi.size()) ||
+        (!e.miso_known.empty() && e.miso_known.size() != e.mosi.size()))
+      throw std::invalid_argument("trace frame: MISO and MOSI lengths differ");
+    ++frames_;
+    s.offset = bytes_.size();
+    s.length = static_cast<std::uint32_t>(e.mosi.size());
+    bytes_.insert(bytes_.end(), e.mosi.begin(), e.mosi.end());
+    if (!e.miso.empty()) {
+      bytes_.insert(bytes_.end(), e.miso.begin(), e.miso.end());
+      s.miso = 1;
+      if (!e.miso_known.empty()) {
+        bytes_.insert(bytes_.end(), e.miso_known.begin(), e.miso_known.end());
+        s.miso = 2;
+      }
+    }
+  }
+  events_.push_back(s);
+}
+
+TraceEvent Trace::operator[](std::size_t i) const {
+  const Stored& s = events_[i];
+  TraceEvent e;
+  e.kind = s.kind;
+  e.tick = s.tick;
+  e.duration = s.duration;
+  e.source_time = s.source_time;
+  e.line = s.line;
+  e.chip = s.chip;
+  e.value = s.value;
+  if (s.kind == TraceEventKind::pin) e.pin = static_cast<TracePin>(s.what);
+  if (s.kind == TraceEventKind::fault) e.fault = static_cast<TraceFault>(s.what);
+  if (s.kind == TraceEventKind::frame) {
+    const std::uint8_t* p = bytes_.data() + s.offset;
+    e.mosi = {p, s.length};
+    if (s.miso >= 1) e.miso = {p + s.length, s.length};
+    if (s.miso == 2) e.miso_known = {p + 2 * std::size_t{s.length}, s.length};
+  }
+  return e;
+}
+
+namespace {
+
+class TraceCursor final : public TraceReader {
+ public:
+  explicit TraceCursor(const Trace& t) : trace_(t) {}
+  const TraceHeader& header() const override { return trace_.header; }
+  bool next(TraceEvent& e) override {
+    if (i_ >= trace_.size()) return false;
+    e = trace_[i_++];
+    return true;
+  }
+
+ private:
+  const Trace& trace_;
+  std::size_t i_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<TraceReader> Trace::reader() const { return std::make_unique<TraceCursor>(*this); }
+
+// ---------------------------------------------------------------- time
+
+bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
+  std::size_t i = 0;
+  bool negative = false;
+  if (i < text.size() && (text[i] == '-' || text[i] == '+')) negative = text[i++] == '-';
+  // Mantissa digits and where the decimal point is.
+  const std::size_t digits_begin = i;
+  std::size_t point = std::string_view::npos;
+  std::size_t digit_count = 0;
+  for (; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c >= '0' && c <= '9') {
+      ++digit_count;
+    } else if (c == '.' && point == std::string_view::npos) {
+      point = digit_count;
+    } else {
+      break;
+    }
+  }
+  if (digit_count == 0) return false;
+  const std::size_t digits_end = i;
+  if (point == std::string_view::npos) point = digit_count;
+  long exponent = 0;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    bool exp_negative = false;
+    if (i < text.size() && (text[i] == '-' || text[i] == '+')) exp_negative = text[i++] == '-';
+    std::size_t exp_digits = 0;
+    for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i, ++exp_digits) {
+      exponent = exponent * 10 + (text[i] - '0');
+      if (exponent > 100000) return false;
+    }
+    if (exp_digits == 0) return false;
+    if (exp_negative) exponent = -exponent;
+  }
+  if (i != text.size()) return false;
+
+  // Digit k (0-based over the mantissa) stands for 10^(point - 1 - k + exponent + unit) seconds.
+  static constexpr std::int64_t kPow10[] = {1,          10,          100,          1000,          10000,
+                                            100000,     1000000,     10000000,     100000000,     1000000000,
+                                            10000000000, 100000000000, 1000000000000};
+  std::int64_t seconds = 0, ps = 0;
+  bool round_up = false, rounded = false;
+  std::size_t k = 0;
+  for (std::size_t j = digits_begin; j < digits_end; ++j) {
+    if (text[j] == '.') continue;
+    const int d = text[j] - '0';
+    const long p = static_cast<long>(point) - 1 - static_cast<long>(k) + exponent + unit_exp10;
+    ++k;
+    if (p >= 0) {
+      // seconds += d * 10^p; only sane captures (below 10^18 s) are accepted.
+      if (p > 17) {
+        if (d != 0) return false;
+        continue;
+      }
+      std::int64_t add = d;
+      for (long q = 0; q < p; ++q) add *= 10;
+      if (seconds > 9'000'000'000'000'000'000 - add) return false;
+      seconds += add;
+    } else if (p >= -12) {
+      ps += d * kPow10[12 + p];
+    } else if (!rounded) {
+      round_up = d >= 5;
+      rounded = true;
+    }
+  }
+  if (round_up && ++ps == kPow10[12]) {
+    ps = 0;
+    ++seconds;
+  }
+  if (negative && (seconds != 0 || ps != 0)) {
+    seconds = -seconds;
+    if (ps != 0) {
+      --seconds;
+      ps = kPow10[12] - ps;
+    }
+  }
+  out = {seconds, ps};
+  return true;
+}
+
+bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out) {
+  if (t < origin) return false;
+  const std::int64_t ds = t.seconds - origin.seconds;
+  if (ds > 9'000'000) return false;  // 104 days: no capture is that long
+  const std::int64_t ps = ds * 1'000'000'000'000 + (t.picoseconds - origin.picoseconds);
+  constexpr std::int64_t kPsPerTick = 250'000;
+  out = static_cast<Tick>((ps + kPsPerTick / 2) / kPsPerTick);
+  return true;
+}
+
+std::string format_seconds(Tick t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%llu.%08llu", static_cast<unsigned long long>(t / kTicksPerSecond),
+                static_cast<unsigned long long>((t % kTicksPerSecond) * 25));
+  return buf;
+}
+
+std::string format_microseconds(Tick t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%llu.%02llu", static_cast<unsigned long long>(t / kTicksPerMicrosecond),
+                static_cast<unsigned long long>((t % kTicksPerMicrosecond) * 25));
+  return buf;
+}
+
+std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string s;
+  s.reserve(bytes.size() * 3);
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) s += ' ';
+    if (!known.empty() && !known[i]) {
+      s += "??";
+      continue;
+    }
+    s += kHex[bytes[i] >> 4];
+    s += kHex[bytes[i] & 15];
+  }
+  return s;
+}
+
+}  // namespace l6470emu

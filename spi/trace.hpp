@@ -1,0 +1,196 @@
+// An SPI trace: CS frames (MOSI and MISO bytes with their virtual time), pin
+// events and backdoor faults, in time order. Models what was on the wire and
+// the test bench, not what the bytes meant (that is daisychain/decode.hpp).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/tick.hpp"
+
+namespace l6470emu {
+
+/// What a trace event is.
+enum class TraceEventKind : std::uint8_t {
+  frame,  ///< one CS frame: CS falls, bytes are exchanged, CS rises
+  pin,    ///< a pin changed level (inputs SW, STCK, STBY) or was observed (outputs BUSY, FLAG)
+  fault,  ///< a backdoor event: a fault condition starts or ends, or the ADCIN level changes
+};
+
+/// The chip pins a trace can carry, by datasheet name.
+enum class TracePin : std::uint8_t {
+  SW,    ///< input; low = switch closed
+  STCK,  ///< input; rising edge = one microstep in step-clock mode
+  STBY,  ///< STBY\RST input; low = logic held in reset
+  BUSY,  ///< BUSY\SYNC output (observed); low = busy
+  FLAG,  ///< FLAG output (observed); low = alarm
+};
+
+/// Backdoor (physical world) events a trace can carry.
+enum class TraceFault : std::uint8_t {
+  UVLO,      ///< motor supply undervoltage; value 1 = on, 0 = off
+  UVLO_ADC,  ///< ADC input undervoltage (gate-driver parts); 1 = on, 0 = off
+  OCD,       ///< overcurrent; 1 = on, 0 = off
+  STALL_A,   ///< stall / step loss on bridge A; 1 = on, 0 = off
+  STALL_B,   ///< stall / step loss on bridge B; 1 = on, 0 = off
+  THERMAL,   ///< die temperature class: value is a core Thermal (0 normal .. 3 device shutdown)
+  ADCIN,     ///< ADCIN level: value is the 5-bit ADC_OUT code
+};
+
+/// Datasheet names used in the native format and in reports.
+std::string_view to_string(TracePin pin);
+std::string_view to_string(TraceFault fault);
+/// Names of the THERMAL values: "normal", "warning", "bridge_shutdown", "device_shutdown".
+std::string_view thermal_name(std::uint8_t value);
+
+/// One event of a trace, as a view: the byte spans stay valid until the reader moves on.
+struct TraceEvent {
+  TraceEventKind kind = TraceEventKind::frame;
+  Tick tick = 0;      ///< frame: CS falling edge; pin/fault: when it happened
+  Tick duration = 0;  ///< frame: ticks from CS falling to CS rising edge (the chips decode at the end)
+  std::span<const std::uint8_t> mosi;        ///< frame: bytes sent by the host, in order
+  std::span<const std::uint8_t> miso;        ///< frame: bytes received, same length as mosi; empty = none known
+  std::span<const std::uint8_t> miso_known;  ///< frame: empty = every miso byte known; else 1 per known byte
+  std::uint16_t chip = 0;                    ///< pin/fault: chip index in the chain (0 drives MISO)
+  TracePin pin = TracePin::SW;               ///< pin events
+  TraceFault fault = TraceFault::UVLO;       ///< fault events
+  std::uint8_t value = 0;                    ///< pin: level 0/1; fault: see TraceFault
+  std::uint64_t line = 0;                    ///< line in the source file (0 = none)
+  double source_time = std::numeric_limits<double>::quiet_NaN();  ///< seconds as in the source file
+
+  /// Tick of the CS rising edge of a frame.
+  Tick end() const { return tick + duration; }
+  /// Whether MISO byte `i` of a frame is known.
+  bool miso_byte_known(std::size_t i) const {
+    return !miso.empty() && (miso_known.empty() || miso_known[i] != 0);
+  }
+  /// Whether the source file gave this event a time of its own.
+  bool has_source_time() const { return source_time == source_time; }
+};
+
+/// Facts about a trace as a whole.
+struct TraceHeader {
+  std::string name;           ///< file name used in messages ("capture.csv")
+  std::string format;         ///< "native", "saleae", "umockdev", "ftrace", "sigrok"
+  std::string chain;          ///< the chain the trace was taken from ("3*L6470"); empty = not known
+  std::uint64_t chain_line = 0;      ///< where `chain` was written (for error messages)
+  std::vector<std::string> notes;    ///< importer remarks: guessed framing, missing channels...
+};
+
+/// A malformed input: file name, line number and what is wrong, as one line of text
+/// ("capture.csv:17: MISO \"0xZZ\" is not a byte").
+class TraceError : public std::runtime_error {
+ public:
+  TraceError(std::string file, std::uint64_t line, const std::string& message);
+  const std::string& file() const { return file_; }
+  std::uint64_t line() const { return line_; }
+
+ private:
+  std::string file_;
+  std::uint64_t line_;
+};
+
+/// A source of trace events, read once from the start (a file being parsed, a Trace in memory).
+class TraceReader {
+ public:
+  virtual ~TraceReader() = default;
+  /// Facts known before the first event.
+  virtual const TraceHeader& header() const = 0;
+  /// Reads the next event into `e`; false at the end. Throws TraceError on malformed input.
+  virtual bool next(TraceEvent& e) = 0;
+};
+
+/// Where recorded events go (a native trace file, a Trace in memory).
+class TraceSink {
+ public:
+  virtual ~TraceSink() = default;
+  /// Called once, before the first event.
+  virtual void write_header(const TraceHeader& header) = 0;
+  /// Appends one event; events come in time order.
+  virtual void write(const TraceEvent& e) = 0;
+};
+
+/// A whole trace in memory: events in a compact array, bytes in one pool.
+/// Importers produce one; it can be read any number of times and recorded into.
+class Trace final : public TraceSink {
+ public:
+  TraceHeader header;
+
+  void write_header(const TraceHeader& h) override { header = h; }
+  void write(const TraceEvent& e) override;
+
+  /// Number of events.
+  std::size_t size() const { return events_.size(); }
+  bool empty() const { return events_.empty(); }
+  /// Event `i`; its spans stay valid until the trace is changed.
+  TraceEvent operator[](std::size_t i) const;
+  /// Number of frame events.
+  std::size_t frame_count() const { return frames_; }
+
+  /// A reader over the events, from the first one.
+  std::unique_ptr<TraceReader> reader() const;
+
+ private:
+  struct Stored {
+    Tick tick;
+    Tick duration;
+    double source_time;
+    std::uint64_t line;
+    std::uint64_t offset;  // mosi at offset, miso at offset + length, mask after that
+    std::uint32_t length;
+    std::uint16_t chip;
+    TraceEventKind kind;
+    std::uint8_t what;   // TracePin / TraceFault
+    std::uint8_t value;
+    std::uint8_t miso;   // 0 = none known, 1 = all known, 2 = with a mask
+  };
+  std::vector<Stored> events_;
+  std::vector<std::uint8_t> bytes_;
+  std::size_t frames_ = 0;
+};
+
+// ---- time -------------------------------------------------------------------
+
+/// A time as written in a capture file: whole seconds (floor) and picoseconds 0..10^12-1.
+/// Exact for every decimal with up to 12 fractional digits; negative times (before a
+/// logic analyzer's trigger) allowed.
+struct SourceTime {
+  std::int64_t seconds = 0;
+  std::int64_t picoseconds = 0;
+  double to_double() const { return static_cast<double>(seconds) + static_cast<double>(picoseconds) * 1e-12; }
+  friend bool operator==(const SourceTime&, const SourceTime&) = default;
+  friend auto operator<=>(const SourceTime&, const SourceTime&) = default;
+};
+
+/// Parses a decimal number ("1.25", "-0.5", "1.2e-05", "12345.678901") in units of
+/// 10^unit_exp10 seconds (0 = s, -6 = µs), rounding beyond 1 ps to nearest. False if malformed.
+bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out);
+
+/// Ticks from `origin` to `t`, rounded to nearest; false when t < origin or the span is too long.
+bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out);
+
+/// Ticks as seconds with 8 decimals, exact ("1.23456725").
+std::string format_seconds(Tick t);
+/// Ticks as microseconds with 2 decimals, exact ("1.75").
+std::string format_microseconds(Tick t);
+
+// ---- bytes -------------------------------------------------------------------
+
+/// Value of a hex digit, or -1.
+constexpr int hex_digit_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+/// Bytes as upper-case hex separated by spaces ("D0 00 7E"); unknown MISO bytes as "??".
+std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
+
+}  // namespace l6470emu

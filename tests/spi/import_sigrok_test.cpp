@@ -1,0 +1,76 @@
+// sigrok-cli's JSON trace of its spi decoder (spi/import_sigrok.cpp): CS frames from the
+// transfer annotations, bytes alone without a cs channel, and one-line errors.
+#include <gtest/gtest.h>
+
+#include "spi/trace_import.hpp"
+#include "support/trace_test_support.hpp"
+
+namespace l6470emu {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+Bytes bytes(std::span<const std::uint8_t> s) { return Bytes(s.begin(), s.end()); }
+
+std::string ev(const char* ph, double ts, const char* tid, const char* name) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "{\"ph\": \"%s\", \"ts\": %f, \"pid\": \"spi-1\", \"tid\": \"%s\", \"name\": \"%s\"}", ph, ts,
+                tid, name);
+  return buf;
+}
+
+std::string doc(const std::vector<std::string>& events) {
+  std::string s = "{\"traceEvents\": [\n";
+  for (std::size_t i = 0; i < events.size(); ++i) s += events[i] + (i + 1 < events.size() ? ",\n" : "\n");
+  return s + "]}\n";
+}
+
+std::string error_of(const std::string& text) {
+  try {
+    import_sigrok_json(text, "spi.json");
+  } catch (const TraceError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(SigrokImport, ReadsTheTransferAnnotationsOfTheFixture) {
+  // fixtures/traces/sigrok_spi.json is sigrok-cli's own output for two_chips.vcd.
+  const Trace t = import_sigrok_json(test::fixture("sigrok_spi.json"), "sigrok_spi.json");
+  EXPECT_EQ(t.header.format, "sigrok");
+  ASSERT_EQ(t.frame_count(), 17u);
+  EXPECT_EQ(bytes(t[0].mosi), (Bytes{0xD0, 0xD0}));
+  EXPECT_EQ(bytes(t[1].miso), (Bytes{0x7C, 0x7C}));
+  EXPECT_EQ(t[0].tick, 0u);
+  EXPECT_GT(t[0].line, 1u);
+}
+
+TEST(SigrokImport, TakesEachByteAsAFrameWithoutTransferAnnotations) {
+  const Trace t = import_sigrok_json(doc({ev("B", 1.3, "MOSI data", "21"), ev("E", 2.9, "MOSI data", "21"),
+                                          ev("B", 1.3, "MISO data", "00"), ev("E", 2.9, "MISO data", "00"),
+                                          ev("B", 5.9, "MOSI data", "00"), ev("E", 7.5, "MOSI data", "00")}),
+                                     "d.json");
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[1].tick, 18u);  // 4.6 µs later
+  EXPECT_TRUE(t[1].miso.empty());
+  EXPECT_NE(t.header.notes[0].find("no MOSI/MISO transfer annotations"), std::string::npos);
+}
+
+TEST(SigrokImport, RejectsBadInputWithOneLineErrors) {
+  EXPECT_EQ(error_of(doc({ev("B", 1.0, "MOSI transfer", "21 D0"), ev("E", 4.6, "MOSI transfer", "21 D0"),
+                          ev("B", 1.0, "MISO transfer", "00"), ev("E", 4.6, "MISO transfer", "00")})),
+            "spi.json:4: MOSI has 2 bytes but MISO has 1 in the frame at 0.000001 s");
+  EXPECT_EQ(error_of(doc({ev("B", 9.0, "MOSI transfer", "21"), ev("E", 10.0, "MOSI transfer", "21"),
+                          ev("B", 1.0, "MOSI transfer", "00"), ev("E", 2.0, "MOSI transfer", "00")})),
+            "spi.json:4: time 0.000001 s goes backwards (the previous frame began at 0.000009 s)");
+  EXPECT_EQ(error_of(doc({ev("B", 1.0, "MOSI transfer", "2100"), ev("E", 2.0, "MOSI transfer", "2100")})),
+            "spi.json:2: MOSI \"2100\" is not a byte (set the spi decoder to 8-bit words)");
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n" + ev("B", 1.0, "MOSI transfer", "21") + ",\n{\"ph\": \"E\", \"ts\": 2."),
+            "spi.json:3: unexpected end of file, expected ',' (truncated file?)");
+  EXPECT_EQ(error_of("1750-5750 spi-1: 21\n"),
+            "spi.json:1: not JSON (expected sigrok-cli --protocol-decoder-jsontrace output, which starts with '{')");
+  EXPECT_EQ(error_of(doc({})), "spi.json: no spi decoder annotations (run sigrok-cli -P spi:...:cs=CS --protocol-decoder-jsontrace)");
+}
+
+}  // namespace
+}  // namespace l6470emu

@@ -1,0 +1,42 @@
+// `l6470emu decode TRACE`: the explained log on standard output, a summary on standard error.
+#include <exception>
+#include <stdexcept>
+#include <ostream>
+
+#include "daisychain/chain_spec.hpp"
+#include "daisychain/decode.hpp"
+#include "tools/trace_commands.hpp"
+
+namespace l6470emu {
+
+int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
+  try {
+    const TraceFile file(args.trace.path, input_options(args.trace));
+    std::string how;
+    const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
+    Chain chain = make_chain(variants);
+    print_notes(file.header(), err);
+    out << "# " << file.path() << " (" << file.header().format << "), chain " << chain_spec_of(variants) << " (" << how
+        << "); chip 0 drives MISO\n";
+    DecodeOptions options;
+    options.show_nops = args.nops;
+    options.max_repeats = args.max_repeats;
+    options.only_chip = args.chip;
+    if (args.chip >= 0 && static_cast<std::size_t>(args.chip) >= chain.size())
+      throw std::invalid_argument("--chip " + std::to_string(args.chip) + ": the chain has " +
+                                  std::to_string(chain.size()) + " chips");
+    std::unique_ptr<TraceReader> reader = file.read();
+    const DecodeSummary s = decode_trace(*reader, chain, out, options);
+    out << "# " << s.frames << " frames, " << s.commands << " commands, " << s.answers << " answers, " << s.diagnostics
+        << " diagnostics";
+    if (s.suppressed) out << " (" << s.suppressed << " not shown: --max-repeats 0 shows all)";
+    if (s.answer_mismatches) out << ", " << s.answer_mismatches << " answers the emulator would give differently (see replay)";
+    out << "\n";
+    return kTraceOk;
+  } catch (const std::exception& e) {
+    err << "l6470emu decode: " << e.what() << "\n";
+    return kTraceBadInput;
+  }
+}
+
+}  // namespace l6470emu

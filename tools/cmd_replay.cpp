@@ -1,0 +1,53 @@
+// `l6470emu replay TRACE`: the trace through the emulated chain, divergence reports on
+// standard output as they are found, a summary line at the end.
+#include <exception>
+#include <ostream>
+
+#include "daisychain/chain_spec.hpp"
+#include "daisychain/replay.hpp"
+#include "tools/trace_commands.hpp"
+
+namespace l6470emu {
+
+int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
+  try {
+    const TraceFile file(args.trace.path, input_options(args.trace));
+    std::string how;
+    const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
+    Chain chain = make_chain(variants);
+    print_notes(file.header(), err);
+    err << "l6470emu: replaying " << file.path() << " through " << chain_spec_of(variants) << " (" << how << ")\n";
+
+    ReplayOptions options;
+    options.keep_going = args.keep_going;
+    options.max_reports = args.max_reports;
+    options.compare_pins = !args.no_pins;
+    std::unique_ptr<TraceReader> reader = file.read();
+    const ReplayResult r = replay_trace(*reader, chain, options, [&](const Divergence& d) {
+      out << (args.quiet ? d.summary : d.report) << "\n";
+    });
+
+    out << file.path() << ": " << r.frames << " frames, " << r.bytes_compared << " MISO bytes compared";
+    if (r.bytes_unknown) out << " (" << r.bytes_unknown << " not captured)";
+    if (r.pin_checks) out << ", " << r.pin_checks << " BUSY/FLAG levels checked";
+    if (r.matched()) {
+      out << ": matched\n";
+      return kTraceOk;
+    }
+    if (r.stopped_early) {
+      out << ": DIVERGED (stopped at the first divergence; --continue reports them all)\n";
+    } else {
+      out << ": DIVERGED in " << r.divergent_frames << " frames";
+      if (r.pin_mismatches) out << " and " << r.pin_mismatches << " pin levels";
+      if (r.divergences.size() < r.divergent_frames + r.pin_mismatches)
+        out << " (" << r.divergences.size() << " reported; --max-reports)";
+      out << "\n";
+    }
+    return kTraceDiverged;
+  } catch (const std::exception& e) {
+    err << "l6470emu replay: " << e.what() << "\n";
+    return kTraceBadInput;
+  }
+}
+
+}  // namespace l6470emu

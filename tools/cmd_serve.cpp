@@ -1,0 +1,73 @@
+// `l6470emu serve` and `l6470emu ctl`.
+#include "tools/cmd_serve.hpp"
+
+#include <iostream>
+
+#include "linux/config.hpp"
+#include "linux/serve/control.hpp"
+#include "linux/serve/daemon.hpp"
+
+namespace l6470emu {
+
+ServeCommands::ServeCommands(CLI::App& app) {
+  serve_ = app.add_subcommand("serve", "run an emulated board as a daemon for unmodified programs (LD_PRELOAD)");
+  serve_->add_option("--chain", chain_,
+                     "the board, as in L6470EMU_CHAIN: 'bus=0 cs=0 chips=3xL6470[ gpiochip=N]; ...' "
+                     "(default: bus=0 cs=0 chips=L6470)");
+  serve_->add_option("--config", config_file_, "read the board from this file instead (one clause per line)");
+  serve_->add_option("--socket", socket_, "Unix socket to serve on (default $L6470EMU_SOCKET, "
+                                          "$XDG_RUNTIME_DIR/l6470emu.sock or /tmp/l6470emu-UID.sock)");
+  serve_->add_option("--time-scale", time_scale_, "virtual seconds per wall-clock second (default 1)")
+      ->check(CLI::Range(1e-6, 1e6));
+  serve_->add_flag("--virtual-time", virtual_time_,
+                   "time moves only with bus traffic and `ctl advance` (deterministic runs)");
+  serve_->add_option("--log", log_, "diagnostics: stderr (default), off, or a file");
+
+  ctl_ = app.add_subcommand("ctl", "control a running daemon: " + std::string("status, get, dump, sw, pin, fault, adc, "
+                                                                               "time, advance, chains (ctl help)"));
+  ctl_->add_option("--socket", socket_, "the daemon's socket (default as for serve)");
+  ctl_->add_option("command", words_, "the command and its arguments")->required();
+  ctl_->prefix_command();
+}
+
+std::optional<int> ServeCommands::run() {
+  if (serve_ && *serve_) {
+    ParseResult parsed;
+    if (!config_file_.empty() && !chain_.empty()) {
+      std::cerr << "l6470emu serve: give --chain or --config, not both\n";
+      return 2;
+    }
+    if (!config_file_.empty())
+      parsed = load_board_config_file(config_file_);
+    else
+      parsed = parse_board_config(chain_.empty() ? "bus=0 cs=0 chips=L6470" : chain_, "--chain");
+    if (!parsed.config) {
+      std::cerr << parsed.error.message << "\n";
+      return 2;
+    }
+    BoardConfig config = *parsed.config;
+    if (config.chains.empty()) {
+      std::cerr << "l6470emu serve: the board has no chain\n";
+      return 2;
+    }
+    if (time_scale_ > 0) config.time.scale = time_scale_;
+    if (virtual_time_) config.time.virtual_time = true;
+    if (!log_.empty()) config.log = log_;
+    const std::string socket = !socket_.empty() ? socket_ : !config.socket.empty() ? config.socket : default_socket_path();
+    return run_daemon(config, socket, std::cout, std::cerr);
+  }
+  if (ctl_ && *ctl_) {
+    std::vector<std::string> all = words_;
+    for (const auto& extra : ctl_->remaining()) all.push_back(extra);
+    std::string command;
+    for (const auto& w : all) command += (command.empty() ? "" : " ") + w;
+    if (command == "help" || command == "--help") {
+      std::cout << control_help();
+      return 0;
+    }
+    return run_ctl(socket_.empty() ? default_socket_path() : socket_, command, std::cout, std::cerr);
+  }
+  return std::nullopt;
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,32 @@
+// The `serve` and `ctl` subcommands: run the emulator as a daemon that unmodified programs
+// reach through libl6470emu-preload.so, and talk to it (the physical world, inspection).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace l6470emu {
+
+/// Registers `serve` and `ctl` on `app`; after parsing, run() executes whichever was chosen.
+class ServeCommands {
+ public:
+  explicit ServeCommands(CLI::App& app);
+  /// The exit status of the chosen subcommand, or nothing when neither was chosen.
+  std::optional<int> run();
+
+ private:
+  CLI::App* serve_ = nullptr;
+  CLI::App* ctl_ = nullptr;
+  std::string chain_;
+  std::string config_file_;
+  std::string socket_;
+  double time_scale_ = 0;
+  bool virtual_time_ = false;
+  std::string log_;
+  std::vector<std::string> words_;
+};
+
+}  // namespace l6470emu

@@ -1,0 +1,96 @@
+// CLI11 wiring of the trace subcommands and the options they share.
+#include "tools/trace_commands.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+namespace l6470emu {
+
+TraceInputOptions input_options(const TraceArgs& args) {
+  TraceInputOptions o;
+  if (args.format != "auto") {
+    o.format = trace_format_named(args.format);
+    if (o.format == TraceFormat::unknown)
+      throw std::invalid_argument("unknown format \"" + args.format +
+                                  "\" (auto, native, saleae, umockdev, ftrace, sigrok, vcd)");
+  }
+  o.import.select = args.select;
+  if (args.framing == "auto") o.import.ftrace_framing = FtraceFraming::automatic;
+  else if (args.framing == "cs") o.import.ftrace_framing = FtraceFraming::cs;
+  else if (args.framing == "transfer") o.import.ftrace_framing = FtraceFraming::transfer;
+  else if (args.framing == "message") o.import.ftrace_framing = FtraceFraming::message;
+  else throw std::invalid_argument("unknown framing \"" + args.framing + "\" (auto, cs, transfer, message)");
+  if (!args.sigrok_decoder.empty()) o.sigrok_decoder = args.sigrok_decoder;
+  return o;
+}
+
+void print_notes(const TraceHeader& header, std::ostream& err) {
+  for (const std::string& n : header.notes) err << "note: " << header.name << ": " << n << "\n";
+}
+
+namespace {
+
+void add_trace_options(CLI::App* sub, TraceArgs& a) {
+  sub->add_option("TRACE", a.path, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
+      ->required();
+  sub->add_option("--format", a.format, "input format (default: recognised from the content)")
+      ->check(CLI::IsMember({"auto", "native", "saleae", "umockdev", "ftrace", "sigrok", "vcd"}));
+  sub->add_option("--chain", a.chain,
+                  "the emulated chain, chip 0 (MISO end) first: N, N*VARIANT or a list (3, 2*L6470,L6480); "
+                  "default: the trace's own, else guessed from the frame lengths");
+  sub->add_option("--select", a.select,
+                  "the stream to take when the file has several: Saleae analyzer name, ftrace device (spi0.0), "
+                  "sigrok decoder (spi-1)");
+  sub->add_option("--framing", a.framing, "ftrace CS frames: auto, cs (spi_set_cs), transfer, message")
+      ->check(CLI::IsMember({"auto", "cs", "transfer", "message"}));
+  sub->add_option("--sigrok-decoder", a.sigrok_decoder,
+                  "sigrok-cli decoder for VCD/.sr captures (default spi:clk=SCK:mosi=MOSI:miso=MISO:cs=CS:cpol=1:cpha=1)");
+}
+
+/// Ends the program with `status` when it is not 0 (CLI11 returns it from main quietly).
+void finish(int status) {
+  if (status != 0) throw CLI::RuntimeError(status);
+}
+
+}  // namespace
+
+void add_trace_commands(CLI::App& app) {
+  auto replay = std::make_shared<ReplayArgs>();
+  CLI::App* r = app.add_subcommand(
+      "replay", "drive a captured trace's MOSI into the emulated chain and compare every MISO byte "
+                "(exit 0 = matched, 1 = diverged, 2 = bad input)");
+  add_trace_options(r, replay->trace);
+  r->add_flag("--continue", replay->keep_going, "report every divergence, not only the first");
+  r->add_option("--max-reports", replay->max_reports, "with --continue: full reports for this many (0 = all)");
+  r->add_flag("--no-pins", replay->no_pins, "do not compare the trace's BUSY/FLAG levels");
+  r->add_flag("--quiet", replay->quiet, "one line per divergence instead of the full report");
+  r->callback([replay] { finish(run_replay(*replay, std::cout, std::cerr)); });
+
+  auto decode = std::make_shared<DecodeArgs>();
+  CLI::App* d = app.add_subcommand("decode", "explain a trace: every command and answer per chip, with protocol diagnostics");
+  add_trace_options(d, decode->trace);
+  d->add_flag("--nops", decode->nops, "also list NOPs and STCK edges");
+  d->add_option("--max-repeats", decode->max_repeats, "show each kind of diagnostic at most this often per chip (0 = all)");
+  d->add_option("--chip", decode->chip, "show only this chip's lines (0 = the chip driving MISO)")->check(CLI::Range(0, 255));
+  d->callback([decode] { finish(run_decode(*decode, std::cout, std::cerr)); });
+
+  auto convert = std::make_shared<ConvertArgs>();
+  CLI::App* c = app.add_subcommand(
+      "convert", "write a trace as native text, VCD (SPI wires in mode 3, BUSY/FLAG/SW/STCK/STBY, ABS_POS) or umockdev .ioctl");
+  add_trace_options(c, convert->trace);
+  c->add_option("-o,--output", convert->output, "file to write (- = standard output)")->required();
+  c->add_option("--to", convert->to, "output format (default: from the extension: .vcd, .ioctl, else native)")
+      ->check(CLI::IsMember({"auto", "native", "vcd", "ioctl"}));
+  c->add_option("--device", convert->device, "umockdev: the spidev node the recording is for");
+  c->add_option("--timescale-ns", convert->timescale_ns, "VCD time unit in ns (1, 10 or 100)")
+      ->check(CLI::IsMember({1u, 10u, 100u}));
+  c->add_option("--sample-us", convert->sample_us, "VCD: how often moving chips are looked at, in µs")
+      ->check(CLI::Range(0.25, 1e6));
+  c->add_flag("--no-emulation", convert->no_emulation, "VCD: only the trace's own signals, no emulated BUSY/FLAG/ABS_POS");
+  c->callback([convert] { finish(run_convert(*convert, std::cout, std::cerr)); });
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,74 @@
+// The trace subcommands of l6470emu: replay (compare a capture with the emulator),
+// decode (explain it), convert (native, VCD or umockdev .ioctl out). Each is a function
+// with its exit status, so tests run them without a process; add_trace_commands wires
+// them into the CLI11 program.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+#include "tools/trace_input.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace l6470emu {
+
+/// Options every trace subcommand takes.
+struct TraceArgs {
+  std::string path;            ///< the trace file
+  std::string format = "auto";  ///< auto, native, saleae, umockdev, ftrace, sigrok, vcd
+  std::string chain;           ///< chain description ("3", "2*L6470,L6480"); empty = the trace's own
+  std::string select;          ///< analyzer / device / decoder to take when the file has several
+  std::string framing = "auto";  ///< ftrace: auto, cs, transfer, message
+  std::string sigrok_decoder;  ///< sigrok-cli decoder spec for VCD/.sr captures (empty = the default)
+};
+
+/// The reading options `args` stand for. Throws std::invalid_argument for an unknown
+/// format or framing name.
+TraceInputOptions input_options(const TraceArgs& args);
+
+/// Prints the importer's notes about `header` to `err`, one "note:" line each.
+void print_notes(const TraceHeader& header, std::ostream& err);
+
+/// Exit statuses of the trace subcommands.
+enum TraceExit : int { kTraceOk = 0, kTraceDiverged = 1, kTraceBadInput = 2 };
+
+struct ReplayArgs {
+  TraceArgs trace;
+  bool keep_going = false;    ///< --continue
+  std::size_t max_reports = 100;
+  bool no_pins = false;       ///< do not check BUSY/FLAG observations
+  bool quiet = false;         ///< summary line only
+};
+/// `l6470emu replay`: 0 when every captured MISO byte and pin level matched, 1 when not, 2 on bad input.
+int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err);
+
+struct DecodeArgs {
+  TraceArgs trace;
+  bool nops = false;
+  std::size_t max_repeats = 10;
+  int chip = -1;  ///< only this chip's lines
+};
+/// `l6470emu decode`: 0, or 2 on bad input.
+int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err);
+
+struct ConvertArgs {
+  TraceArgs trace;
+  std::string output;           ///< file to write ("-" = standard output)
+  std::string to = "auto";      ///< native, vcd, ioctl; auto = from the output's extension
+  std::string device = "/dev/spidev0.0";  ///< umockdev device name
+  unsigned timescale_ns = 10;   ///< VCD time unit
+  double sample_us = 10;        ///< VCD: how often moving chips are looked at
+  bool no_emulation = false;    ///< VCD: only what the trace holds (no BUSY/FLAG/ABS_POS from the emulator)
+};
+/// `l6470emu convert`: 0, or 2 on bad input.
+int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err);
+
+/// Adds replay, decode and convert to `app`. They run in CLI11 callbacks and end the
+/// program through CLI::RuntimeError with their exit status when it is not 0.
+void add_trace_commands(CLI::App& app);
+
+}  // namespace l6470emu
