@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/heap_counter.hpp"
+#include "bench/motion_workload.hpp"
 #include "core/chip.hpp"
 #include "core/fast_motion.hpp"
 #include "daisychain/chain.hpp"
@@ -25,36 +27,6 @@
 #define L6470EMU_BUILD_TYPE "unknown"
 #endif
 
-// ---- heap accounting (as in memory_bench.cpp): every global operator new / delete.
-// Nothing allocates inside the timed loops, so this costs the timings nothing.
-namespace {
-
-std::size_t g_live_bytes = 0;
-constexpr std::size_t kHeader = alignof(std::max_align_t);
-
-void* counted_alloc(std::size_t n) {
-  void* raw = std::malloc(n + kHeader);
-  if (raw == nullptr) throw std::bad_alloc();
-  *static_cast<std::size_t*>(raw) = n;
-  g_live_bytes += n;
-  return static_cast<char*>(raw) + kHeader;
-}
-
-void counted_free(void* p) noexcept {
-  if (p == nullptr) return;
-  char* raw = static_cast<char*>(p) - kHeader;
-  g_live_bytes -= *reinterpret_cast<std::size_t*>(raw);
-  std::free(raw);
-}
-
-}  // namespace
-
-void* operator new(std::size_t n) { return counted_alloc(n); }
-void* operator new[](std::size_t n) { return counted_alloc(n); }
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
 
 namespace {
 
@@ -127,202 +99,8 @@ SpiResult measure_spi(std::size_t n, double min_seconds) {
 }
 
 // ---------------------------------------------------------------- motion
-// MotionWorkload is a copy of the one in motion_bench.cpp; keep the two in sync.
-
-/// Which motion engine the chips run; every benchmark is registered once per engine so the
-/// rows compare side by side. A further engine = one more case here and one more registration.
-using Engine = MotionEngine;
-
-constexpr const char* engine_name(Engine e) {
-  switch (e) {
-    case Engine::reference: return "reference";
-    case Engine::fast: return "fast";
-  }
-  return "?";
-}
-
-/// A chain of `n` default L6470s whose chips use `engine` (set explicitly: the default may change).
-Chain make_chain(std::size_t n, Engine engine) {
-  Chain chain(n);
-  chain.set_motion_engine(engine);
-  return chain;
-}
-
-struct Axis {
-  enum class Phase : std::uint8_t { idle, moving, running, stopping } phase = Phase::idle;
-  Tick run_until = 0;
-};
-
-struct MotionStats {
-  std::uint64_t polls = 0, frames = 0, commands = 0, moves_done = 0, runs_done = 0, cmd_errors = 0;
-};
-
-/// N chips behind one chip-select; a host that polls every chip every 1 ms of simulated time
-/// and gives each idle axis a random Move or Run (Runs end with SoftStop after 20..300 ms).
-/// Bus: 5 MHz SCK, 1 us CS high; every CS frame advances the chain by its own duration.
-class MotionWorkload {
- public:
-  static constexpr Tick kPollPeriod = ticks_from_ms(1);
-  static constexpr std::uint32_t kSckHz = 5'000'000;
-
-  MotionWorkload(std::size_t chips, Engine engine, std::uint64_t seed = 0x6470)
-      : chain_(make_chain(chips, engine)),
-        rng_(seed),
-        axes_(chips),
-        status_(chips),
-        rx_(chips),
-        msb_(chips),
-        get_status_(chips, 0xD0),
-        nops_(chips, 0x00),
-        frame_ticks_(transfer_ticks(static_cast<std::uint32_t>(chips), kSckHz) + BusTiming{}.cs_high_ticks) {
-    for (auto& f : cmd_) f.assign(chips, 0x00);
-    const StatusLayout& layout = chain_.chip(0).variant().status;
-    busy_bit_ = 1u << layout.busy;
-    mot_shift_ = static_cast<unsigned>(layout.mot_status);
-    error_bits_ = (1u << layout.notperf_cmd) | (1u << layout.wrong_cmd);
-    setup_profiles();
-    next_poll_ = chain_.now();  // first poll at once; it also clears the power-up UVLO latch
-  }
-
-  /// Runs exactly `ms` milliseconds of simulated time: a poll (and the commands it leads to)
-  /// at the start of each ms. Calls compose: run_ms(a) then run_ms(b) is run_ms(a + b).
-  /// (Exact while the frames of one ms fit in it: 64 chips at 5 MHz need at most 0.7 ms.)
-  void run_ms(std::uint64_t ms) {
-    for (std::uint64_t i = 0; i < ms; ++i) {
-      chain_.advance_to(next_poll_);
-      poll();
-      command_round();
-      next_poll_ += kPollPeriod;
-    }
-    chain_.advance_to(next_poll_);
-  }
-
-  Tick now() const { return chain_.now(); }
-  const MotionStats& stats() const { return stats_; }
-  std::size_t chips() const { return chain_.size(); }
-  const Chain& chain() const { return chain_; }
-
- private:
-  using Bytes = std::vector<std::uint8_t>;
-
-  void frame(const Bytes& tx, Bytes& rx) {
-    chain_.advance_to(chain_.now() + frame_ticks_);
-    chain_.select();
-    chain_.exchange(tx, rx);
-    chain_.deselect();
-    ++stats_.frames;
-  }
-
-  void setup_profiles() {
-    struct Param { std::uint8_t address; std::uint32_t lo, hi; };
-    constexpr std::array<Param, 3> params{{{0x05, 0x020, 0x400}, {0x06, 0x020, 0x400}, {0x07, 0x020, 0x120}}};
-    max_speed_.assign(chips(), 0);
-    for (const Param& p : params) {
-      std::uniform_int_distribution<std::uint32_t> dist(p.lo, p.hi);
-      Bytes addr(chips(), p.address), hi(chips()), lo(chips());
-      for (std::size_t k = 0; k < chips(); ++k) {
-        const std::uint32_t v = dist(rng_);
-        hi[k] = static_cast<std::uint8_t>(v >> 8);
-        lo[k] = static_cast<std::uint8_t>(v);
-        if (p.address == 0x07) max_speed_[k] = v;
-      }
-      frame(addr, rx_);
-      frame(hi, rx_);
-      frame(lo, rx_);
-    }
-  }
-
-  void poll() {
-    frame(get_status_, rx_);
-    frame(nops_, msb_);
-    frame(nops_, rx_);
-    for (std::size_t k = 0; k < chips(); ++k) status_[k] = static_cast<std::uint16_t>(msb_[k] << 8 | rx_[k]);
-    ++stats_.polls;
-  }
-
-  void command_round() {
-    std::size_t longest = 0;
-    for (std::size_t k = 0; k < chips(); ++k) {
-      const std::uint16_t st = status_[k];
-      const bool busy = (st & busy_bit_) == 0;
-      const bool stopped = ((st >> mot_shift_) & 3u) == 0;
-      if (st & error_bits_) ++stats_.cmd_errors;
-      Axis& a = axes_[k];
-      switch (a.phase) {
-        case Axis::Phase::moving:
-          if (!busy) { ++stats_.moves_done; a.phase = Axis::Phase::idle; }
-          break;
-        case Axis::Phase::running:
-          if (chain_.now() >= a.run_until) {
-            longest = std::max(longest, put_command(k, {0xB0}));
-            a.phase = Axis::Phase::stopping;
-          }
-          break;
-        case Axis::Phase::stopping:
-          if (!busy && stopped) { ++stats_.runs_done; a.phase = Axis::Phase::idle; }
-          break;
-        case Axis::Phase::idle:
-          break;
-      }
-      if (a.phase == Axis::Phase::idle) longest = std::max(longest, start_random_motion(k));
-    }
-    if (longest == 0) return;
-    for (std::size_t f = cmd_.size() - longest; f < cmd_.size(); ++f) {
-      frame(cmd_[f], rx_);
-      std::fill(cmd_[f].begin(), cmd_[f].end(), 0x00);
-    }
-  }
-
-  std::size_t start_random_motion(std::size_t k) {
-    Axis& a = axes_[k];
-    const bool forward = std::uniform_int_distribution<int>(0, 1)(rng_) == 1;
-    if (std::uniform_int_distribution<int>(0, 1)(rng_) == 0) {
-      const std::uint32_t steps = std::uniform_int_distribution<std::uint32_t>(2'000, 200'000)(rng_);
-      a.phase = Axis::Phase::moving;
-      return put_command(k, {static_cast<std::uint8_t>(0x40 | forward), steps});
-    }
-    const std::uint32_t top = max_speed_[k] << 10;
-    const std::uint32_t spd = std::uniform_int_distribution<std::uint32_t>(top / 8, top)(rng_);
-    a.phase = Axis::Phase::running;
-    a.run_until = chain_.now() + ticks_from_ms(std::uniform_int_distribution<std::uint64_t>(20, 300)(rng_));
-    return put_command(k, {static_cast<std::uint8_t>(0x50 | forward), spd});
-  }
-
-  struct Command {
-    std::uint8_t opcode;
-    std::uint32_t arg = 0;
-    bool has_arg = true;
-    Command(std::uint8_t op) : opcode(op), has_arg(false) {}
-    Command(std::uint8_t op, std::uint32_t a) : opcode(op), arg(a) {}
-  };
-
-  std::size_t put_command(std::size_t k, Command c) {
-    ++stats_.commands;
-    const std::size_t last = cmd_.size() - 1;
-    if (!c.has_arg) {
-      cmd_[last][k] = c.opcode;
-      return 1;
-    }
-    cmd_[last - 3][k] = c.opcode;
-    cmd_[last - 2][k] = static_cast<std::uint8_t>(c.arg >> 16);
-    cmd_[last - 1][k] = static_cast<std::uint8_t>(c.arg >> 8);
-    cmd_[last][k] = static_cast<std::uint8_t>(c.arg);
-    return 4;
-  }
-
-  Chain chain_;
-  std::mt19937_64 rng_;
-  std::vector<Axis> axes_;
-  std::vector<std::uint32_t> max_speed_;
-  std::vector<std::uint16_t> status_;
-  Bytes rx_, msb_, get_status_, nops_;
-  std::array<Bytes, 4> cmd_;
-  Tick frame_ticks_;
-  Tick next_poll_ = 0;
-  std::uint16_t busy_bit_ = 0, error_bits_ = 0;
-  unsigned mot_shift_ = 0;
-  MotionStats stats_;
-};
+// The workload is bench/motion_workload.hpp, shared with motion_bench.cpp.
+using namespace l6470emu::bench;
 
 constexpr std::size_t kMotionChips = 64;
 constexpr double kGoalSimPerWall = 1000.0;
@@ -368,9 +146,9 @@ constexpr double kGoalBytesPerChip = 1024.0;
 
 /// (sizeof(Chain) + heap the chain owns) / chips, for a chain of 256.
 double measure_bytes_per_chip() {
-  const std::size_t before = g_live_bytes;
+  const std::size_t before = live_heap_bytes();
   const Chain chain(kMemoryChips);
-  return static_cast<double>(sizeof(Chain) + (g_live_bytes - before)) / static_cast<double>(chain.size());
+  return static_cast<double>(sizeof(Chain) + (live_heap_bytes() - before)) / static_cast<double>(chain.size());
 }
 
 const char* verdict(bool met) { return met ? "met" : "NOT MET"; }

@@ -7,44 +7,15 @@
 #include <cstdlib>
 #include <new>
 
+#include "bench/heap_counter.hpp"
 #include "core/chip.hpp"
 #include "daisychain/chain.hpp"
 
-// ---- heap accounting: every global operator new / delete of the process goes through here.
-namespace {
-
-std::size_t g_live_bytes = 0;  // requested bytes currently allocated
-std::size_t g_peak_bytes = 0;  // high-water mark of g_live_bytes
-constexpr std::size_t kHeader = alignof(std::max_align_t);  // keeps the size in front of the block
-
-void* counted_alloc(std::size_t n) {
-  void* raw = std::malloc(n + kHeader);
-  if (raw == nullptr) throw std::bad_alloc();
-  *static_cast<std::size_t*>(raw) = n;
-  g_live_bytes += n;
-  if (g_live_bytes > g_peak_bytes) g_peak_bytes = g_live_bytes;
-  return static_cast<char*>(raw) + kHeader;
-}
-
-void counted_free(void* p) noexcept {
-  if (p == nullptr) return;
-  char* raw = static_cast<char*>(p) - kHeader;
-  g_live_bytes -= *reinterpret_cast<std::size_t*>(raw);
-  std::free(raw);
-}
-
-}  // namespace
-
-void* operator new(std::size_t n) { return counted_alloc(n); }
-void* operator new[](std::size_t n) { return counted_alloc(n); }
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
 
 namespace {
 
 using namespace l6470emu;
+using namespace l6470emu::bench;
 
 constexpr double kGoalBytesPerChip = 1024.0;
 
@@ -56,10 +27,10 @@ struct ChainMemory {
 };
 
 ChainMemory measure_chain(std::size_t n) {
-  const std::size_t live_before = g_live_bytes;
-  g_peak_bytes = g_live_bytes;
+  const std::size_t live_before = live_heap_bytes();
+  reset_peak_heap_bytes();
   const Chain chain(n);
-  return {chain.size(), g_live_bytes - live_before, g_peak_bytes - live_before};
+  return {chain.size(), live_heap_bytes() - live_before, peak_heap_bytes() - live_before};
 }
 
 }  // namespace
@@ -70,8 +41,8 @@ int main() {
   std::printf("    of which MotionState %5zu bytes, Profile %zu bytes, DiagnosticSink %zu bytes\n", sizeof(MotionState),
               sizeof(Profile), sizeof(DiagnosticSink));
   std::printf("  sizeof(Chain)         %6zu bytes\n", sizeof(Chain));
-  const std::size_t before = g_live_bytes;
-  { const Chip chip; std::printf("  heap owned by a Chip  %6zu bytes\n\n", g_live_bytes - before); }
+  const std::size_t before = live_heap_bytes();
+  { const Chip chip; std::printf("  heap owned by a Chip  %6zu bytes\n\n", live_heap_bytes() - before); }
 
   std::printf("  %6s  %12s  %12s  %14s  %14s  %s\n", "chips", "heap bytes", "peak bytes", "bytes/chip", "expected*", "goal < 1 KiB");
   for (const std::size_t n : {std::size_t{1}, std::size_t{8}, std::size_t{64}, std::size_t{256}}) {
