@@ -175,10 +175,11 @@ long Board::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> 
   if (suspicious)
     check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
   catch_up(c);
+  record_outputs(c);
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
-    if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) other->chain.deselect();
-  run_spidev_message(c.chain, c.spi, xfers, tx, rx);
+    if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) spi_of(*other).deselect();
+  run_spidev_message(spi_of(c), c.spi, xfers, tx, rx);
   if (c.gpio >= 0 && !gpios_[static_cast<std::size_t>(c.gpio)]->watched.empty()) {
     emit_changes(c, c.chain.now());
     wake_pump();
@@ -339,11 +340,7 @@ void Board::set_chip_input(GpioDev& g, unsigned offset, bool level) {
   }
   if (l.level == level) return;
   l.level = level;
-  ChainDev& c = *chains_[g.chain];
-  Chip& chip = c.chain.chip(chip_of_line(offset));
-  if (p == Pin::SW) chip.set_sw_pin(level);
-  if (p == Pin::STCK) chip.set_stck_pin(level);
-  if (p == Pin::STBY_RST) chip.set_stby_rst_pin(level);
+  apply_input(*chains_[g.chain], chip_of_line(offset), p, level);
 }
 
 void Board::refresh_watch_list(GpioDev& g) {
@@ -357,6 +354,7 @@ void Board::refresh_watch_list(GpioDev& g) {
 }
 
 void Board::emit_changes(ChainDev& c, Tick tick) {
+  record_outputs(c);
   if (c.gpio < 0) return;
   GpioDev& g = *gpios_[static_cast<std::size_t>(c.gpio)];
   for (unsigned off : g.watched) {
@@ -445,10 +443,7 @@ bool Board::drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level) 
   if (chip >= c.chain.size()) return false;
   catch_up(c);
   if (c.gpio < 0) {
-    Chip& ch = c.chain.chip(chip);
-    if (pin == Pin::SW) ch.set_sw_pin(level);
-    if (pin == Pin::STCK) ch.set_stck_pin(level);
-    if (pin == Pin::STBY_RST) ch.set_stby_rst_pin(level);
+    apply_input(c, chip, pin, level);
     return true;
   }
   GpioDev& g = *gpios_[static_cast<std::size_t>(c.gpio)];

@@ -26,6 +26,7 @@
 #include "linux/gpio_lines.hpp"
 #include "linux/log.hpp"
 #include "linux/spidev_rules.hpp"
+#include "spi/trace.hpp"
 
 namespace l6470emu {
 
@@ -56,8 +57,8 @@ struct NewFile {
   HandleKind kind = HandleKind::spidev;
 };
 
-/// Called after every SPI message with the chain index, the message and the bytes: the place
-/// where a trace recorder attaches (see linux/serve/control.cpp, `ctl trace`).
+/// Called after every SPI message with the chain index, the message and the bytes (for
+/// observers of the traffic; native traces are recorded by start_recording instead).
 using MessageObserver = std::function<void(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
                                            std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx,
                                            Tick end_tick)>;
@@ -114,6 +115,27 @@ class Board {
   const BoardClock& clock() const { return clock_; }
   /// Attaches (or with an empty function detaches) the SPI message observer.
   void set_message_observer(MessageObserver observer);
+  /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain `chain`,
+  /// recorded when the chain is being recorded. Returns false for a bad index.
+  bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+
+  // ---- trace recording (board_record.cpp) -----------------------------------------
+
+  /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
+  /// progress on the chain is stopped first): every CS frame, every input pin change (host gpio
+  /// or ctl), every backdoor event and the BUSY/FLAG changes, each line flushed as it is written.
+  /// Returns "" or one line saying why not.
+  std::string start_recording(std::size_t chain, const std::string& path);
+  /// Starts recording every chain: into `path` for one chain, else trace_path_for_chain files.
+  std::string start_recording_all(const std::string& path);
+  /// Stops recording chain `chain` (a frame still open, CS held low, is not written).
+  /// Returns false when it was not recording; `summary` gets "N frames to PATH".
+  bool stop_recording(std::size_t chain, std::string* summary = nullptr);
+  /// Where chain `chain` is being recorded ("" = not recording).
+  std::string recording_path(std::size_t chain);
+  /// After fork() in the child: drops the parent's recordings without writing to them.
+  void forget_recordings_after_fork();
+
   /// Open handles, by kind, as text (for `ctl dump`).
   std::string describe_handles();
 
@@ -163,6 +185,11 @@ class Board {
   long reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
                          const std::vector<std::uint32_t>& debounce);
   bool logical_value(Handle& h, unsigned index);
+
+  // recording (board_record.cpp)
+  SpiDevice& spi_of(ChainDev& c);
+  void apply_input(ChainDev& c, std::size_t chip, Pin pin, bool level);
+  void record_outputs(ChainDev& c);
 
   DiagnosticLog& log_;
   BoardClock clock_;

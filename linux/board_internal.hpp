@@ -6,6 +6,7 @@
 
 #include "linux/board.hpp"
 #include "linux/gpio_uapi.hpp"
+#include "linux/trace_recorder.hpp"
 
 namespace l6470emu {
 
@@ -18,6 +19,7 @@ struct Board::ChainDev {
   unsigned users = 0;             // open files (spidev resets speed_hz at the last close)
   std::uint32_t reported = 0;     // setting problems already reported since the last settings change
   int gpio = -1;                  // index into gpios_, -1 = no gpiochip
+  std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
   ChainDev(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

@@ -159,10 +159,12 @@ struct Parser {
           cfg.log = v;
         } else if (key == "socket") {
           cfg.socket = v;
+        } else if (key == "trace") {
+          cfg.trace = v;
         } else if (key == "bus" || key == "cs" || key == "path" || key == "gpiochip") {
           return fail("chain key '" + k + "' without chips= in the same clause");
         } else {
-          return fail("unknown key '" + k + "' (globals: time, scale, log, socket; a chain needs chips=)");
+          return fail("unknown key '" + k + "' (globals: time, scale, log, socket, trace; a chain needs chips=)");
         }
       }
     }
@@ -229,6 +231,7 @@ std::string describe_board_config(const BoardConfig& config) {
       << " mode=" << unsigned{c.mode} << " bufsiz=" << c.bufsiz << "\n";
   }
   o << "time=" << (config.time.virtual_time ? "virtual" : "wall") << " scale=" << config.time.scale << "\n";
+  if (!config.trace.empty()) o << "trace=" << config.trace << "\n";
   return o.str();
 }
 

@@ -36,6 +36,7 @@ struct BoardConfig {
   TimeConfig time;
   std::string log = "stderr";  ///< where diagnostics go: "stderr", "off" or a file path
   std::string socket;          ///< daemon socket (preload: forward to it instead of emulating in process)
+  std::string trace;           ///< record every chain into this native trace file ("" = no recording)
 };
 
 /// A config error: one line saying where and what.
@@ -46,7 +47,7 @@ struct ConfigError {
 /// Parses a board description. Clauses are separated by newlines or ';', words by blanks,
 /// '#' starts a comment. A clause with chips= is a chain:
 ///   bus=0 cs=0 chips=L6470,2xL6480 [path=/dev/spidev0.0] [gpiochip=N|none] [speed=HZ] [mode=0..3] [bufsiz=N]
-/// other clauses set globals: time=wall|virtual, scale=F, log=stderr|off|FILE, socket=PATH.
+/// other clauses set globals: time=wall|virtual, scale=F, log=stderr|off|FILE, socket=PATH, trace=FILE.
 /// `origin` names the source in error messages ("L6470EMU_CHAIN", a file name).
 /// Returns the config, or the first error.
 struct ParseResult {

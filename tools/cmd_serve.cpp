@@ -1,6 +1,7 @@
 // `l6470emu serve` and `l6470emu ctl`.
 #include "tools/cmd_serve.hpp"
 
+#include <filesystem>
 #include <iostream>
 
 #include "linux/config.hpp"
@@ -22,9 +23,12 @@ ServeCommands::ServeCommands(CLI::App& app) {
   serve_->add_flag("--virtual-time", virtual_time_,
                    "time moves only with bus traffic and `ctl advance` (deterministic runs)");
   serve_->add_option("--log", log_, "diagnostics: stderr (default), off, or a file");
+  serve_->add_option("--record", record_,
+                     "record every chain into this native trace, flushed frame by frame "
+                     "(several chains: the chain's name goes before the extension)");
 
   ctl_ = app.add_subcommand("ctl", "control a running daemon: " + std::string("status, get, dump, sw, pin, fault, adc, "
-                                                                               "time, advance, chains (ctl help)"));
+                                                                               "time, advance, chains, trace (ctl help)"));
   ctl_->add_option("--socket", socket_, "the daemon's socket (default as for serve)");
   ctl_->add_option("command", words_, "the command and its arguments")->required();
   ctl_->prefix_command();
@@ -53,12 +57,16 @@ std::optional<int> ServeCommands::run() {
     if (time_scale_ > 0) config.time.scale = time_scale_;
     if (virtual_time_) config.time.virtual_time = true;
     if (!log_.empty()) config.log = log_;
+    if (!record_.empty()) config.trace = record_;
     const std::string socket = !socket_.empty() ? socket_ : !config.socket.empty() ? config.socket : default_socket_path();
     return run_daemon(config, socket, std::cout, std::cerr);
   }
   if (ctl_ && *ctl_) {
     std::vector<std::string> all = words_;
     for (const auto& extra : ctl_->remaining()) all.push_back(extra);
+    // The daemon runs elsewhere: a relative trace file is meant from here.
+    if (all.size() >= 3 && all[0] == "trace" && all[1] == "start" && !all[2].empty() && all[2][0] != '/' && all[2][0] != '-')
+      all[2] = std::filesystem::absolute(all[2]).lexically_normal().string();
     std::string command;
     for (const auto& w : all) command += (command.empty() ? "" : " ") + w;
     if (command == "help" || command == "--help") {

@@ -26,6 +26,7 @@ class ServeCommands {
   double time_scale_ = 0;
   bool virtual_time_ = false;
   std::string log_;
+  std::string record_;
   std::vector<std::string> words_;
 };
 

@@ -6,7 +6,11 @@ namespace {
 
 class LocalBackend final : public Backend {
  public:
-  explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_) {}
+  explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_) {
+    if (!config.trace.empty())
+      if (const std::string error = board_.start_recording_all(config.trace); !error.empty())
+        log_.line("trace not recorded: " + error);
+  }
 
   const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
   NewFile open(std::size_t device, bool cloexec) override { return board_.open(device, cloexec); }
@@ -25,6 +29,7 @@ class LocalBackend final : public Backend {
   void after_fork_child() override {
     board_.mutex().unlock();
     board_.forget_pump_after_fork();
+    board_.forget_recordings_after_fork();
   }
 
  private:

@@ -69,6 +69,7 @@ __attribute__((constructor)) void load_config() {
   g_config = new BoardConfig(std::move(*parsed.config));
   if (socket && *socket) g_config->socket = socket;
   if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) g_config->log = log;
+  if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) g_config->trace = trace;
   g_log = new DiagnosticLog(g_config->log);
   pthread_atfork(atfork_prepare, atfork_parent, atfork_child);
   g_active.store(true, std::memory_order_release);
@@ -93,6 +94,8 @@ Backend* backend() {
   try {
     std::unique_ptr<Backend> made = g_config->socket.empty() ? make_local_backend(*g_config)
                                                              : make_remote_backend(g_config->socket, g_config->log);
+    if (!g_config->socket.empty() && !g_config->trace.empty())
+      log_line("trace= / L6470EMU_TRACE is ignored with a daemon: record with `serve --record` or `ctl trace start`");
     b = made.release();
   } catch (const std::exception& e) {
     log_line(std::string("cannot start the emulator: ") + e.what());

@@ -68,7 +68,8 @@ std::string control_help() {
          "  adc CODE --chip K                   ADCIN conversion result, 0..31\n"
          "  time                                virtual time of each chain\n"
          "  advance MS                          virtual-time daemons: let MS milliseconds pass\n"
-         "  trace start FILE | trace stop       record the SPI traffic (not available yet)\n";
+         "  trace start FILE                    record the chain's SPI frames, pins and faults (native trace)\n"
+         "  trace stop                          stop recording (every chain, or the --chain one)\n";
 }
 
 int run_control(Board& board, const std::string& command, std::string& out) {
@@ -212,23 +213,22 @@ int run_control(Board& board, const std::string& command, std::string& out) {
         out = "ctl: thermal level must be normal, warning, bridge-shutdown or device-shutdown\n";
         return 2;
       }
-      board.with_chain(ci, [&](Chain& c) { c.chip(k).set_thermal(t); });
+      board.inject_fault(ci, k, TraceFault::THERMAL, static_cast<std::uint8_t>(t));
     } else {
       if (v != "on" && v != "off") {
         out = "ctl: fault state must be on or off\n";
         return 2;
       }
       const bool on = v == "on";
+      TraceFault fault = TraceFault::UVLO;
       bool known = true;
-      board.with_chain(ci, [&](Chain& c) {
-        Chip& chip = c.chip(k);
-        if (f == "uvlo") chip.set_undervoltage(on);
-        else if (f == "uvlo-adc") chip.set_adc_undervoltage(on);
-        else if (f == "ocd") chip.set_overcurrent(on);
-        else if (f == "stall-a") chip.set_stall(Bridge::A, on);
-        else if (f == "stall-b") chip.set_stall(Bridge::B, on);
-        else known = false;
-      });
+      if (f == "uvlo") fault = TraceFault::UVLO;
+      else if (f == "uvlo-adc") fault = TraceFault::UVLO_ADC;
+      else if (f == "ocd") fault = TraceFault::OCD;
+      else if (f == "stall-a") fault = TraceFault::STALL_A;
+      else if (f == "stall-b") fault = TraceFault::STALL_B;
+      else known = false;
+      if (known) board.inject_fault(ci, k, fault, on ? 1 : 0);
       if (!known) {
         out = "ctl: unknown fault '" + f + "' (uvlo, uvlo-adc, ocd, stall-a, stall-b, thermal)\n";
         return 2;
@@ -244,7 +244,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
       out = "ctl: usage: adc CODE --chip K (CODE 0..31)\n";
       return 2;
     }
-    board.with_chain(ci, [&](Chain& c) { c.chip(k).set_adc_input(static_cast<std::uint8_t>(code)); });
+    board.inject_fault(ci, k, TraceFault::ADCIN, static_cast<std::uint8_t>(code));
     o << "chip " << k << ": ADC_OUT " << code << "\n";
   } else if (cmd == "time") {
     for (std::size_t i = 0; i < board.chain_count(); ++i) {
@@ -269,10 +269,31 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     }
     o << "advanced " << ms << " ms\n";
   } else if (cmd == "trace") {
-    // Extension point: the trace recorder (spi/trace*, daisychain/recording_chain*) attaches here
-    // through Board::set_message_observer, which sees every SPI message with its bytes and tick.
-    out = "ctl: trace recording is not available yet (it arrives with the trace recorder)\n";
-    return 1;
+    // One native trace per chain; without --chain, `stop` ends every recording.
+    if (a.words.size() == 2 && a.words[0] == "start") {
+      if (const std::string error = board.start_recording(ci, a.words[1]); !error.empty()) {
+        out = "ctl: " + error + "\n";
+        return 1;
+      }
+      o << board.chain_summary(ci) << ": recording to " << a.words[1] << "\n";
+    } else if (a.words.size() == 1 && a.words[0] == "stop") {
+      bool any = false;
+      for (std::size_t i = 0; i < board.chain_count(); ++i) {
+        if (!a.chain.empty() && i != ci) continue;
+        std::string summary;
+        if (board.stop_recording(i, &summary)) {
+          any = true;
+          o << board.chain_summary(i) << ": recorded " << summary << "\n";
+        }
+      }
+      if (!any) {
+        out = "ctl: nothing is being recorded\n";
+        return 1;
+      }
+    } else {
+      out = "ctl: usage: trace start FILE [--chain NAME] | trace stop [--chain NAME]\n";
+      return 2;
+    }
   } else {
     out = "ctl: unknown command '" + cmd + "'\n" + control_help();
     return 2;

@@ -117,6 +117,15 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
 
   DiagnosticLog log(config.log);
   Board board(config, log);
+  if (!config.trace.empty()) {
+    if (const std::string error = board.start_recording_all(config.trace); !error.empty()) {
+      err << "l6470emu serve: cannot record: " << error << "\n";
+      close(listener);
+      unlink(socket_path.c_str());
+      if (sfd >= 0) close(sfd);
+      return 1;
+    }
+  }
   board.start_pump();
   std::mutex control_mutex;  // ctl commands one at a time
   const ControlHandler control = [&](const std::string& command, std::string& text) {
@@ -128,6 +137,8 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   for (std::size_t i = 0; i < board.chain_count(); ++i) out << "  " << board.chain_summary(i) << "\n";
   out << "  " << (config.time.virtual_time ? std::string("virtual time") : "wall clock x " + std::to_string(config.time.scale))
       << "\n";
+  for (std::size_t i = 0; i < board.chain_count(); ++i)
+    if (const std::string path = board.recording_path(i); !path.empty()) out << "  recording to " << path << "\n";
   out << "run programs with: LD_PRELOAD=<path>/libl6470emu-preload.so L6470EMU_SOCKET=" << socket_path << " <program>\n";
   out.flush();
 
@@ -175,6 +186,10 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   for (auto& c : connections) {
     if (c.thread.joinable()) c.thread.join();
     close(c.fd);
+  }
+  for (std::size_t i = 0; i < board.chain_count(); ++i) {
+    std::string summary;
+    if (board.stop_recording(i, &summary)) out << "l6470emu serve: recorded " << summary << "\n";
   }
   board.stop_pump();
   if (sfd >= 0) close(sfd);
