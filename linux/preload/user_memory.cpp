@@ -43,27 +43,24 @@ PageCache& cache() {
   return t_cache;
 }
 
-}  // namespace
-
-bool copy_from_user(void* dst, const void* src, std::size_t n) {
+/// One checked copy: `user` is the host program's side (read from or written to), `vm_copy`
+/// the process_vm_readv/writev call that faults cleanly instead of crashing. Pages that
+/// copied fine once are remembered so hot buffers cost a plain memcpy.
+template <class VmCopy>
+bool checked_copy(void* dst, const void* src, std::size_t n, const void* user, std::uintptr_t* seen, VmCopy vm_copy) {
   if (n == 0) return true;
-  const auto a = reinterpret_cast<std::uintptr_t>(src);
+  const auto a = reinterpret_cast<std::uintptr_t>(user);
   if (a < kPage || a + n < a) return false;
   const std::uintptr_t first = a / kPage, last = (a + n - 1) / kPage;
-  PageCache& c = cache();
-  if (last - first < 8 && known(c.read, first, last)) {
+  if ((last - first < 8 && known(seen, first, last)) || g_vm_unsupported.load(std::memory_order_relaxed)) {
     std::memcpy(dst, src, n);
     return true;
   }
-  if (g_vm_unsupported.load(std::memory_order_relaxed)) {
-    std::memcpy(dst, src, n);
-    return true;
-  }
-  iovec local{dst, n}, remote{const_cast<void*>(src), n};
+  iovec local{const_cast<void*>(user == src ? dst : src), n}, remote{const_cast<void*>(user), n};
   const int saved = errno;
-  const ssize_t r = process_vm_readv(getpid(), &local, 1, &remote, 1, 0);
+  const ssize_t r = vm_copy(&local, &remote);
   if (r == static_cast<ssize_t>(n)) {
-    remember(c.read, first, last);
+    remember(seen, first, last);
     errno = saved;
     return true;
   }
@@ -77,36 +74,16 @@ bool copy_from_user(void* dst, const void* src, std::size_t n) {
   return false;
 }
 
+}  // namespace
+
+bool copy_from_user(void* dst, const void* src, std::size_t n) {
+  return checked_copy(dst, src, n, src, cache().read,
+                      [](iovec* local, iovec* remote) { return process_vm_readv(getpid(), local, 1, remote, 1, 0); });
+}
+
 bool copy_to_user(void* dst, const void* src, std::size_t n) {
-  if (n == 0) return true;
-  const auto a = reinterpret_cast<std::uintptr_t>(dst);
-  if (a < kPage || a + n < a) return false;
-  const std::uintptr_t first = a / kPage, last = (a + n - 1) / kPage;
-  PageCache& c = cache();
-  if (last - first < 8 && known(c.write, first, last)) {
-    std::memcpy(dst, src, n);
-    return true;
-  }
-  if (g_vm_unsupported.load(std::memory_order_relaxed)) {
-    std::memcpy(dst, src, n);
-    return true;
-  }
-  iovec local{const_cast<void*>(src), n}, remote{dst, n};
-  const int saved = errno;
-  const ssize_t r = process_vm_writev(getpid(), &local, 1, &remote, 1, 0);
-  if (r == static_cast<ssize_t>(n)) {
-    remember(c.write, first, last);
-    errno = saved;
-    return true;
-  }
-  if (r < 0 && (errno == ENOSYS || errno == EPERM)) {
-    g_vm_unsupported.store(1);
-    errno = saved;
-    std::memcpy(dst, src, n);
-    return true;
-  }
-  errno = saved;
-  return false;
+  return checked_copy(dst, src, n, dst, cache().write,
+                      [](iovec* local, iovec* remote) { return process_vm_writev(getpid(), local, 1, remote, 1, 0); });
 }
 
 void forget_user_pages() { g_generation.fetch_add(1, std::memory_order_relaxed); }
