@@ -34,29 +34,15 @@ class Json {
     if (peek() == '[') {
       read_event_array(out);
     } else if (peek() == '{') {
-      ++i_;
       bool found = false;
-      for (bool first = true;; first = false) {
-        skip_ws();
-        if (peek() == '}') {
-          ++i_;
-          break;
-        }
-        if (!first) {
-          expect(',');
-          skip_ws();
-        }
-        const std::string key = read_string();
-        skip_ws();
-        expect(':');
-        skip_ws();
+      read_members([&](const std::string& key) {
         if (key == "traceEvents") {
           read_event_array(out);
           found = true;
         } else {
           skip_value();
         }
-      }
+      });
       if (!found) fail("no \"traceEvents\" array (expected sigrok-cli --protocol-decoder-jsontrace output)");
     } else {
       fail("not JSON (expected sigrok-cli --protocol-decoder-jsontrace output, which starts with '{')");
@@ -69,6 +55,28 @@ class Json {
   [[noreturn]] void fail(const std::string& message) const { throw TraceError(name_, line_, message); }
 
  private:
+  /// Reads an object; on_member(key) is called with the member's value next in line and must read it.
+  template <class F>
+  void read_members(F on_member) {
+    expect('{');
+    for (bool first = true;; first = false) {
+      skip_ws();
+      if (peek() == '}') {
+        ++i_;
+        return;
+      }
+      if (!first) {
+        expect(',');
+        skip_ws();
+      }
+      const std::string key = read_string();
+      skip_ws();
+      expect(':');
+      skip_ws();
+      on_member(key);
+    }
+  }
+
   char peek() const { return i_ < s_.size() ? s_[i_] : '\0'; }
   void skip_ws() {
     while (i_ < s_.size()) {
@@ -176,21 +184,7 @@ class Json {
       }
       JsonEvent e;
       e.line = line_;
-      expect('{');
-      for (bool f2 = true;; f2 = false) {
-        skip_ws();
-        if (peek() == '}') {
-          ++i_;
-          break;
-        }
-        if (!f2) {
-          expect(',');
-          skip_ws();
-        }
-        const std::string key = read_string();
-        skip_ws();
-        expect(':');
-        skip_ws();
+      read_members([&](const std::string& key) {
         if (key == "ts") {
           if (peek() == '"') fail("\"ts\" must be a number");
           e.ts = read_number();
@@ -204,7 +198,7 @@ class Json {
         } else {
           skip_value();
         }
-      }
+      });
       out.push_back(std::move(e));
     }
   }
