@@ -122,33 +122,13 @@ MotStatus mot_status(const MotionState& s, const Profile& p) {
 }
 
 MotionFlags motion_flags(const MotionState& s, const Profile& p) {
-  switch (s.activity) {
-    case Activity::idle:
-    case Activity::step_clock:
-      return {MotStatus::stopped, false};
-    case Activity::run: {
-      if (s.reversing) return {MotStatus::deceleration, true};
-      const std::uint64_t t = constant_speed_target(s, p);
-      if (s.speed < t) return {MotStatus::acceleration, true};
-      if (s.speed > t) return {MotStatus::deceleration, true};
-      return {MotStatus::constant_speed, false};
-    }
-    default:
-      return {mot_status(s, p), true};
-  }
+  const MotStatus mot = mot_status(s, p);
+  // A Run keeps BUSY low until it cruises at its target; every other activity until it ends.
+  const bool busy = s.activity == Activity::run ? mot != MotStatus::constant_speed : !motor_stopped(s);
+  return {mot, busy};
 }
 
-bool motion_busy(const MotionState& s, const Profile& p) {
-  switch (s.activity) {
-    case Activity::idle:
-    case Activity::step_clock:
-      return false;
-    case Activity::run:
-      return s.reversing || s.speed != constant_speed_target(s, p);
-    default:
-      return true;
-  }
-}
+bool motion_busy(const MotionState& s, const Profile& p) { return motion_flags(s, p).busy; }
 
 unsigned __int128 braking_distance(std::uint64_t v, const Profile& p) {
   const std::uint64_t f = p.floor_speed();
