@@ -14,7 +14,7 @@
 
 namespace l6470emu {
 
-Board::Board(const BoardConfig& config, DiagnosticLog& log) : log_(log), clock_(config.time) {
+Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : log_(log), time_(config.time, host) {
   unsigned spi_minor = 0;
   for (const ChainConfig& cc : config.chains) {
     std::vector<Chip> chips;
@@ -160,6 +160,23 @@ void Board::release(Handle& h) {
 
 long Board::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                         std::span<std::uint8_t> rx) {
+  Tick end = 0;
+  const long r = run_spi_message(handle, xfers, tx, rx, end);
+  if (r >= 0) wait_for(end);  // the call takes the message's bus time, as a kernel transfer does
+  return r;
+}
+
+void Board::wait_for(Tick tick) {
+  // Virtual time with nobody else to wait for: the bus time simply passes (and edges with it).
+  if (time_.is_virtual() && !time_.waiter()) {
+    advance_to(tick);
+    return;
+  }
+  time_.wait_until(tick);
+}
+
+long Board::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
+                            std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end) {
   std::lock_guard lock(m_);
   Handle* h = find(handle, HandleKind::spidev);
   if (!h) return -EBADF;
@@ -174,7 +191,11 @@ long Board::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> 
     if (x.speed_hz > kChipMaxSpeedHz || (x.bits_per_word != 0 && x.bits_per_word != 8)) suspicious = true;
   if (suspicious)
     check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
-  catch_up(c);
+  // The message starts when the bus is free: now, or when the message before it on this bus ends
+  // (its caller may still be waiting for that end).
+  Tick& bus_free = bus_free_[c.config.bus];
+  const Tick start = std::max(time_.now(), bus_free);
+  if (start > c.chain.now()) advance_chain(c, start);
   record_outputs(c);
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
@@ -185,6 +206,7 @@ long Board::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> 
     wake_pump();
   }
   if (observer_) observer_(h->dev, xfers, tx, rx, c.chain.now());
+  end = bus_free = c.chain.now();
   return total;
 }
 
@@ -244,7 +266,7 @@ long Board::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_
 // ---------------------------------------------------------------- time and edges
 
 void Board::catch_up(ChainDev& c) {
-  const Tick target = clock_.now();
+  const Tick target = time_.now();
   if (target > c.chain.now()) advance_chain(c, target);
 }
 
@@ -373,12 +395,9 @@ void Board::emit_changes(ChainDev& c, Tick tick) {
 void Board::send_line_event(Handle& h, unsigned index, bool rising, Tick tick) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned off = h.offsets[index];
-  std::int64_t ts = clock_.wall_ns_of(tick);
-  if (g.lines[off].flags & GPIO_V2_LINE_FLAG_EVENT_CLOCK_REALTIME) {
-    timespec rt{};
-    clock_gettime(CLOCK_REALTIME, &rt);
-    ts += (std::int64_t{rt.tv_sec} * 1'000'000'000 + rt.tv_nsec) - monotonic_ns();
-  }
+  // The host's clock at the edge's tick (the kernel stamps the edge when it happens).
+  std::int64_t ts = time_.host_ns_of(tick);
+  if (g.lines[off].flags & GPIO_V2_LINE_FLAG_EVENT_CLOCK_REALTIME) ts += time_.realtime_offset_ns();
   ssize_t n = 0;
   if (h.kind == HandleKind::line_event_v1) {
     gpioevent_data e{};
@@ -468,15 +487,27 @@ bool Board::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
   return pin == Pin::STBY_RST ? ch.spi_enabled() : false;
 }
 
-bool Board::advance(Tick ticks) {
-  if (!clock_.is_virtual()) return false;
+bool Board::advance(Tick ticks) { return time_.is_virtual() && advance_to(time_.now() + ticks); }
+
+bool Board::advance_to(Tick tick) {
+  if (!time_.is_virtual()) return false;
   std::lock_guard lock(m_);
-  clock_.advance(ticks);
+  const Tick target = time_.set_now(tick);
   for (auto& c : chains_) {
-    advance_chain(*c, c->chain.now() + ticks);
+    if (c->chain.now() < target) advance_chain(*c, target);
     emit_changes(*c, c->chain.now());
   }
   return true;
+}
+
+Tick Board::next_edge_tick() {
+  std::lock_guard lock(m_);
+  Tick best = kNever;
+  for (auto& c : chains_) {
+    catch_up(*c);
+    best = std::min(best, predict_next_edge(*c));
+  }
+  return best;
 }
 
 Tick Board::now(std::size_t chain) {

@@ -66,8 +66,9 @@ using MessageObserver = std::function<void(std::size_t chain, std::span<const sp
 /// The emulated hardware and the kernel-side state of its device nodes. Thread-safe.
 class Board {
  public:
-  /// Builds the chains and gpiochips of `config`; diagnostics go to `log`.
-  Board(const BoardConfig& config, DiagnosticLog& log);
+  /// Builds the chains and gpiochips of `config`; diagnostics go to `log`. The board's time is
+  /// read from `host` (the kernel's clocks unless a test injects its own).
+  Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host = real_host_clock());
   ~Board();
   Board(const Board&) = delete;
   Board& operator=(const Board&) = delete;
@@ -88,6 +89,9 @@ class Board {
   long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
   /// SPI_IOC_MESSAGE(n): `tx` holds the tx data of the transfers with a tx_buf, concatenated;
   /// `rx` (spidev_rx_bytes long) receives the rx data. Returns the total length or -errno.
+  /// Like a kernel transfer, the call takes the message's bus time: the message starts when
+  /// the bus is free (now, or when the message before it on the same bus ends) and the call
+  /// returns when the board's time reaches its end (a sleep in wall mode, a wait in virtual mode).
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                    std::span<std::uint8_t> rx);
   /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
@@ -110,9 +114,17 @@ class Board {
   bool pin_level(std::size_t chain, std::size_t chip, Pin pin);
   /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
   bool advance(Tick ticks);
+  /// Virtual time: moves the board's time to `tick` if it is later and brings every chain
+  /// there, delivering the BUSY/FLAG edges of watched lines at their own ticks. Wall time: false.
+  bool advance_to(Tick tick);
+  /// The earliest tick at which a watched BUSY/FLAG line will change by itself (kNever: none).
+  /// A host thread waiting on line events wakes then.
+  Tick next_edge_tick();
   /// Current tick of chain `chain`.
   Tick now(std::size_t chain);
-  const BoardClock& clock() const { return clock_; }
+  /// The board's time (the one owner of the clock: spidev, gpio events, ctl, traces).
+  BoardTime& time() { return time_; }
+  const BoardTime& time() const { return time_; }
   /// Attaches (or with an empty function detaches) the SPI message observer.
   void set_message_observer(MessageObserver observer);
   /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain `chain`,
@@ -162,6 +174,9 @@ class Board {
   void release_if_closed(std::uint64_t id);
 
   // time and edges
+  long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                       std::span<std::uint8_t> rx, Tick& end);
+  void wait_for(Tick tick);
   void catch_up(ChainDev& c);
   void advance_chain(ChainDev& c, Tick target);
   Tick first_change(ChainDev& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
@@ -192,7 +207,8 @@ class Board {
   void record_outputs(ChainDev& c);
 
   DiagnosticLog& log_;
-  BoardClock clock_;
+  BoardTime time_;
+  std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last message ends
   std::vector<DeviceNode> nodes_;
   std::vector<std::unique_ptr<ChainDev>> chains_;
   std::vector<std::unique_ptr<GpioDev>> gpios_;

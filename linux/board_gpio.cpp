@@ -65,7 +65,7 @@ void Board::notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_typ
       continue;
     gpio_v2_line_info info{};
     fill_v2_info(g, offset, &info);
-    const std::uint64_t ts = static_cast<std::uint64_t>(monotonic_ns());
+    const std::uint64_t ts = static_cast<std::uint64_t>(time_.host_ns_of(time_.now()));
     if (h->watch_abi == 1) {
       gpioline_info_changed c{};
       c.info.line_offset = offset;
@@ -247,7 +247,7 @@ long Board::request_lines(Handle& chip, HandleKind kind, const std::vector<unsig
   emit_changes(c, c.chain.now());  // outputs set at request time may have edges for others
   for (unsigned off : offsets) notify_lineinfo(g, off, GPIO_V2_LINE_CHANGED_REQUESTED);
   *created = f;
-  if (edges && !clock_.is_virtual() && !pump_running_) {
+  if (edges && !time_.is_virtual() && !pump_running_) {
     pump_stop_ = false;
     pump_running_ = true;
     pump_ = std::thread([this] { pump_loop(); });
@@ -276,7 +276,7 @@ long Board::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags
   ChainDev& c = *chains_[g.chain];
   emit_changes(c, c.chain.now());
   for (unsigned off : h.offsets) notify_lineinfo(g, off, GPIO_V2_LINE_CHANGED_CONFIG);
-  if (edges && !clock_.is_virtual() && !pump_running_) {
+  if (edges && !time_.is_virtual() && !pump_running_) {
     pump_stop_ = false;
     pump_running_ = true;
     pump_ = std::thread([this] { pump_loop(); });

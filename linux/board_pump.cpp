@@ -56,9 +56,9 @@ void Board::pump_loop() {
       for (auto& c : chains_) {
         if (c->gpio < 0 || gpios_[static_cast<std::size_t>(c->gpio)]->watched.empty()) continue;
         catch_up(*c);
-        if (clock_.is_virtual()) continue;
+        if (time_.is_virtual()) continue;
         const Tick t = predict_next_edge(*c);
-        if (t != kNever) deadline = std::min(deadline, clock_.wall_ns_of(t));
+        if (t != kNever) deadline = std::min(deadline, time_.host_ns_of(t));
       }
       fds.push_back({wake_fd_, POLLIN, 0});
       for (auto& [id, h] : handles_) {
@@ -69,7 +69,7 @@ void Board::pump_loop() {
     timespec ts{};
     timespec* tsp = nullptr;
     if (deadline != INT64_MAX) {
-      std::int64_t wait = deadline - monotonic_ns();
+      std::int64_t wait = deadline - time_.host().monotonic_ns();
       if (wait < 0) wait = 0;
       ts.tv_sec = wait / 1'000'000'000;
       ts.tv_nsec = wait % 1'000'000'000;

@@ -254,8 +254,8 @@ int run_control(Board& board, const std::string& command, std::string& out) {
                     static_cast<double>(t) / static_cast<double>(kTicksPerSecond));
       o << board.chain_summary(i) << ": " << b << "\n";
     }
-    o << (board.clock().is_virtual() ? "virtual time (moves with bus traffic and `advance`)\n"
-                                     : "wall clock x " + std::to_string(board.clock().scale()) + "\n");
+    o << (board.time().is_virtual() ? "virtual time (moves with bus traffic and `advance`)\n"
+                                    : "wall clock x " + std::to_string(board.time().scale()) + "\n");
   } else if (cmd == "advance") {
     char* end = nullptr;
     const double ms = a.words.size() == 1 ? std::strtod(a.words[0].c_str(), &end) : -1;
