@@ -14,8 +14,11 @@ namespace l6470emu {
 
 /// How the board's virtual clock follows the wall clock.
 struct TimeConfig {
-  bool virtual_time = false;  ///< true: time moves only with bus traffic and explicit advances
+  bool virtual_time = false;  ///< true: the host program's own time is the board's (preload: time=virtual)
   double scale = 1.0;         ///< wall mode: virtual seconds per wall second (> 0)
+  /// Virtual mode: real time after which, with some thread neither waiting nor entering or
+  /// leaving a covered call, virtual time moves on anyway (logged once). 0 = never (idle=off).
+  std::int64_t idle_ns = 1'000'000'000;
 };
 
 /// One daisy chain behind one spidev chip-select, and the gpiochip carrying its pins.
