@@ -85,17 +85,6 @@ Tick command_ticks(std::size_t n, std::uint32_t hz) {
   return static_cast<Tick>(n) * (transfer_ticks(1, hz) + ticks_from_us(10));
 }
 
-/// The tick at which a Move of `n_step` microsteps, decoded at tick 0 on a power-up L6470,
-/// releases BUSY: the profile's own duration.
-Tick profile_ticks(bool forward, std::uint32_t n_step) {
-  Chain c(1);
-  ChainHost h(c, 0);
-  h.move(0, forward, n_step);
-  const Tick start = c.now();
-  while (!c.chip(0).busy_sync_pin()) c.advance_to(c.next_event_tick());
-  return c.now() - start;
-}
-
 TEST(BoardTime, WallTicksAndHostTimeMapBothWaysExactlyAtAnyScale) {
   for (double scale : {1.0, 20.0, 0.5, 3.7}) {
     FakeHostClock clock;
@@ -172,7 +161,7 @@ TEST(BoardPacing, AHostPollingWithoutPauseSeesAMoveLastItsProfileDuration) {
     const Tick decoded = rig.tick() - ticks_from_us(10);  // the Move runs from its last CS rise
     while (!(rig.get_status() & status_bits::kBusyN)) rig.clock.now += 2'000;  // 2 µs of host work per poll
     const Tick seen = rig.tick() - decoded;
-    const Tick profile = profile_ticks(true, n_step);
+    const Tick profile = move_profile_ticks(true, n_step);
     EXPECT_GE(seen, profile) << n_step;
     // STATUS is sampled at the first CS rise of a poll, which returns two frames later: the host
     // learns of the release at most one whole poll (plus its 2 µs of work) after it happened.
@@ -241,7 +230,7 @@ TEST(BoardPacing, ABusyEdgeCarriesTheHostClockAtTheTickItHappened) {
     EXPECT_EQ(ev[0].id, GPIO_V2_LINE_EVENT_FALLING_EDGE);
     EXPECT_EQ(ev[1].id, GPIO_V2_LINE_EVENT_RISING_EDGE);
     const std::int64_t offset = realtime ? rig.clock.realtime_offset : 0;
-    const std::int64_t release = rig.board.time().host_ns_of(decoded + profile_ticks(false, n_step)) + offset;
+    const std::int64_t release = rig.board.time().host_ns_of(decoded + move_profile_ticks(false, n_step)) + offset;
     EXPECT_EQ(static_cast<std::int64_t>(ev[1].timestamp_ns), release) << (realtime ? "REALTIME" : "MONOTONIC");
     ::close(line.fd);
     ::close(chip.fd);

@@ -37,6 +37,10 @@ inline constexpr unsigned kStopped = 0, kAccel = 1, kDecel = 2, kConst = 3;
 inline unsigned mot(std::uint16_t status) { return (status >> 5) & 3u; }
 }  // namespace status_bits
 
+/// How long a Move of `n_step` microsteps takes on an L6470 in its power-up state (BUSY low from
+/// the decoded command to its release): the profile's own duration, from the model itself.
+Tick move_profile_ticks(bool forward, std::uint32_t n_step);
+
 /// One L6470 behind its own chip-select, with a host talking to it.
 struct OneChip {
   Chain chain{1};

@@ -1,0 +1,132 @@
+// Time as real host programs see it on their own clock (wall mode), in process and through
+// `l6470emu serve`: py-spidev and a C driver polling a Move, a Run polled for a second, a ported
+// vendor example that sleeps, and BUSY edges arriving as libgpiod events. Bounds are one-sided
+// where the design guarantees them (the board never runs ahead of the host) and generous where
+// the scheduler adds noise, so they cannot flake.
+#include <signal.h>
+
+#include <chrono>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "run_program.hpp"
+#include "support/test_support.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+/// key=value words of a program's output.
+std::map<std::string, std::string> fields(const std::string& out) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(out);
+  std::string w;
+  while (in >> w)
+    if (const auto eq = w.find('='); eq != std::string::npos) m[w.substr(0, eq)] = w.substr(eq + 1);
+  return m;
+}
+
+double seconds(Tick t) { return static_cast<double>(t) / static_cast<double>(kTicksPerSecond); }
+
+/// Runs each scenario in process (param false) or through a daemon (param true).
+class HostTime : public ::testing::TestWithParam<bool> {
+ protected:
+  void SetUp() override {
+    const std::string why = missing_prerequisites();
+    if (!why.empty()) GTEST_SKIP() << why;
+    if (!GetParam()) return;
+    socket_ = temp_socket_path("host-time");
+    daemon_ = std::make_unique<Background>(
+        std::vector<std::string>{l6470emu_program(), "serve", "--chain", kChain, "--socket", socket_});
+    for (int i = 0; i < 500 && daemon_->out().find("listening on") == std::string::npos; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    ASSERT_NE(daemon_->out().find("listening on"), std::string::npos) << daemon_->out();
+  }
+  void TearDown() override {
+    if (daemon_) daemon_->stop(SIGTERM);
+  }
+  Env env() const {
+    if (GetParam()) return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_SOCKET", socket_}};
+    return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", kChain}};
+  }
+  std::map<std::string, std::string> python(const std::vector<std::string>& args) {
+    std::vector<std::string> argv = {system_python(), script("host_time.py")};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const RunResult r = run_program(argv, env(), 60);
+    EXPECT_EQ(r.status, 0) << r.out << r.err;
+    return fields(r.out);
+  }
+
+  static constexpr const char* kChain = "bus=0 cs=0 chips=L6470 log=off";
+  std::string socket_;
+  std::unique_ptr<Background> daemon_;
+};
+
+/// A polled Move, as the host measured it: never shorter than the profile (the board cannot run
+/// ahead of the host's clock), and within 5 % plus scheduling noise of it.
+void expect_move_seen_to_last_its_profile(const std::map<std::string, std::string>& f, std::uint32_t full_steps,
+                                          double poll_s) {
+  ASSERT_TRUE(f.count("released")) << "no result";
+  const double profile = seconds(move_profile_ticks(true, full_steps * 128));
+  const double seen = std::stod(f.at("released")) - std::stod(f.at("start"));
+  EXPECT_GE(seen, profile) << full_steps << " full steps";
+  EXPECT_LE(seen, profile * 1.05 + poll_s + 0.25) << full_steps << " full steps";
+}
+
+TEST_P(HostTime, PySpidevPollingAMoveSeesBusyReleasedAfterTheProfileDuration) {
+  for (std::uint32_t steps : {200u, 1000u}) {
+    const auto f = python({"poll-move", std::to_string(steps), "5000000"});
+    expect_move_seen_to_last_its_profile(f, steps, 0.001);
+  }
+}
+
+TEST_P(HostTime, PySpidevPollingAt10kHzSeesTheSameDuration) {
+  const auto f = python({"poll-move", "200", "10000"});
+  expect_move_seen_to_last_its_profile(f, 200, 3 * 8 / 10'000.0 + 0.001);  // one GetStatus at 10 kHz
+}
+
+TEST_P(HostTime, ACDriverPollingAMoveSeesBusyReleasedAfterTheProfileDuration) {
+  for (const char* hz : {"10000", "5000000"}) {
+    const RunResult r = run_program({client("poll_move"), "/dev/spidev0.0", "200", hz}, env(), 60);
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    expect_move_seen_to_last_its_profile(fields(r.out), 200, 0.003);
+  }
+}
+
+TEST_P(HostTime, PollingARunForOneSecondMovesTheMotorOneSecondsWorth) {
+  const auto f = python({"run-poll", "100000"});
+  ASSERT_TRUE(f.count("abs_pos"));
+  const double elapsed = std::stod(f.at("elapsed"));
+  const long pos = std::stol(f.at("abs_pos"));
+  // 200 full steps/s after a 0.1 s ramp at the power-up ACC: 190 full steps in the first second.
+  EXPECT_GE(pos, 189 * 128) << "the motor lags the host";
+  EXPECT_LE(pos, static_cast<long>(200 * 128 * elapsed)) << "the motor ran ahead of the host's clock";
+}
+
+TEST_P(HostTime, AVendorExampleThatRunsSleepsAndReadsSpeedSeesFullSpeed) {
+  auto f = python({"run-sleep"});
+  EXPECT_EQ(f["speed"], "0x0346E");  // 200 step/s in 2^-28 step/tick: reached after 0.1 s of ramp
+  EXPECT_GE(std::stol(f["abs_pos"]), 189 * 128);
+}
+
+TEST_P(HostTime, ABusyEdgeAfterHeavyPollingArrivesOnTimeStampedWithTheHostClock) {
+  const auto f = python({"edge-after-poll"});
+  ASSERT_NE(f.count("edge"), 0u);
+  ASSERT_NE(f.at("edge"), "None") << "no rising edge within 5 s";
+  const double profile = seconds(move_profile_ticks(false, 200 * 128));
+  const double start = std::stod(f.at("start")) / 1e9, sent = std::stod(f.at("sent")) / 1e9;
+  const double edge = std::stod(f.at("edge")) / 1e9, received = std::stod(f.at("received")) / 1e9;
+  // The Move was decoded between start and sent; its edge is stamped at the host's clock then.
+  EXPECT_GE(edge - start, profile - 0.001);
+  EXPECT_LE(edge - sent, profile + 0.001);
+  EXPECT_GE(received, edge);
+  EXPECT_LT(received - edge, 0.2) << "the edge reached the host late";
+}
+
+INSTANTIATE_TEST_SUITE_P(InProcessAndThroughTheDaemon, HostTime, ::testing::Values(false, true),
+                         [](const auto& info) { return info.param ? "Daemon" : "InProcess"; });
+
+}  // namespace
+}  // namespace l6470emu::test
