@@ -1,10 +1,19 @@
-// Parser of the board description (L6470EMU_CHAIN, config files, `serve --chain`).
+// Parser of the board description (L6470EMU_CHAIN, config files, `serve --chain`): every key
+// checked against its range, one error line that says where, what and how to write it instead.
 #include "linux/config.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
-#include <cstdlib>
-#include <fstream>
+#include <cmath>
+#include <cstring>
+#include <map>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -12,9 +21,56 @@
 namespace l6470emu {
 namespace {
 
+constexpr std::size_t kMaxChipsPerChain = 256;
+constexpr std::size_t kMaxChains = 256;
+constexpr std::size_t kMaxPathBytes = 255;
+constexpr std::size_t kMaxSocketPathBytes = 107;  // sizeof sockaddr_un::sun_path - 1
+constexpr unsigned kMaxGpiochip = 1023;
+
+enum class Scope { chain, board };
+
+struct KeySpec {
+  std::string_view name;
+  Scope scope;
+  std::string_view example;  // a whole word, as a user would write it
+};
+
+// Every key, in the order the docs table lists them.
+constexpr std::array<KeySpec, 14> kKeys{{
+    {"chips", Scope::chain, "chips=2xL6470,L6480"},
+    {"bus", Scope::chain, "bus=0"},
+    {"cs", Scope::chain, "cs=1"},
+    {"path", Scope::chain, "path=/dev/spidev-motors"},
+    {"gpiochip", Scope::chain, "gpiochip=4"},
+    {"speed", Scope::chain, "speed=2000000"},
+    {"mode", Scope::chain, "mode=3"},
+    {"bufsiz", Scope::chain, "bufsiz=65536"},
+    {"time", Scope::board, "time=virtual"},
+    {"scale", Scope::board, "scale=10"},
+    {"idle", Scope::board, "idle=0.2"},
+    {"log", Scope::board, "log=/tmp/l6470emu.log"},
+    {"socket", Scope::board, "socket=/tmp/l6470emu.sock"},
+    {"trace", Scope::board, "trace=run.trace"},
+}};
+
+const KeySpec* find_key(std::string_view name) {
+  for (const KeySpec& k : kKeys)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+std::string key_list(Scope scope) {
+  std::string out;
+  for (const KeySpec& k : kKeys)
+    if (k.scope == scope) out += (out.empty() ? "" : ", ") + std::string(k.name);
+  return out;
+}
+
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
 std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
   return s;
 }
 
@@ -22,42 +78,155 @@ std::vector<std::string_view> split_words(std::string_view s) {
   std::vector<std::string_view> words;
   std::size_t i = 0;
   while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) ++i;
+    while (i < s.size() && is_blank(s[i])) ++i;
     std::size_t j = i;
-    while (j < s.size() && s[j] != ' ' && s[j] != '\t' && s[j] != '\r') ++j;
+    while (j < s.size() && !is_blank(s[j])) ++j;
     if (j > i) words.push_back(s.substr(i, j - i));
     i = j;
   }
   return words;
 }
 
+bool is_control(unsigned char c) { return c < 0x20 || c == 0x7f; }
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// Levenshtein distance, case-insensitive; only for the short words suggestions are made for.
+std::size_t edit_distance(std::string_view a_in, std::string_view b_in) {
+  const std::string a = lower(a_in), b = lower(b_in);
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// The candidates closest to `word` (at most 2 edits, and fewer than the word's length), as
+// "A" or "A or B"; "" when nothing is close.
+std::string closest(std::string_view word, const std::vector<std::string>& candidates) {
+  if (word.empty() || word.size() > 32) return "";
+  std::size_t best = 3;
+  std::vector<std::string> hits;
+  for (const auto& c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d >= word.size() || d > best) continue;
+    if (d < best) hits.clear();
+    best = d;
+    hits.push_back(c);
+  }
+  std::string out;
+  for (std::size_t i = 0; i < hits.size(); ++i) out += (i == 0 ? "" : i + 1 == hits.size() ? " or " : ", ") + hits[i];
+  return out;
+}
+
+std::vector<std::string> variant_names() {
+  std::vector<std::string> names;
+  for (const Variant* v : all_variants()) names.emplace_back(v->name);
+  return names;
+}
+
+std::string variant_suggestion(std::string_view name) {
+  const std::string near = closest(name, variant_names());
+  return near.empty() ? "" : "did you mean " + near + "? ";
+}
+
+// Words users write for a key under another name.
+std::string_view key_alias(std::string_view key) {
+  static constexpr std::pair<std::string_view, std::string_view> kAliases[] = {
+      {"chip", "chips"},       {"variant", "chips"},  {"variants", "chips"},   {"device", "path"},
+      {"dev", "path"},         {"node", "path"},      {"hz", "speed"},         {"speed_hz", "speed"},
+      {"max_speed_hz", "speed"}, {"timescale", "scale"}, {"time-scale", "scale"}, {"time_scale", "scale"},
+      {"gpio", "gpiochip"},    {"record", "trace"},   {"cs_pin", "cs"},        {"chipselect", "cs"},
+  };
+  const std::string k = lower(key);
+  for (const auto& [alias, real] : kAliases)
+    if (k == alias) return real;
+  return {};
+}
+
+std::string key_suggestion(std::string_view key) {
+  if (const std::string_view alias = key_alias(key); !alias.empty()) return std::string(alias);
+  std::vector<std::string> names;
+  for (const KeySpec& k : kKeys) names.emplace_back(k.name);
+  return closest(key, names);
+}
+
 template <typename T>
-bool parse_uint(std::string_view s, T& out, unsigned long long max) {
+bool parse_uint(std::string_view s, T& out, unsigned long long min, unsigned long long max) {
   unsigned long long v = 0;
   const auto* end = s.data() + s.size();
   auto [p, ec] = std::from_chars(s.data(), end, v, 10);
-  if (ec != std::errc{} || p != end || s.empty() || v > max) return false;
+  if (ec != std::errc{} || p != end || s.empty() || v < min || v > max) return false;
   out = static_cast<T>(v);
   return true;
 }
 
-bool parse_double(std::string_view s, double& out) {
-  std::string text(s);
-  char* end = nullptr;
-  errno = 0;
-  out = std::strtod(text.c_str(), &end);
-  return !text.empty() && errno == 0 && end == text.c_str() + text.size();
+// A plain decimal number ("10", "0.5", "2e3"): no sign, no inf/nan, no hex, within [min, max].
+bool parse_decimal(std::string_view s, double& out, double min, double max) {
+  if (s.empty() || !(std::isdigit(static_cast<unsigned char>(s[0])) || s[0] == '.')) return false;
+  for (char c : s)
+    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' || c == '+' || c == '-'))
+      return false;
+  double v = 0;
+  const auto* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, v, std::chars_format::general);
+  if (ec != std::errc{} || p != end || !std::isfinite(v) || v < min || v > max) return false;
+  out = v;
+  return true;
 }
+
+// Device nodes of every Linux system that a chain must not take over in the host program.
+std::string system_node_reason(std::string_view name) {
+  const std::string_view first = name.substr(0, name.find('/'));
+  static constexpr std::string_view kStandard[] = {"null",  "zero",  "full",   "random", "urandom", "console",
+                                                    "ptmx",  "kmsg",  "mem",    "kmem",   "port",    "stdin",
+                                                    "stdout", "stderr", "log",  "initctl", "fuse",   "net",
+                                                    "pts",   "fd",    "shm",    "mqueue", "hugepages", "tty"};
+  for (std::string_view s : kStandard)
+    if (first == s) return "a standard device of the system";
+  if (first.substr(0, 3) == "tty") return "a terminal";
+  if (first.substr(0, 8) == "gpiochip") return "where the emulator puts a chain's pins (gpiochip=N)";
+  return "";
+}
+
+// The shortest text that reads back as exactly `v`.
+std::string shortest(double v) {
+  std::array<char, 32> buf{};
+  const auto [p, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return ec == std::errc{} ? std::string(buf.data(), p) : std::to_string(v);
+}
+
+// How the config file is read: at most this much (a board description is a few lines).
+constexpr std::size_t kMaxBytes = kMaxConfigBytes;
+
+struct Setting {
+  unsigned clause = 0;
+  std::string value;
+};
 
 struct Parser {
   std::string_view origin;
   std::string error;
   unsigned clause_no = 0;
+  std::map<std::string, Setting, std::less<>> board_keys;  // board-wide key -> where it was set
+  std::vector<unsigned> chain_clause;                      // clause of each chain
+  std::vector<bool> chain_gpiochip_given;                  // gpiochip= written for each chain
 
-  bool fail(std::string what) {
+  bool fail(const std::string& what) {
     if (error.empty()) {
       std::ostringstream o;
-      o << "l6470emu: config " << origin << ", clause " << clause_no << ": " << what;
+      o << "l6470emu: config " << shown_text(origin, 200) << ", clause " << clause_no << ": " << what;
       error = o.str();
     }
     return false;
@@ -65,172 +234,370 @@ struct Parser {
 
   // "L6470", "3xL6470", "L6470x3", "3*L6470", "L6470*3"
   bool parse_chip_list(std::string_view list, std::vector<const Variant*>& chips) {
+    std::vector<std::pair<const Variant*, unsigned long long>> items;
     std::size_t start = 0;
     while (start <= list.size()) {
       std::size_t comma = list.find(',', start);
       if (comma == std::string_view::npos) comma = list.size();
-      std::string_view item = trim(list.substr(start, comma - start));
-      if (item.empty()) return fail("empty entry in chips=" + std::string(list));
-      unsigned count = 1;
-      std::string_view name = item;
-      for (char sep : {'x', '*'}) {
-        const std::size_t at = item.find(sep);
-        if (at == std::string_view::npos || at == 0 || at + 1 >= item.size()) continue;
-        unsigned n = 0;
-        if (parse_uint(item.substr(0, at), n, 256) && lookup_variant(item.substr(at + 1))) {
-          count = n;
-          name = item.substr(at + 1);
-          break;
-        }
-        if (parse_uint(item.substr(at + 1), n, 256) && lookup_variant(item.substr(0, at))) {
-          count = n;
-          name = item.substr(0, at);
-          break;
+      const std::string_view item = list.substr(start, comma - start);
+      start = comma + 1;
+      if (item.empty()) return fail("empty entry in chips=" + quoted_text(list) + " (write e.g. chips=L6470,2xL6480)");
+      std::string_view name = item, count_text;
+      if (!lookup_variant(item)) {
+        std::size_t d = 0;
+        while (d < item.size() && std::isdigit(static_cast<unsigned char>(item[d]))) ++d;
+        std::size_t t = item.size();
+        while (t > 0 && std::isdigit(static_cast<unsigned char>(item[t - 1]))) --t;
+        auto is_sep = [](char c) { return c == 'x' || c == 'X' || c == '*'; };
+        if (d > 0 && d < item.size() && is_sep(item[d])) {
+          count_text = item.substr(0, d);
+          name = item.substr(d + 1);
+        } else if (t < item.size() && t > 0 && is_sep(item[t - 1])) {
+          count_text = item.substr(t);
+          name = item.substr(0, t - 1);
         }
       }
+      if (name.empty())
+        return fail(quoted_text(item) + " names no chip variant (write e.g. chips=3xL6470; known: " + known_variant_names() +
+                    ")");
       const Variant* v = lookup_variant(name);
       if (v == nullptr)
-        return fail("unknown chip variant '" + std::string(name) + "' (known: " + known_variant_names() + ")");
-      if (count == 0) return fail("chip count 0 in '" + std::string(item) + "'");
-      for (unsigned i = 0; i < count; ++i) chips.push_back(v);
-      start = comma + 1;
+        return fail("unknown chip variant " + quoted_text(name) + " (" + variant_suggestion(name) +
+                    "known: " + known_variant_names() + ")");
+      unsigned long long count = 1;
+      if (!count_text.empty()) {
+        const bool fits = parse_uint(count_text, count, 0, ~0ull);
+        if (count == 0 && fits) return fail("chip count 0 in " + quoted_text(item) + ": a chain holds 1 to 256 chips");
+        if (!fits || count > kMaxChipsPerChain)
+          return fail("a chain holds at most 256 chips; " + quoted_text(item) + " asks for " + shown_text(count_text));
+      }
+      items.emplace_back(v, count);
     }
-    if (chips.size() > 256) return fail("a chain holds at most 256 chips, not " + std::to_string(chips.size()));
+    unsigned long long total = 0;
+    for (const auto& [v, n] : items) total += n;
+    if (total > kMaxChipsPerChain)
+      return fail("a chain holds at most 256 chips; chips=" + quoted_text(list) + " asks for " + std::to_string(total));
+    for (const auto& [v, n] : items) chips.insert(chips.end(), n, v);
     return true;
+  }
+
+  bool check_path(std::string_view value) {
+    const std::string q = quoted_text(value);
+    if (value.size() > kMaxPathBytes)
+      return fail("path is " + std::to_string(value.size()) + " bytes long; a device node name has at most 255");
+    if (value.substr(0, 5) != "/dev/")
+      return fail("path must be a device node under /dev/ (e.g. path=/dev/spidev0.0), not " + q);
+    const std::string_view name = value.substr(5);
+    if (name.empty() || name.back() == '/') return fail("path " + q + " names a directory, not a device node");
+    for (char c : name)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' || c == '+' || c == ':' ||
+            c == '@' || c == '/'))
+        return fail("path " + q + " has a character a device node name does not use (letters, digits and . _ - + : @ /)");
+    std::size_t start = 0;
+    while (start <= name.size()) {
+      std::size_t slash = name.find('/', start);
+      if (slash == std::string_view::npos) slash = name.size();
+      const std::string_view part = name.substr(start, slash - start);
+      if (part.empty() || part == "." || part == "..")
+        return fail("path " + q + " must name a node directly (no empty, '.' or '..' parts)");
+      start = slash + 1;
+    }
+    if (const std::string why = system_node_reason(name); !why.empty())
+      return fail("path " + q + " is " + why + ", not a spidev node: the emulator would take it over in the host program "
+                  "(write e.g. path=/dev/spidev0.0, or leave path= out)");
+    return true;
+  }
+
+  // A board-wide key: given at most once in the whole description.
+  bool set_board_key(const KeySpec& key, std::string_view value, BoardConfig& cfg) {
+    const std::string k(key.name);
+    if (auto it = board_keys.find(k); it != board_keys.end())
+      return fail(k + "= is given twice: clause " + std::to_string(it->second.clause) + " says " +
+                  quoted_text(it->second.value) + ", clause " + std::to_string(clause_no) + " says " + quoted_text(value) +
+                  " (a board-wide key is given once)");
+    board_keys[k] = {clause_no, std::string(value)};
+    const std::string q = quoted_text(value);
+    if (k == "time") {
+      if (value == "wall")
+        cfg.time.virtual_time = false;
+      else if (value == "virtual")
+        cfg.time.virtual_time = true;
+      else
+        return fail("time must be wall or virtual, not " + q);
+    } else if (k == "scale") {
+      if (!parse_decimal(value, cfg.time.scale, 1e-6, 1e6))
+        return fail("scale must be a number from 0.000001 to 1000000 (virtual seconds per wall second), not " + q);
+    } else if (k == "idle") {
+      double s = 0;
+      if (value == "off")
+        cfg.time.idle_ns = 0;
+      else if (parse_decimal(value, s, 0.001, 3600))
+        cfg.time.idle_ns = std::llround(s * 1e9);
+      else
+        return fail("idle must be off or a number of seconds from 0.001 to 3600, not " + q);
+    } else if (k == "log") {
+      if (value == "stdout" || value == "none" || value == "null")
+        return fail("log=" + std::string(value) + " would be a file of that name: write log=stderr, log=off, or log=./" +
+                    std::string(value) + " if a file is meant");
+      if (value.back() == '/') return fail("log " + q + " names a directory; give a file");
+      cfg.log = std::string(value);
+    } else if (k == "socket") {
+      if (value.size() > kMaxSocketPathBytes)
+        return fail("socket path is " + std::to_string(value.size()) + " bytes long; a Unix socket path has at most 107");
+      if (value.back() == '/') return fail("socket " + q + " names a directory; give the socket's path");
+      cfg.socket = std::string(value);
+    } else if (k == "trace") {
+      if (value.back() == '/') return fail("trace " + q + " names a directory; give a file");
+      cfg.trace = std::string(value);
+    }
+    // Combinations that would be silently ignored.
+    auto time_given = board_keys.find(std::string_view("time"));
+    if (time_given != board_keys.end()) {
+      const bool virtual_time = time_given->second.value == "virtual";
+      if (virtual_time && board_keys.count(std::string_view("scale")))
+        return fail("scale= applies to time=wall only: with time=virtual (clause " + std::to_string(time_given->second.clause) +
+                    ") the host program's own clock is the board's");
+      if (!virtual_time && board_keys.count(std::string_view("idle")))
+        return fail("idle= applies to time=virtual only, and clause " + std::to_string(time_given->second.clause) +
+                    " says time=wall");
+    }
+    return true;
+  }
+
+  bool set_chain_key(const KeySpec& key, std::string_view value, ChainConfig& chain) {
+    const std::string q = quoted_text(value);
+    const std::string_view k = key.name;
+    if (k == "bus") {
+      if (!parse_uint(value, chain.bus, 0, 32767)) return fail("bus must be a number from 0 to 32767, not " + q);
+    } else if (k == "cs") {
+      if (!parse_uint(value, chain.cs, 0, 255)) return fail("cs must be a number from 0 to 255, not " + q);
+    } else if (k == "path") {
+      if (!check_path(value)) return false;
+      chain.path = std::string(value);
+    } else if (k == "chips") {
+      if (!parse_chip_list(value, chain.chips)) return false;
+    } else if (k == "gpiochip") {
+      unsigned n = 0;
+      if (value == "none")
+        chain.gpiochip.reset();
+      else if (parse_uint(value, n, 0, kMaxGpiochip))
+        chain.gpiochip = n;
+      else
+        return fail("gpiochip must be a number from 0 to 1023 or none, not " + q);
+    } else if (k == "speed") {
+      if (!parse_uint(value, chain.max_speed_hz, 1, 1'000'000'000))
+        return fail("speed must be a frequency in Hz from 1 to 1000000000 (e.g. speed=5000000), not " + q);
+    } else if (k == "mode") {
+      if (!parse_uint(value, chain.mode, 0, 3)) return fail("mode must be an SPI mode from 0 to 3, not " + q);
+    } else if (k == "bufsiz") {
+      if (!parse_uint(value, chain.bufsiz, 1, 1u << 22)) return fail("bufsiz must be a number from 1 to 4194304, not " + q);
+    }
+    return true;
+  }
+
+  // A word that is not key=value: say what was probably meant.
+  bool fail_bare_word(std::string_view w) {
+    const std::string q = quoted_text(w);
+    if (w.front() == '=') return fail(q + " has no key before '=' (write key=value, without blanks around '=')");
+    if (lookup_variant(w)) return fail("expected key=value, got " + q + " (did you mean chips=" + std::string(w) + "?)");
+    if (w == "virtual" || w == "wall") return fail("expected key=value, got " + q + " (did you mean time=" + std::string(w) + "?)");
+    if (const KeySpec* k = find_key(w))
+      return fail(std::string(k->name) + " needs a value written right after '=', without blanks: e.g. " +
+                  std::string(k->example));
+    return fail("expected key=value, got " + q);
   }
 
   bool parse_clause(std::string_view clause, BoardConfig& cfg) {
     const auto words = split_words(clause);
+    std::vector<std::pair<const KeySpec*, std::string_view>> settings;
+    std::map<std::string_view, std::string_view> in_clause;
+    const KeySpec* first_chain_key = nullptr;
     bool is_chain = false;
-    for (auto w : words)
-      if (w.substr(0, 6) == "chips=") is_chain = true;
-    ChainConfig chain;
-    bool have_gpiochip = false;
     for (auto w : words) {
+      for (char c : w)
+        if (is_control(static_cast<unsigned char>(c)))
+          return fail("control character in " + quoted_text(w) + " (a board description is plain text)");
       const std::size_t eq = w.find('=');
-      if (eq == std::string_view::npos || eq == 0)
-        return fail("expected key=value, got '" + std::string(w) + "'");
+      if (eq == std::string_view::npos || eq == 0) return fail_bare_word(w);
       const std::string_view key = w.substr(0, eq), value = w.substr(eq + 1);
-      const std::string k(key), v(value);
-      if (value.empty()) return fail("empty value for " + k);
-      if (is_chain) {
-        if (key == "bus") {
-          if (!parse_uint(value, chain.bus, 32767)) return fail("bus must be a number 0..32767, not '" + v + "'");
-        } else if (key == "cs") {
-          if (!parse_uint(value, chain.cs, 255)) return fail("cs must be a number 0..255, not '" + v + "'");
-        } else if (key == "path") {
-          if (value.substr(0, 5) != "/dev/") return fail("path must be under /dev/, not '" + v + "'");
-          chain.path = v;
-        } else if (key == "chips") {
-          if (!parse_chip_list(value, chain.chips)) return false;
-        } else if (key == "gpiochip") {
-          have_gpiochip = true;
-          if (value == "none") {
-            chain.gpiochip.reset();
-          } else {
-            unsigned n = 0;
-            if (!parse_uint(value, n, 1023)) return fail("gpiochip must be a number or 'none', not '" + v + "'");
-            chain.gpiochip = n;
-          }
-        } else if (key == "speed") {
-          if (!parse_uint(value, chain.max_speed_hz, 1'000'000'000) || chain.max_speed_hz == 0)
-            return fail("speed must be a frequency in Hz (1..1000000000), not '" + v + "'");
-        } else if (key == "mode") {
-          if (!parse_uint(value, chain.mode, 3)) return fail("mode must be 0..3, not '" + v + "'");
-        } else if (key == "bufsiz") {
-          if (!parse_uint(value, chain.bufsiz, 1u << 22) || chain.bufsiz == 0)
-            return fail("bufsiz must be 1..4194304, not '" + v + "'");
-        } else {
-          return fail("unknown chain key '" + k + "' (keys: bus, cs, path, chips, gpiochip, speed, mode, bufsiz)");
-        }
-      } else {
-        if (key == "time") {
-          if (value == "wall")
-            cfg.time.virtual_time = false;
-          else if (value == "virtual")
-            cfg.time.virtual_time = true;
-          else
-            return fail("time must be 'wall' or 'virtual', not '" + v + "'");
-        } else if (key == "scale") {
-          double s = 0;
-          if (!parse_double(value, s) || !(s > 0) || s > 1e6) return fail("scale must be a number > 0 (and <= 1e6), not '" + v + "'");
-          cfg.time.scale = s;
-        } else if (key == "log") {
-          cfg.log = v;
-        } else if (key == "socket") {
-          cfg.socket = v;
-        } else if (key == "trace") {
-          cfg.trace = v;
-        } else if (key == "bus" || key == "cs" || key == "path" || key == "gpiochip") {
-          return fail("chain key '" + k + "' without chips= in the same clause");
-        } else {
-          return fail("unknown key '" + k + "' (globals: time, scale, log, socket, trace; a chain needs chips=)");
-        }
+      const KeySpec* spec = find_key(key);
+      if (spec == nullptr) {
+        const std::string near = key_suggestion(key);
+        return fail("unknown key " + quoted_text(key) + (near.empty() ? "" : ": did you mean " + near + "=?") +
+                    " (chain keys: " + key_list(Scope::chain) + "; board-wide keys: " + key_list(Scope::board) + ")");
       }
+      if (auto it = in_clause.find(spec->name); it != in_clause.end())
+        return fail(std::string(key) + "= is given twice in this clause (" + quoted_text(it->second) + ", then " +
+                    quoted_text(value) + ")");
+      in_clause[spec->name] = value;
+      if (value.empty()) return fail(std::string(key) + "= has no value (e.g. " + std::string(spec->example) + ")");
+      if (spec->scope == Scope::chain && !first_chain_key) first_chain_key = spec;
+      if (spec->name == "chips") is_chain = true;
+      settings.emplace_back(spec, value);
+    }
+    if (first_chain_key && !is_chain)
+      return fail(std::string(first_chain_key->name) +
+                  "= describes a chain: add chips= to this clause (e.g. 'bus=0 cs=0 chips=L6470')");
+    ChainConfig chain;
+    for (const auto& [spec, value] : settings) {
+      const bool ok = spec->scope == Scope::board ? set_board_key(*spec, value, cfg) : set_chain_key(*spec, value, chain);
+      if (!ok) return false;
     }
     if (!is_chain) return true;
+    if (cfg.chains.size() >= kMaxChains) return fail("a board holds at most 256 chains");
     if (chain.path.empty()) chain.path = "/dev/spidev" + std::to_string(chain.bus) + "." + std::to_string(chain.cs);
-    if (!have_gpiochip) {
-      // Default: the k-th chain gets /dev/gpiochip<k>, skipping numbers already taken.
-      std::set<unsigned> used;
-      for (const auto& c : cfg.chains)
-        if (c.gpiochip) used.insert(*c.gpiochip);
-      unsigned n = 0;
-      while (used.count(n)) ++n;
-      chain.gpiochip = n;
+    for (std::size_t i = 0; i < cfg.chains.size(); ++i) {
+      const auto& c = cfg.chains[i];
+      if (c.path == chain.path)
+        return fail("two chains on " + chain.path + " (clause " + std::to_string(chain_clause[i]) + " and this one)");
+      if (c.gpiochip && chain.gpiochip && *c.gpiochip == *chain.gpiochip && chain_gpiochip_given[i])
+        return fail("two chains on /dev/gpiochip" + std::to_string(*chain.gpiochip) + " (clause " +
+                    std::to_string(chain_clause[i]) + " and this one)");
     }
-    for (const auto& c : cfg.chains) {
-      if (c.path == chain.path) return fail("two chains on " + chain.path);
-      if (c.gpiochip && chain.gpiochip && *c.gpiochip == *chain.gpiochip)
-        return fail("two chains on /dev/gpiochip" + std::to_string(*chain.gpiochip));
-    }
+    chain_clause.push_back(clause_no);
+    chain_gpiochip_given.push_back(in_clause.count("gpiochip") != 0);
     cfg.chains.push_back(std::move(chain));
+    return true;
+  }
+
+  // Chains without gpiochip= get the lowest numbers no chain asked for, in order.
+  bool assign_default_gpiochips(BoardConfig& cfg) {
+    std::set<unsigned> used;
+    for (std::size_t i = 0; i < cfg.chains.size(); ++i)
+      if (chain_gpiochip_given[i] && cfg.chains[i].gpiochip) used.insert(*cfg.chains[i].gpiochip);
+    unsigned n = 0;
+    for (std::size_t i = 0; i < cfg.chains.size(); ++i) {
+      if (chain_gpiochip_given[i]) continue;
+      while (used.count(n)) ++n;
+      if (n > kMaxGpiochip) {
+        clause_no = chain_clause[i];
+        return fail("no free gpiochip number left (0..1023): write gpiochip=none");
+      }
+      cfg.chains[i].gpiochip = n;
+      used.insert(n);
+    }
     return true;
   }
 };
 
 }  // namespace
 
+std::string shown_text(std::string_view text, std::size_t max_bytes) {
+  std::string out;
+  const std::size_t n = std::min(text.size(), max_bytes);
+  out.reserve(n + 8);
+  static constexpr char kHex[] = "0123456789abcdef";
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (is_control(c) || c >= 0x80 || c == '\\') {
+      out += "\\x";
+      out += kHex[c >> 4];
+      out += kHex[c & 15];
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  if (text.size() > max_bytes) out += "\u2026";
+  return out;
+}
+
+std::string quoted_text(std::string_view text) {
+  std::string out = "'" + shown_text(text) + "'";
+  if (text.size() > kQuotedTextBytes) out += " (" + std::to_string(text.size()) + " bytes)";
+  return out;
+}
+
 ParseResult parse_board_config(std::string_view text, std::string_view origin) {
-  Parser p{origin, {}, 0};
+  Parser p{origin, {}, 0, {}, {}, {}};
+  if (text.size() > kMaxBytes)
+    return {std::nullopt, {"l6470emu: config " + shown_text(origin, 200) +
+                           ": longer than 1 MiB (a board description is a few lines)"}};
   BoardConfig cfg;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    std::size_t end = text.find_first_of(";\n", start);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view clause = text.substr(start, end - start);
-    const std::size_t hash = clause.find('#');
-    if (hash != std::string_view::npos) clause = clause.substr(0, hash);
-    clause = trim(clause);
-    ++p.clause_no;
-    if (!clause.empty() && !p.parse_clause(clause, cfg)) return {std::nullopt, {p.error}};
-    start = end + 1;
+  // Lines end at newlines and '#' comments run to the end of the line; ';' separates clauses
+  // within a line. Clauses are numbered through the whole text.
+  std::size_t line_start = 0;
+  while (line_start <= text.size()) {
+    std::size_t line_end = text.find('\n', line_start);
+    if (line_end == std::string_view::npos) line_end = text.size();
+    std::string_view line = text.substr(line_start, line_end - line_start);
+    line = line.substr(0, line.find('#'));
+    std::size_t start = 0;
+    while (start <= line.size()) {
+      std::size_t end = line.find(';', start);
+      if (end == std::string_view::npos) end = line.size();
+      const std::string_view clause = trim(line.substr(start, end - start));
+      ++p.clause_no;
+      if (!clause.empty() && !p.parse_clause(clause, cfg)) return {std::nullopt, {p.error}};
+      start = end + 1;
+    }
+    line_start = line_end + 1;
   }
-  if (cfg.chains.empty() && cfg.socket.empty()) {
-    p.clause_no = 0;
-    return {std::nullopt, {"l6470emu: config " + std::string(origin) +
+  if (!p.assign_default_gpiochips(cfg)) return {std::nullopt, {p.error}};
+  if (cfg.chains.empty() && cfg.socket.empty())
+    return {std::nullopt, {"l6470emu: config " + shown_text(origin, 200) +
                            ": no chain (write e.g. 'bus=0 cs=0 chips=L6470' or 'socket=PATH')"}};
-  }
   return {std::move(cfg), {}};
 }
 
 ParseResult load_board_config_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return {std::nullopt, {"l6470emu: config file " + path + ": cannot be read"}};
-  std::stringstream s;
-  s << in.rdbuf();
-  return parse_board_config(s.str(), path);
+  const std::string where = "l6470emu: config file " + shown_text(path, 200) + ": ";
+  auto failed = [&](const std::string& what) { return ParseResult{std::nullopt, {where + what}}; };
+  // stat first: opening a device can block or have effects; a FIFO (a shell's <(...)) is fine.
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return failed(std::string("cannot be read (") + std::strerror(errno) + ")");
+  if (S_ISDIR(st.st_mode)) return failed("is a directory (give the board description file)");
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return failed("is a device, not a board description file");
+  if (!S_ISREG(st.st_mode) && !S_ISFIFO(st.st_mode)) return failed("is not a regular file");
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return failed(std::string("cannot be read (") + std::strerror(errno) + ")");
+  std::string text(kMaxBytes + 1, '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int e = errno;
+      ::close(fd);
+      return failed(std::string("cannot be read (") + std::strerror(e) + ")");
+    }
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  if (got > kMaxBytes) return failed("longer than 1 MiB (a board description is a few lines: is this the right file?)");
+  text.resize(got);
+  return parse_board_config(text, path);
 }
 
 std::string describe_board_config(const BoardConfig& config) {
   std::ostringstream o;
   for (const auto& c : config.chains) {
     o << "bus=" << c.bus << " cs=" << c.cs << " path=" << c.path << " chips=";
-    for (std::size_t i = 0; i < c.chips.size(); ++i) o << (i ? "," : "") << c.chips[i]->name;
+    for (std::size_t i = 0; i < c.chips.size();) {
+      std::size_t run = 1;
+      while (i + run < c.chips.size() && c.chips[i + run] == c.chips[i]) ++run;
+      o << (i ? "," : "");
+      if (run > 1) o << run << "x";
+      o << c.chips[i]->name;
+      i += run;
+    }
     o << " gpiochip=" << (c.gpiochip ? std::to_string(*c.gpiochip) : std::string("none")) << " speed=" << c.max_speed_hz
       << " mode=" << unsigned{c.mode} << " bufsiz=" << c.bufsiz << "\n";
   }
-  o << "time=" << (config.time.virtual_time ? "virtual" : "wall") << " scale=" << config.time.scale << "\n";
+  // scale= only means something on the wall clock, idle= only in virtual time.
+  if (config.time.virtual_time) {
+    o << "time=virtual";
+    const TimeConfig defaults;
+    if (config.time.idle_ns == 0)
+      o << " idle=off";
+    else if (config.time.idle_ns != defaults.idle_ns)
+      o << " idle=" << shortest(static_cast<double>(config.time.idle_ns) / 1e9);
+  } else {
+    o << "time=wall scale=" << shortest(config.time.scale);
+  }
+  o << "\n";
+  if (config.log != "stderr") o << "log=" << config.log << "\n";
+  if (!config.socket.empty()) o << "socket=" << config.socket << "\n";
   if (!config.trace.empty()) o << "trace=" << config.trace << "\n";
   return o.str();
 }

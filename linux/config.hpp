@@ -2,6 +2,7 @@
 // the clock and the log, parsed from L6470EMU_CHAIN / a config file. No OS calls here.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -17,7 +18,8 @@ struct TimeConfig {
   bool virtual_time = false;  ///< true: the host program's own time is the board's (preload: time=virtual)
   double scale = 1.0;         ///< wall mode: virtual seconds per wall second (> 0)
   /// Virtual mode: real time after which, with some thread neither waiting nor entering or
-  /// leaving a covered call, virtual time moves on anyway (logged once). 0 = never (idle=off).
+  /// leaving a covered call, virtual time moves on anyway (logged once). 0 = never (idle=off);
+  /// the parser accepts 0.001 s to 3600 s.
   std::int64_t idle_ns = 1'000'000'000;
 };
 
@@ -47,22 +49,42 @@ struct ConfigError {
   std::string message;
 };
 
-/// Parses a board description. Clauses are separated by newlines or ';', words by blanks,
-/// '#' starts a comment. A clause with chips= is a chain:
-///   bus=0 cs=0 chips=L6470,2xL6480 [path=/dev/spidev0.0] [gpiochip=N|none] [speed=HZ] [mode=0..3] [bufsiz=N]
-/// other clauses set globals: time=wall|virtual, scale=F, log=stderr|off|FILE, socket=PATH, trace=FILE.
-/// `origin` names the source in error messages ("L6470EMU_CHAIN", a file name).
-/// Returns the config, or the first error.
+/// Parses a board description. Lines end at newlines, '#' starts a comment that runs to the end
+/// of the line, ';' separates clauses within a line, words are separated by blanks. Each word is
+/// key=value, each key at most once per clause. A clause with chips= is a chain:
+///   chips=L6470,2xL6480 [bus=0..32767] [cs=0..255] [path=/dev/NAME] [gpiochip=0..1023|none]
+///   [speed=HZ] [mode=0..3] [bufsiz=N]
+/// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
+/// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual
+/// time), log=stderr|off|FILE, socket=PATH, trace=FILE. Every value is checked against its
+/// range; docs/linux.md has the table. `origin` names the source in error messages
+/// ("L6470EMU_CHAIN", a file name). Returns the config, or the first error, on one line:
+/// "l6470emu: config ORIGIN, clause N: what", user text quoted by quoted_text.
 struct ParseResult {
   std::optional<BoardConfig> config;
   ConfigError error;
 };
 ParseResult parse_board_config(std::string_view text, std::string_view origin);
 
-/// Reads the file and parses it; I/O errors are reported as ConfigErrors.
+/// The longest board description read or parsed (bytes); a longer one is an error.
+inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
+
+/// Reads the file (at most kMaxConfigBytes + 1 bytes: /dev/zero or an endless FIFO fails fast)
+/// and parses it. A directory, a device or an unreadable file is a ConfigError saying so.
 ParseResult load_board_config_file(const std::string& path);
 
-/// The config text of a board, as parse_board_config reads it (for `serve` to print).
+/// How many bytes of a user's text an error message shows.
+inline constexpr std::size_t kQuotedTextBytes = 60;
+
+/// User text made safe for a one-line message: at most `max_bytes` bytes of it, control
+/// characters, backslash and non-ASCII bytes as \xNN, and "…" when cut.
+std::string shown_text(std::string_view text, std::size_t max_bytes = kQuotedTextBytes);
+
+/// shown_text in single quotes, followed by " (N bytes)" when cut.
+std::string quoted_text(std::string_view text);
+
+/// The config text of a board, as parse_board_config reads it back (for `serve` to print):
+/// scale= in wall time, idle= in virtual time when not the default 1 s, log/socket/trace when set.
 std::string describe_board_config(const BoardConfig& config);
 
 /// The variant called `name` (case-insensitive), or nullptr.

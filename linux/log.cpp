@@ -1,4 +1,5 @@
-// Diagnostic log over raw system calls.
+// Diagnostic log over raw system calls; a log file that cannot be opened is reported once on
+// stderr and stderr is used instead.
 #include "linux/log.hpp"
 
 #include <fcntl.h>
@@ -6,6 +7,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
+#include <set>
+
+#include "linux/config.hpp"
 
 namespace l6470emu {
 
@@ -23,6 +28,25 @@ bool raw_write_all(int fd, const void* data, std::size_t size) {
   return true;
 }
 
+namespace {
+
+// Says once per process and file, on stderr, that a log file could not be opened: several
+// DiagnosticLogs of one process (the preload's own, its backend's) may name the same file.
+void report_unopenable(const std::string& where, int error) {
+  static std::mutex m;
+  static std::set<std::string>* reported = new std::set<std::string>();  // never freed: used until exit
+  {
+    std::lock_guard lock(m);
+    if (!reported->insert(where).second) return;
+  }
+  const std::string why = error == ENXIO ? "a FIFO that nobody reads" : std::strerror(error);
+  const std::string text = "l6470emu: log file " + quoted_text(where) + " cannot be opened (" + why +
+                           "): diagnostics go to stderr\n";
+  raw_write_all(2, text.data(), text.size());
+}
+
+}  // namespace
+
 DiagnosticLog::DiagnosticLog(const std::string& where) {
   if (where == "off" || where.empty()) return;
   if (where == "stderr") {
@@ -30,10 +54,22 @@ DiagnosticLog::DiagnosticLog(const std::string& where) {
     return;
   }
   const int saved = errno;
-  fd_ = static_cast<int>(syscall(SYS_openat, AT_FDCWD, where.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644));
+  // O_NONBLOCK: a FIFO without a reader fails (ENXIO) instead of blocking the host program in
+  // its start-up; cleared again once open. O_NOCTTY: a terminal named here is written to, not
+  // made the process's controlling terminal.
+  const int fd = static_cast<int>(syscall(SYS_openat, AT_FDCWD, where.c_str(),
+                                          O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | O_NOCTTY | O_NONBLOCK, 0644));
+  if (fd >= 0) {
+    const long flags = syscall(SYS_fcntl, fd, F_GETFL);
+    if (flags >= 0) syscall(SYS_fcntl, fd, F_SETFL, flags & ~static_cast<long>(O_NONBLOCK));
+    fd_ = fd;
+    owned_ = true;
+  } else {
+    open_error_ = errno;
+    fd_ = 2;  // fall back to stderr rather than lose diagnostics, and say so once
+    report_unopenable(where, open_error_);
+  }
   errno = saved;
-  owned_ = fd_ >= 0;
-  if (fd_ < 0) fd_ = 2;  // fall back to stderr rather than lose diagnostics
 }
 
 DiagnosticLog::~DiagnosticLog() {

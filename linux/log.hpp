@@ -8,7 +8,8 @@
 
 namespace l6470emu {
 
-/// A line-oriented diagnostic log ("stderr", "off" or a file path, appended to).
+/// A line-oriented diagnostic log ("stderr", "off" or a file path, appended to and created
+/// if missing).
 class DiagnosticLog {
  public:
   explicit DiagnosticLog(const std::string& where = "stderr");
@@ -19,10 +20,15 @@ class DiagnosticLog {
   /// Writes "l6470emu: <text>\n" (nothing when off).
   void line(std::string_view text);
   bool enabled() const { return fd_ >= 0; }
+  /// The errno of opening the log file, 0 if it opened (or none was named). When it failed,
+  /// one line said so on stderr at construction (once per file and process) and lines go to
+  /// stderr instead: a host program is never stopped by its log.
+  int open_error() const { return open_error_; }
 
  private:
   int fd_ = -1;
   bool owned_ = false;
+  int open_error_ = 0;
   std::mutex m_;
 };
 
