@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "run_program.hpp"
 
@@ -97,15 +100,37 @@ TEST_F(InProcess, WithoutAConfigTheLibraryStaysOutOfTheWay) {
 }
 
 TEST_F(InProcess, AMalformedConfigGivesOneClearErrorLineAndANonZeroExit) {
-  for (const std::string chain : {"bus=0 cs=0 chips=L6471", "bus=x chips=L6470", "chips=L6470 colour=blue", "time=sometimes"}) {
+  for (const std::string& chain : std::vector<std::string>{
+           "bus=0 cs=0 chips=L6471", "bus=x chips=L6470", "chips=L6470 colour=blue", "time=sometimes",
+           "bus=0 bus=1 chips=L6470", "chips=257xL6470", "chips=0xL6470", "chips=L6470 path=/dev/null",
+           "chips=L6470 scale=1e-300", "chips=L6470 time=virtual idle=0", "bus= chips=L6470",
+           "chips=L6470 log=a\x01" "b", "chips=" + std::string(100'000, 'z')}) {
     const RunResult r = run_program({"/bin/true"}, {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", chain}});
     EXPECT_EQ(r.status, 2) << chain;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_EQ(r.err.rfind("l6470emu: config L6470EMU_CHAIN, clause 1: ", 0), 0u) << r.err;
+    EXPECT_LT(r.err.size(), 300u) << r.err;
   }
-  const RunResult r = run_program({"/bin/true"}, {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CONFIG", "/nonexistent.conf"}});
-  EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(r.err, "l6470emu: config file /nonexistent.conf: cannot be read\n");
+  for (const auto& [file, error] : std::vector<std::pair<std::string, std::string>>{
+           {"/nonexistent.conf", "cannot be read (No such file or directory)"},
+           {"/tmp", "is a directory (give the board description file)"},
+           {"/dev/zero", "is a device, not a board description file"}}) {
+    const RunResult r = run_program({"/bin/true"}, {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CONFIG", file}});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "l6470emu: config file " + file + ": " + error + "\n");
+  }
+}
+
+TEST_F(InProcess, ALogFileThatCannotBeOpenedIsReportedOnceAndTheProgramRuns) {
+  const RunResult r = run_program({system_python(), "-c",
+                                   "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
+                                   "print([hex(s.xfer2([b])[0]) for b in (0xD0, 0, 0)])\n"},
+                                  env("bus=0 cs=0 chips=L6470 log=/nonexistent-dir/emu.log"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(has_line(r.out, "['0x0', '0x7c', '0x3']")) << r.out;
+  EXPECT_EQ(r.err,
+            "l6470emu: log file '/nonexistent-dir/emu.log' cannot be opened (No such file or directory): diagnostics go "
+            "to stderr\n");
 }
 
 TEST_F(InProcess, GpiodToolsSeeTheChipAndItsNamedLines) {
