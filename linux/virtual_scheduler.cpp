@@ -1,0 +1,350 @@
+// Virtual host time's scheduler: thread accounting, waits blocked on a per-thread eventfd, and
+// the jump of virtual time when every thread waits. No libc function is replaced here.
+#include "linux/virtual_scheduler.hpp"
+
+#include <errno.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <string>
+
+#include "linux/clock.hpp"
+
+namespace l6470emu {
+namespace {
+
+// At most this many jumps that wake nobody (edges or timers no waiter sees) in one decision.
+constexpr int kMaxEmptyJumps = 100'000;
+// A thread whose wake-up eventfd could not be made looks at its state this often instead.
+constexpr std::int64_t kFallbackPollNs = 1'000'000;
+
+// Whether this thread holds the scheduler's lock (a semaphore post from a signal handler
+// interrupting the scheduler must not take it again).
+thread_local bool t_holds_lock = false;
+
+// The calling thread's wake-up descriptor: the scheduler writes it to end the thread's wait.
+struct ThreadWakeFd {
+  int fd = -1;
+  ~ThreadWakeFd() {
+    if (fd >= 0) ::close(fd);
+  }
+  int get() {
+    if (fd < 0) fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+    return fd;
+  }
+  void renew() {
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+    get();
+  }
+  void drain() const {
+    std::uint64_t v;
+    if (fd >= 0) [[maybe_unused]] const ssize_t n = ::read(fd, &v, sizeof v);
+  }
+};
+thread_local ThreadWakeFd t_wake;
+
+class Locked {
+ public:
+  explicit Locked(std::mutex& m) : lock_(m) { t_holds_lock = true; }
+  ~Locked() { t_holds_lock = false; }
+
+ private:
+  std::unique_lock<std::mutex> lock_;
+};
+
+timespec to_timespec(std::int64_t ns) {
+  return {static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+}
+
+}  // namespace
+
+struct VirtualScheduler::Waiter {
+  const Wait* w = nullptr;
+  int fd = -1;  // the waiting thread's wake-up eventfd
+  std::uint64_t seq = 0;
+  std::atomic<bool> done{false};
+  End end = End::timed_out;
+};
+
+VirtualScheduler::VirtualScheduler(Hooks hooks, std::int64_t idle_ns, int threads)
+    : hooks_(std::move(hooks)), idle_ns_(idle_ns > 0 ? idle_ns : 0), running_(threads) {
+  touch();
+}
+
+VirtualScheduler::~VirtualScheduler() = default;
+
+std::int64_t VirtualScheduler::real_now() const { return hooks_.real_ns ? hooks_.real_ns() : monotonic_ns(); }
+
+void VirtualScheduler::touch() { last_activity_ns_.store(real_now(), std::memory_order_release); }
+
+VirtualScheduler::End VirtualScheduler::wait(const Wait& w) {
+  Waiter me;
+  me.w = &w;
+  me.fd = t_wake.get();
+  {
+    Locked lock(m_);
+    if (w.try_now && w.try_now()) return End::ready;
+    if (w.deadline <= hooks_.now()) return End::timed_out;
+    me.seq = next_seq_++;
+    waiters_.push_back(&me);
+    --running_;
+    touch();
+    decide_locked(false);
+  }
+  if (w.after_register && !w.after_register()) {
+    Locked lock(m_);
+    if (!me.done.load(std::memory_order_acquire)) end_locked(me, End::aborted);
+  }
+  return block(me);
+}
+
+VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
+  const Wait& w = *me.w;
+  std::vector<pollfd> pf;
+  pf.reserve(w.fds.size() + 1);
+  for (const pollfd& p : w.fds) pf.push_back({p.fd, p.events, 0});
+  pf.push_back({me.fd, POLLIN, 0});
+  const std::size_t own = pf.size() - 1;
+  while (!me.done.load(std::memory_order_acquire)) {
+    std::int64_t timeout_ns = -1;
+    auto at_most = [&](std::int64_t ns) { timeout_ns = timeout_ns < 0 ? ns : std::min(timeout_ns, ns); };
+    if (idle_ns_ > 0)
+      at_most(std::max<std::int64_t>(kFallbackPollNs,
+                                     last_activity_ns_.load(std::memory_order_acquire) + idle_ns_ - real_now()));
+    if (w.ready && w.recheck_ns > 0) at_most(w.recheck_ns);
+    if (me.fd < 0) at_most(kFallbackPollNs);
+    const timespec ts = to_timespec(timeout_ns < 0 ? 0 : timeout_ns);
+    for (pollfd& p : pf) p.revents = 0;
+    const int n = ::ppoll(pf.data(), pf.size(), timeout_ns < 0 ? nullptr : &ts, w.sigmask);
+    const int err = errno;
+    Locked lock(m_);
+    if (me.done.load(std::memory_order_acquire)) break;
+    if (n < 0) {
+      if (err == EINTR && w.interruptible) end_locked(me, End::interrupted);
+      continue;
+    }
+    if (n > 0) {
+      if (pf[own].revents & POLLNVAL) {  // the program closed our descriptor: make another
+        t_wake.fd = -1;
+        me.fd = pf[own].fd = t_wake.get();
+      } else if (pf[own].revents & POLLIN) {
+        t_wake.drain();
+      }
+      for (std::size_t i = 0; i < own; ++i)
+        if (pf[i].revents) {
+          end_locked(me, End::ready);
+          break;
+        }
+      continue;
+    }
+    // A real timeout: the periodic check, and the idle grace.
+    if (w.ready && w.ready()) {
+      end_locked(me, End::ready);
+      continue;
+    }
+    if (idle_ns_ > 0 && running_ > 0 &&
+        real_now() - last_activity_ns_.load(std::memory_order_acquire) >= idle_ns_) {
+      if (!idle_logged_.exchange(true) && hooks_.log)
+        hooks_.log("virtual time: no covered wait was entered or left for " + std::to_string(idle_ns_ / 1'000'000) +
+                   " ms while " + std::to_string(running_) +
+                   " thread(s) ran outside one (blocked in a call the preload does not cover, or computing); "
+                   "time moved on to the next wake-up anyway, so this run may not repeat exactly (idle= sets the grace)");
+      touch();
+      decide_locked(true);
+    }
+  }
+  {
+    Locked lock(m_);
+    remove_locked(me);
+    touch();
+  }
+  t_wake.drain();
+  return me.end;
+}
+
+void VirtualScheduler::wait_in(const void* object, const std::function<void()>& block_fn) {
+  Wait w;
+  w.object = object;
+  w.interruptible = false;
+  Waiter me;
+  me.w = &w;
+  me.fd = t_wake.get();
+  {
+    Locked lock(m_);
+    me.seq = next_seq_++;
+    waiters_.push_back(&me);
+    --running_;
+    touch();
+    decide_locked(false);
+  }
+  block_fn();
+  {
+    Locked lock(m_);
+    if (!me.done.load(std::memory_order_acquire)) {
+      me.done.store(true, std::memory_order_release);
+      ++running_;
+    }
+    remove_locked(me);
+    touch();
+  }
+  t_wake.drain();
+}
+
+void VirtualScheduler::end_locked(Waiter& w, End how) {
+  w.end = how;
+  w.done.store(true, std::memory_order_release);
+  ++running_;
+  if (w.fd >= 0) {
+    const std::uint64_t one = 1;
+    [[maybe_unused]] const ssize_t n = ::write(w.fd, &one, sizeof one);
+  }
+}
+
+void VirtualScheduler::remove_locked(Waiter& w) {
+  const auto it = std::find(waiters_.begin(), waiters_.end(), &w);
+  if (it != waiters_.end()) waiters_.erase(it);
+}
+
+bool VirtualScheduler::wake_ready_locked() {
+  bool woke = false;
+  std::vector<pollfd> pf;
+  for (Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed)) continue;
+    if (!w->w->fds.empty()) {
+      // A copy: the waiting thread may be inside ppoll on its own array right now.
+      pf.clear();
+      for (const pollfd& p : w->w->fds) pf.push_back({p.fd, p.events, 0});
+      if (::poll(pf.data(), pf.size(), 0) > 0) {
+        end_locked(*w, End::ready);
+        woke = true;
+        continue;
+      }
+    }
+    if (w->w->ready && w->w->ready()) {
+      end_locked(*w, End::ready);
+      woke = true;
+    }
+  }
+  return woke;
+}
+
+void VirtualScheduler::decide_locked(bool forced) {
+  for (int empty = 0; empty < kMaxEmptyJumps; ++empty) {
+    if (waiters_.empty()) return;
+    if (running_ > 0 && !forced) return;
+    // An in-process hand-off (a descriptor another thread made ready, a semaphore) goes first:
+    // that thread runs on at the current time.
+    if (wake_ready_locked()) return;
+    Tick d = kNever;
+    bool board = false;
+    for (Waiter* w : waiters_) {
+      if (w->done.load(std::memory_order_relaxed)) continue;
+      d = std::min(d, w->w->deadline);
+      board = board || w->w->watches_board;
+    }
+    if (board && hooks_.next_edge) d = std::min(d, hooks_.next_edge());
+    for (const auto& [id, tick] : timers_) d = std::min(d, tick);
+    if (d == kNever) return;  // every thread waits for something outside the process
+    d = std::max(d, hooks_.now());
+    hooks_.advance_to(d);
+    for (auto it = timers_.begin(); it != timers_.end();) {
+      if (it->second > d) {
+        ++it;
+        continue;
+      }
+      const int id = it->first;
+      it = timers_.erase(it);
+      if (hooks_.fire_timer) hooks_.fire_timer(id);
+    }
+    bool woke = false;
+    for (Waiter* w : waiters_)
+      if (!w->done.load(std::memory_order_relaxed) && w->w->deadline <= d) {
+        end_locked(*w, End::timed_out);
+        woke = true;
+      }
+    if (wake_ready_locked()) woke = true;
+    if (woke) return;
+  }
+}
+
+int VirtualScheduler::notify(const void* object, bool all) {
+  if (t_holds_lock) return 0;
+  Locked lock(m_);
+  int n = 0;
+  for (Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed) || w->w->object != object) continue;
+    end_locked(*w, End::notified);
+    ++n;
+    if (!all) break;
+  }
+  return n;
+}
+
+bool VirtualScheduler::grant(const void* object) { return notify(object, false) > 0; }
+
+void VirtualScheduler::thread_started() {
+  Locked lock(m_);
+  ++running_;
+  touch();
+}
+
+void VirtualScheduler::thread_not_started() {
+  Locked lock(m_);
+  --running_;
+  touch();
+  decide_locked(false);
+}
+
+void VirtualScheduler::thread_exited(const void* joined) {
+  Locked lock(m_);
+  --running_;
+  touch();
+  if (joined)
+    for (Waiter* w : waiters_)
+      if (!w->done.load(std::memory_order_relaxed) && w->w->object == joined) end_locked(*w, End::notified);
+  decide_locked(false);
+}
+
+void VirtualScheduler::set_timer(int id, Tick tick) {
+  Locked lock(m_);
+  if (tick == kNever)
+    timers_.erase(id);
+  else
+    timers_[id] = tick;
+}
+
+int VirtualScheduler::running() const {
+  Locked lock(m_);
+  return running_;
+}
+
+int VirtualScheduler::waiting() const {
+  Locked lock(m_);
+  return static_cast<int>(std::count_if(waiters_.begin(), waiters_.end(),
+                                        [](Waiter* w) { return !w->done.load(std::memory_order_relaxed); }));
+}
+
+void VirtualScheduler::before_fork() {
+  m_.lock();
+  t_holds_lock = true;
+}
+
+void VirtualScheduler::after_fork_parent() {
+  t_holds_lock = false;
+  m_.unlock();
+}
+
+void VirtualScheduler::after_fork_child() {
+  // The other threads (and their waits) did not survive the fork; the eventfd is shared with
+  // the parent's thread, so this thread gets its own.
+  waiters_.clear();
+  running_ = 1;
+  t_wake.renew();
+  t_holds_lock = false;
+  m_.unlock();
+  touch();
+}
+
+}  // namespace l6470emu

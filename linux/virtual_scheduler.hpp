@@ -1,0 +1,143 @@
+// The scheduler of virtual host time (time=virtual): which threads of a program are blocked in a
+// covered wait and, when every one is, the jump of virtual time to the earliest wake-up (the rule
+// of Go's testing/synctest). It blocks and wakes threads itself (one eventfd per thread, ppoll);
+// it interposes nothing: the preload library's intercept_* files turn libc calls into its waits.
+#pragma once
+
+#include <poll.h>
+#include <signal.h>
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "core/tick.hpp"
+
+namespace l6470emu {
+
+/// Virtual time for the threads of one process.
+///
+/// Every thread of the program is either *running* or *waiting* in a covered wait. Virtual time
+/// moves only when every thread waits: then it jumps to the earliest wake-up (a waiter's deadline,
+/// an armed timer, or, when a waiter watches the board's lines, the board's next edge), the board
+/// is brought there (edges delivered), and exactly the waiters due are woken. A woken thread counts
+/// as running from the moment of that decision, not from when it gets a CPU, so the outcome does
+/// not depend on the host's scheduler. In-process hand-offs (notify() for condition variables and
+/// joins, grant() for semaphores, descriptors made ready by another thread, checked with a
+/// zero-timeout poll before any jump) end waits without moving time.
+///
+/// A thread that is neither running covered code nor waiting (blocked in a call the preload does
+/// not see) stalls time; after `idle_ns` of real time without any wait entered or left, time moves
+/// on anyway to the earliest wake-up, and that is logged once (the run may not repeat exactly).
+class VirtualScheduler {
+ public:
+  /// What the scheduler drives and reads. `now` and `advance_to` are required.
+  struct Hooks {
+    std::function<Tick()> now;               ///< the board's tick
+    std::function<void(Tick)> advance_to;    ///< moves the board to a tick (edges delivered)
+    std::function<Tick()> next_edge;         ///< the board's next edge on a watched line (kNever: none)
+    std::function<void(int)> fire_timer;     ///< a timer set with set_timer() expired
+    std::function<std::int64_t()> real_ns;   ///< the real monotonic clock, ns (idle grace)
+    std::function<void(std::string_view)> log;  ///< diagnostics (the idle-grace line)
+  };
+
+  /// How a wait ends.
+  enum class End : std::uint8_t {
+    timed_out,    ///< virtual time reached the deadline
+    ready,        ///< a descriptor became ready, or try_now / ready succeeded
+    notified,     ///< notify() or grant() on the wait's object
+    interrupted,  ///< a signal handler ran (interruptible waits only)
+    aborted,      ///< after_register returned false
+  };
+
+  /// One covered wait, described by the caller (the preload's interposers, or a test).
+  struct Wait {
+    Tick deadline = kNever;                 ///< virtual tick at which the wait times out
+    std::span<const pollfd> fds;            ///< real descriptors whose readiness ends the wait
+    bool watches_board = false;             ///< fds include lines with edge events: the next edge is a wake-up
+    const void* object = nullptr;           ///< notify(object) / grant(object) ends the wait
+    const sigset_t* sigmask = nullptr;      ///< signal mask while blocked (ppoll, pselect, epoll_pwait)
+    bool interruptible = true;              ///< a signal handler ends the wait (else it goes on)
+    /// Checked under the scheduler's lock before registering: true ends the wait at once (ready).
+    std::function<bool()> try_now;
+    /// Called outside the lock once the wait is registered (a condition variable releases its
+    /// mutex here, so a notify after it cannot be lost). false aborts the wait.
+    std::function<bool()> after_register;
+    /// In-process readiness besides `fds` (e.g. a semaphore taken for the waiter): checked before
+    /// every jump and every `recheck_ns` of real time; true ends the wait (ready).
+    std::function<bool()> ready;
+    std::int64_t recheck_ns = 0;            ///< real period of the `ready` check (0: only before jumps)
+  };
+
+  /// `threads` threads exist already and count as running. `idle_ns` is the grace (0: none).
+  VirtualScheduler(Hooks hooks, std::int64_t idle_ns, int threads);
+  ~VirtualScheduler();
+  VirtualScheduler(const VirtualScheduler&) = delete;
+  VirtualScheduler& operator=(const VirtualScheduler&) = delete;
+
+  /// Blocks the calling thread in `w` until it ends; may move time (when this thread was the last
+  /// one running). Returns at once (timed_out) when the deadline is not in the future.
+  End wait(const Wait& w);
+  /// Counts the calling thread as waiting for `object` while `block` runs (a real blocking call
+  /// that returns by itself, such as pthread_join); notify(object) marks it running again.
+  void wait_in(const void* object, const std::function<void()>& block);
+
+  /// Ends the wait of the first waiter on `object` (all of them with `all`), in registration
+  /// order, as notified. Returns how many were woken.
+  int notify(const void* object, bool all);
+  /// Hands one unit of `object` (a semaphore post) to its first waiter. False: nobody waits on
+  /// it (or this thread already holds the scheduler's lock: a post from a signal handler), and the
+  /// caller posts for real.
+  bool grant(const void* object);
+
+  /// A thread is about to be created (it counts as running from now on).
+  void thread_started();
+  /// The calling thread ends; waiters in wait_in(`joined`) are notified (nullptr: none).
+  void thread_exited(const void* joined);
+  /// A thread creation failed after thread_started().
+  void thread_not_started();
+
+  /// Arms timer `id` to fire at `tick` (kNever: disarms). A fired timer is disarmed.
+  void set_timer(int id, Tick tick);
+
+  /// Threads counted as running (for tests and diagnostics).
+  int running() const;
+  /// Threads in a wait now.
+  int waiting() const;
+  /// Whether the idle grace has moved time on at least once.
+  bool idle_grace_used() const { return idle_logged_.load(std::memory_order_acquire); }
+
+  /// fork() in a threaded program: hold the lock across it (prepare / parent), and in the child,
+  /// which has one thread, forget the parent's waiters and give the thread its own wake-up fd.
+  void before_fork();
+  void after_fork_parent();
+  void after_fork_child();
+
+ private:
+  struct Waiter;
+
+  End block(Waiter& me);
+  void decide_locked(bool forced);
+  bool wake_ready_locked();
+  void end_locked(Waiter& w, End how);
+  void remove_locked(Waiter& w);
+  void touch();
+  std::int64_t real_now() const;
+
+  Hooks hooks_;
+  std::int64_t idle_ns_;
+  mutable std::mutex m_;
+  int running_;
+  std::vector<Waiter*> waiters_;          // registration order
+  std::map<int, Tick> timers_;            // armed timers: id -> tick
+  std::uint64_t next_seq_ = 0;
+  std::atomic<std::int64_t> last_activity_ns_{0};
+  std::atomic<bool> idle_logged_{false};
+};
+
+}  // namespace l6470emu

@@ -1,0 +1,330 @@
+// VirtualScheduler with real std::threads and a plain tick counter for the board: the order and
+// virtual times of wake-ups are exact however the host schedules the threads; only the idle-grace
+// test uses real time (a tiny injected grace).
+#include "linux/virtual_scheduler.hpp"
+
+#include <gtest/gtest.h>
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace l6470emu::test {
+namespace {
+
+using End = VirtualScheduler::End;
+
+/// A board stand-in: a tick, the jumps made to it, and an optional edge at a fixed tick that
+/// makes a pipe readable when time reaches it.
+struct FakeBoard {
+  std::atomic<Tick> now{0};
+  std::vector<Tick> jumps;
+  Tick edge = kNever;
+  int edge_pipe = -1;
+  std::vector<std::pair<int, Tick>> fired;
+  std::vector<std::string> log;
+
+  VirtualScheduler::Hooks hooks() {
+    VirtualScheduler::Hooks h;
+    h.now = [this] { return now.load(); };
+    h.advance_to = [this](Tick t) {
+      if (t > now) now = t;
+      jumps.push_back(t);
+      if (edge != kNever && now >= edge) {
+        edge = kNever;
+        [[maybe_unused]] const ssize_t n = ::write(edge_pipe, "e", 1);
+      }
+    };
+    h.next_edge = [this] { return edge; };
+    h.fire_timer = [this](int id) { fired.emplace_back(id, now.load()); };
+    h.log = [this](std::string_view s) { log.emplace_back(s); };
+    return h;
+  }
+};
+
+/// What threads saw, in the order they saw it (one mutex: appends from several threads).
+struct Journal {
+  std::mutex m;
+  std::vector<std::string> lines;
+  void add(const std::string& s) {
+    std::lock_guard lock(m);
+    lines.push_back(s);
+  }
+};
+
+/// A thread known to the scheduler: counted from before its creation, joined through wait_in.
+class Worker {
+ public:
+  template <typename F>
+  Worker(VirtualScheduler& s, F body) : s_(s) {
+    s_.thread_started();
+    t_ = std::thread([this, body] {
+      body();
+      s_.thread_exited(this);
+    });
+  }
+  void join() {
+    s_.wait_in(this, [this] { t_.join(); });
+  }
+  ~Worker() {
+    if (t_.joinable()) t_.join();
+  }
+  pthread_t handle() { return t_.native_handle(); }
+
+ private:
+  VirtualScheduler& s_;
+  std::thread t_;
+};
+
+End sleep_until(VirtualScheduler& s, Tick deadline) {
+  VirtualScheduler::Wait w;
+  w.deadline = deadline;
+  return s.wait(w);
+}
+
+void wait_until_waiting(VirtualScheduler& s, int n) {
+  while (s.waiting() < n) std::this_thread::sleep_for(std::chrono::microseconds(100));
+}
+
+TEST(VirtualScheduler, TwoSleepersWakeInDeadlineOrderAtTheirExactVirtualTimes) {
+  for (int round = 0; round < 20; ++round) {
+    FakeBoard board;
+    VirtualScheduler s(board.hooks(), 0, 1);
+    Journal j;
+    Worker late(s, [&] {
+      EXPECT_EQ(sleep_until(s, 3000), End::timed_out);
+      j.add("late@" + std::to_string(board.now.load()));
+    });
+    Worker early(s, [&] {
+      EXPECT_EQ(sleep_until(s, 1000), End::timed_out);
+      j.add("early@" + std::to_string(board.now.load()));
+    });
+    late.join();
+    early.join();
+    EXPECT_EQ(j.lines, (std::vector<std::string>{"early@1000", "late@3000"}));
+    EXPECT_EQ(board.jumps, (std::vector<Tick>{1000, 3000}));
+    EXPECT_EQ(s.running(), 1);
+  }
+}
+
+TEST(VirtualScheduler, ASingleThreadSleepingJumpsStraightToItsDeadline) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  EXPECT_EQ(sleep_until(s, 4'000'000), End::timed_out);
+  EXPECT_EQ(board.now.load(), 4'000'000u);
+  EXPECT_EQ(sleep_until(s, 10), End::timed_out);  // already past: no wait, no jump
+  EXPECT_EQ(board.jumps, (std::vector<Tick>{4'000'000}));
+}
+
+TEST(VirtualScheduler, JoiningASleeperCountsAsWaitingSoTheSleepEnds) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  Tick woke = 0;
+  Worker sleeper(s, [&] {
+    sleep_until(s, 5000);
+    woke = board.now.load();
+  });
+  sleeper.join();
+  EXPECT_EQ(woke, 5000u);
+  EXPECT_EQ(board.now.load(), 5000u);
+}
+
+TEST(VirtualScheduler, ANotifiedWaiterRunsOnAtTheNotifiersTimeNotAtItsTimeout) {
+  for (int round = 0; round < 20; ++round) {
+    FakeBoard board;
+    VirtualScheduler s(board.hooks(), 0, 1);
+    int cond = 0;  // stands for a condition variable's address
+    End end = End::aborted;
+    Tick woke = 0;
+    Worker waiter(s, [&] {
+      VirtualScheduler::Wait w;
+      w.deadline = 10'000;
+      w.object = &cond;
+      end = s.wait(w);
+      woke = board.now.load();
+    });
+    wait_until_waiting(s, 1);
+    sleep_until(s, 100);  // the waiter's timeout is later: time jumps to 100 only
+    EXPECT_EQ(s.notify(&cond, false), 1);
+    waiter.join();
+    EXPECT_EQ(end, End::notified);
+    EXPECT_EQ(woke, 100u);
+    EXPECT_EQ(board.jumps, (std::vector<Tick>{100}));
+  }
+}
+
+TEST(VirtualScheduler, APostIsGrantedToTheFirstWaiterInRegistrationOrder) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  int sem = 0;
+  Journal j;
+  auto waiter = [&](const std::string& name) {
+    return [&, name] {
+      VirtualScheduler::Wait w;
+      w.object = &sem;
+      if (s.wait(w) == End::notified) j.add(name);
+    };
+  };
+  Worker first(s, waiter("first"));
+  wait_until_waiting(s, 1);
+  Worker second(s, waiter("second"));
+  wait_until_waiting(s, 2);
+  EXPECT_TRUE(s.grant(&sem));
+  first.join();
+  EXPECT_TRUE(s.grant(&sem));
+  second.join();
+  EXPECT_FALSE(s.grant(&sem));  // nobody waits: the caller posts for real
+  EXPECT_EQ(j.lines, (std::vector<std::string>{"first", "second"}));
+  EXPECT_TRUE(board.jumps.empty());
+}
+
+TEST(VirtualScheduler, ADescriptorMadeReadyByAnotherThreadEndsTheWaitBeforeAnyJump) {
+  for (int round = 0; round < 20; ++round) {
+    FakeBoard board;
+    VirtualScheduler s(board.hooks(), 0, 1);
+    int p[2];
+    ASSERT_EQ(pipe(p), 0);
+    End end = End::aborted;
+    Tick woke = 0;
+    Worker reader(s, [&] {
+      const pollfd fd{p[0], POLLIN, 0};
+      VirtualScheduler::Wait w;
+      w.deadline = 1'000'000;
+      w.fds = std::span<const pollfd>(&fd, 1);
+      end = s.wait(w);
+      woke = board.now.load();
+    });
+    wait_until_waiting(s, 1);
+    ASSERT_EQ(::write(p[1], "x", 1), 1);
+    // The reader may not have been scheduled yet; the check before the jump finds it ready.
+    sleep_until(s, 10);
+    reader.join();
+    EXPECT_EQ(end, End::ready);
+    EXPECT_EQ(woke, 0u);
+    EXPECT_EQ(board.jumps, (std::vector<Tick>{10}));
+    ::close(p[0]);
+    ::close(p[1]);
+  }
+}
+
+TEST(VirtualScheduler, AWaiterWatchingTheBoardWakesAtTheEdgeTick) {
+  FakeBoard board;
+  int p[2];
+  ASSERT_EQ(pipe(p), 0);
+  board.edge = 250;
+  board.edge_pipe = p[1];
+  VirtualScheduler s(board.hooks(), 0, 1);
+  const pollfd fd{p[0], POLLIN, 0};
+  VirtualScheduler::Wait w;
+  w.deadline = 4000;
+  w.fds = std::span<const pollfd>(&fd, 1);
+  w.watches_board = true;
+  EXPECT_EQ(s.wait(w), End::ready);
+  EXPECT_EQ(board.now.load(), 250u);
+  ::close(p[0]);
+  ::close(p[1]);
+}
+
+TEST(VirtualScheduler, AnArmedTimerFiresAtItsTickOnTheWayToALaterDeadline) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  s.set_timer(7, 400);
+  s.set_timer(8, 600);
+  s.set_timer(8, kNever);  // disarmed
+  EXPECT_EQ(sleep_until(s, 1000), End::timed_out);
+  EXPECT_EQ(board.fired, (std::vector<std::pair<int, Tick>>{{7, 400}}));
+  EXPECT_EQ(board.jumps, (std::vector<Tick>{400, 1000}));
+}
+
+TEST(VirtualScheduler, ATryThatSucceedsEndsTheWaitWithoutRegistering) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  VirtualScheduler::Wait w;
+  w.deadline = 100;
+  w.try_now = [] { return true; };
+  EXPECT_EQ(s.wait(w), End::ready);
+  EXPECT_TRUE(board.jumps.empty());
+}
+
+TEST(VirtualScheduler, WithAThreadOutsideAnyWaitTimeMovesOnlyAfterTheIdleGraceAndSaysSoOnce) {
+  FakeBoard board;
+  // Two threads: this one, and one that never waits (blocked in something uncovered).
+  VirtualScheduler s(board.hooks(), 20'000'000, 2);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(sleep_until(s, 500), End::timed_out);
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(20));
+  EXPECT_EQ(board.now.load(), 500u);  // still exactly the deadline
+  EXPECT_EQ(sleep_until(s, 900), End::timed_out);
+  EXPECT_EQ(board.now.load(), 900u);
+  ASSERT_EQ(board.log.size(), 1u);
+  EXPECT_NE(board.log[0].find("may not repeat exactly"), std::string::npos) << board.log[0];
+  EXPECT_TRUE(s.idle_grace_used());
+}
+
+void on_signal(int) {}
+
+TEST(VirtualScheduler, ASignalHandlerInterruptsAnInterruptibleWait) {
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;  // no SA_RESTART: like the kernel, the wait ends with EINTR
+  struct sigaction old {};
+  ASSERT_EQ(sigaction(SIGUSR1, &sa, &old), 0);
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 2);  // the second thread stands for one that never waits
+  std::atomic<bool> done{false};
+  End end = End::aborted;
+  Worker sleeper(s, [&] {
+    end = sleep_until(s, 1'000'000);
+    done = true;
+  });
+  wait_until_waiting(s, 1);
+  // A signal sent just before the thread enters ppoll is handled there and lost: send until it ends.
+  for (int i = 0; i < 1000 && !done; ++i) {
+    pthread_kill(sleeper.handle(), SIGUSR1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  sleeper.join();
+  EXPECT_EQ(end, End::interrupted);
+  EXPECT_EQ(board.now.load(), 0u);
+  sigaction(SIGUSR1, &old, nullptr);
+}
+
+TEST(VirtualScheduler, ManyThreadsSleepingInALoopSeeTheSameTimesEveryRun) {
+  std::vector<std::string> first;
+  for (int round = 0; round < 5; ++round) {
+    FakeBoard board;
+    VirtualScheduler s(board.hooks(), 0, 1);
+    Journal j;
+    std::vector<std::unique_ptr<Worker>> ws;
+    for (int k = 1; k <= 4; ++k)
+      ws.push_back(std::make_unique<Worker>(s, [&, k] {
+        Tick t = 0;
+        for (int i = 0; i < 25; ++i) {
+          t += static_cast<Tick>(k) * 7;
+          sleep_until(s, t);
+          std::lock_guard lock(j.m);
+          j.lines.push_back(std::to_string(k) + "@" + std::to_string(board.now.load()));
+        }
+      }));
+    for (auto& w : ws) w->join();
+    // Lines at one tick come in any order; per thread, the sequence is fixed.
+    std::vector<std::string> sorted = j.lines;
+    std::sort(sorted.begin(), sorted.end());
+    if (round == 0)
+      first = sorted;
+    else
+      EXPECT_EQ(sorted, first);
+    for (const std::string& l : j.lines) {
+      const int k = std::stoi(l.substr(0, 1));
+      EXPECT_EQ(std::stoul(l.substr(2)) % static_cast<unsigned long>(k * 7), 0u) << l;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace l6470emu::test
