@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -29,40 +30,29 @@ class Daemon : public ::testing::Test {
   }
 
   void start(const std::string& chain, std::vector<std::string> extra) {
-    socket_ = temp_socket_path("daemon");
-    std::vector<std::string> argv = {l6470emu_program(), "serve", "--chain", chain, "--socket", socket_};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    daemon_ = std::make_unique<Background>(argv);
-    for (int i = 0; i < 500 && daemon_->out().find("listening on") == std::string::npos; ++i)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    ASSERT_NE(daemon_->out().find("listening on"), std::string::npos) << daemon_->out();
+    daemon_ = std::make_unique<ServeDaemon>(chain, extra);
+    socket_ = daemon_->socket();
+    ASSERT_TRUE(daemon_->ready()) << daemon_->process().out();
   }
 
   void TearDown() override {
     if (daemon_) {
-      const RunResult r = daemon_->stop(SIGTERM);
+      const RunResult r = daemon_->process().stop(SIGTERM);
       EXPECT_EQ(r.status, 0) << r.out << r.err;
       EXPECT_EQ(access(socket_.c_str(), F_OK), -1) << "the daemon leaves no socket behind";
     }
   }
 
-  Env env() const { return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_SOCKET", socket_}}; }
+  Env env() const { return daemon_->env(); }
   RunResult ctl(const std::string& command) {
-    std::vector<std::string> argv = {l6470emu_program(), "ctl", "--socket", socket_};
-    std::string w;
-    for (char c : command + " ") {
-      if (c == ' ') {
-        if (!w.empty()) argv.push_back(w);
-        w.clear();
-      } else {
-        w += c;
-      }
-    }
-    return run_program(argv);
+    std::vector<std::string> words;
+    std::istringstream in(command);
+    for (std::string w; in >> w;) words.push_back(w);
+    return daemon_->ctl(words);
   }
 
   std::string socket_;
-  std::unique_ptr<Background> daemon_;
+  std::unique_ptr<ServeDaemon> daemon_;
 };
 
 TEST_F(Daemon, ChainStateSurvivesFromOneProgramRunToTheNext) {

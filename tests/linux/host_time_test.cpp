@@ -3,12 +3,8 @@
 // vendor example that sleeps, and BUSY edges arriving as libgpiod events. Bounds are one-sided
 // where the design guarantees them (the board never runs ahead of the host) and generous where
 // the scheduler adds noise, so they cannot flake.
-#include <signal.h>
-
-#include <chrono>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -37,18 +33,11 @@ class HostTime : public ::testing::TestWithParam<bool> {
     const std::string why = missing_prerequisites();
     if (!why.empty()) GTEST_SKIP() << why;
     if (!GetParam()) return;
-    socket_ = temp_socket_path("host-time");
-    daemon_ = std::make_unique<Background>(
-        std::vector<std::string>{l6470emu_program(), "serve", "--chain", kChain, "--socket", socket_});
-    for (int i = 0; i < 500 && daemon_->out().find("listening on") == std::string::npos; ++i)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    ASSERT_NE(daemon_->out().find("listening on"), std::string::npos) << daemon_->out();
-  }
-  void TearDown() override {
-    if (daemon_) daemon_->stop(SIGTERM);
+    daemon_ = std::make_unique<ServeDaemon>(kChain);
+    ASSERT_TRUE(daemon_->ready()) << daemon_->process().out();
   }
   Env env() const {
-    if (GetParam()) return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_SOCKET", socket_}};
+    if (GetParam()) return daemon_->env();
     return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", kChain}};
   }
   std::map<std::string, std::string> python(const std::vector<std::string>& args) {
@@ -60,8 +49,7 @@ class HostTime : public ::testing::TestWithParam<bool> {
   }
 
   static constexpr const char* kChain = "bus=0 cs=0 chips=L6470 log=off";
-  std::string socket_;
-  std::unique_ptr<Background> daemon_;
+  std::unique_ptr<ServeDaemon> daemon_;
 };
 
 /// A polled Move, as the host measured it: never shorter than the profile (the board cannot run

@@ -124,22 +124,12 @@ TEST_F(Recording, AHostKilledMidRunLeavesATraceCompleteUpToItsLastFrame) {
 class RecordingDaemon : public Recording {
  protected:
   void start(std::vector<std::string> extra) {
-    socket_ = temp_socket_path("recd");
-    std::vector<std::string> argv = {l6470emu_program(), "serve", "--chain", "bus=0 cs=0 chips=L6470", "--socket", socket_};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    daemon_ = std::make_unique<Background>(argv);
-    for (int i = 0; i < 500 && daemon_->out().find("listening on") == std::string::npos; ++i)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    ASSERT_NE(daemon_->out().find("listening on"), std::string::npos) << daemon_->out();
+    daemon_ = std::make_unique<ServeDaemon>("bus=0 cs=0 chips=L6470", extra);
+    ASSERT_TRUE(daemon_->ready()) << daemon_->process().out();
   }
-  RunResult ctl(std::vector<std::string> words) {
-    std::vector<std::string> argv = {l6470emu_program(), "ctl", "--socket", socket_};
-    argv.insert(argv.end(), words.begin(), words.end());
-    return run_program(argv);
-  }
-  Env env() const { return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_SOCKET", socket_}}; }
-  std::string socket_;
-  std::unique_ptr<Background> daemon_;
+  RunResult ctl(std::vector<std::string> words) { return daemon_->ctl(words); }
+  Env env() const { return daemon_->env(); }
+  std::unique_ptr<ServeDaemon> daemon_;
 };
 
 TEST_F(RecordingDaemon, ServeRecordTakesProgramsCtlSwitchAndFaultsAndReplaysClean) {
@@ -153,7 +143,7 @@ TEST_F(RecordingDaemon, ServeRecordTakesProgramsCtlSwitchAndFaultsAndReplaysClea
                                    "print([s.xfer2([b])[0] for b in (0xD0, 0, 0, 0x29, 0)])\n"},
                                   env());
   ASSERT_EQ(g.status, 0) << g.err;
-  const RunResult d = daemon_->stop(SIGTERM);
+  const RunResult d = daemon_->process().stop(SIGTERM);
   daemon_.reset();
   ASSERT_EQ(d.status, 0) << d.out << d.err;
   EXPECT_NE(d.out.find(" frames to " + trace_ + "\n"), std::string::npos) << d.out;
@@ -181,7 +171,7 @@ TEST_F(RecordingDaemon, CtlTraceStartAndStopRecordWhatHappensInBetween) {
   const std::string before = read_file(trace_);
   ASSERT_EQ(run_program({client("spidev_messages"), "/dev/spidev0.0"}, env()).status, 0);
   EXPECT_EQ(read_file(trace_), before);
-  const RunResult d = daemon_->stop(SIGTERM);
+  const RunResult d = daemon_->process().stop(SIGTERM);
   daemon_.reset();
   EXPECT_EQ(d.status, 0) << d.err;
 }
@@ -189,9 +179,9 @@ TEST_F(RecordingDaemon, CtlTraceStartAndStopRecordWhatHappensInBetween) {
 TEST_F(RecordingDaemon, ADaemonKilledWhileRecordingLeavesACompleteTrace) {
   start({"--record", trace_});
   ASSERT_EQ(run_program({system_python(), script("spidev_sequence.py"), "0", "0"}, env()).status, 0);
-  daemon_->stop(SIGKILL);
+  daemon_->process().stop(SIGKILL);
+  unlink(daemon_->socket().c_str());
   daemon_.reset();
-  unlink(socket_.c_str());
   const std::string text = read_file(trace_);
   EXPECT_GT(count_of(text, " frame "), 100u) << text;
   // The program's last command (GetStatus, one frame per byte) is the file's last frame.

@@ -12,6 +12,8 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <thread>
+#include <chrono>
 
 extern char** environ;
 
@@ -126,6 +128,25 @@ RunResult Background::wait(double timeout_s) {
 }
 
 std::string Background::out() const { return slurp(out_path_); }
+
+ServeDaemon::ServeDaemon(const std::string& chain, const std::vector<std::string>& extra)
+    : socket_(unique_path("serve.sock")) {
+  std::vector<std::string> argv = {l6470emu_program(), "serve", "--chain", chain, "--socket", socket_};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  process_ = std::make_unique<Background>(argv);
+  for (int i = 0; i < 1000 && !ready_; ++i) {
+    ready_ = process_->out().find("listening on") != std::string::npos;
+    if (!ready_) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+Env ServeDaemon::env() const { return {{"LD_PRELOAD", preload_library()}, {"L6470EMU_SOCKET", socket_}}; }
+
+RunResult ServeDaemon::ctl(const std::vector<std::string>& words) const {
+  std::vector<std::string> argv = {l6470emu_program(), "ctl", "--socket", socket_};
+  argv.insert(argv.end(), words.begin(), words.end());
+  return run_program(argv);
+}
 
 std::string build_dir() { return L6470EMU_BINARY_DIR; }
 std::string preload_library() { return build_dir() + "/libl6470emu-preload.so"; }

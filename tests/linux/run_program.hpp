@@ -4,6 +4,7 @@
 
 #include <sys/types.h>
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,25 @@ class Background {
   std::string out_path_, err_path_;
   bool done_ = false;
   RunResult result_;
+};
+
+/// `l6470emu serve --chain CHAIN --socket <fresh path> EXTRA...` in the background, waited for
+/// until it listens (ready() says whether it did); stopped with SIGKILL when destroyed if still running.
+class ServeDaemon {
+ public:
+  explicit ServeDaemon(const std::string& chain, const std::vector<std::string>& extra = {});
+  bool ready() const { return ready_; }
+  const std::string& socket() const { return socket_; }
+  /// The environment that sends a program's spidev and gpiochip files to this daemon.
+  Env env() const;
+  /// `l6470emu ctl --socket SOCKET WORDS...`.
+  RunResult ctl(const std::vector<std::string>& words) const;
+  Background& process() { return *process_; }
+
+ private:
+  std::string socket_;
+  std::unique_ptr<Background> process_;
+  bool ready_ = false;
 };
 
 /// Paths of what the tests run.
