@@ -180,6 +180,7 @@ long Board::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transf
   std::lock_guard lock(m_);
   Handle* h = find(handle, HandleKind::spidev);
   if (!h) return -EBADF;
+  if (xfers.empty()) return 0;  // spidev answers SPI_IOC_MESSAGE(0) without touching the bus
   ChainDev& c = *chains_[h->dev];
   const long total = validate_spidev_message(c.spi, xfers);
   if (total < 0) return total;

@@ -141,7 +141,7 @@ void serve_request(Board& board, const ControlHandler& control, std::span<const 
         return;
       }
       std::vector<spi_ioc_transfer> xfers(n);
-      std::memcpy(xfers.data(), payload.data(), n * sizeof(spi_ioc_transfer));
+      if (n > 0) std::memcpy(xfers.data(), payload.data(), n * sizeof(spi_ioc_transfer));
       const auto tx = payload.subspan(n * sizeof(spi_ioc_transfer));
       std::uint64_t rx_len = 0;
       for (const auto& x : xfers)

@@ -30,7 +30,9 @@ ServeCommands::ServeCommands(CLI::App& app) {
   ctl_ = app.add_subcommand("ctl", "control a running daemon: " + std::string("status, get, dump, sw, pin, fault, adc, "
                                                                                "time, advance, chains, trace (ctl help)"));
   ctl_->add_option("--socket", socket_, "the daemon's socket (default as for serve)");
-  ctl_->add_option("command", words_, "the command and its arguments")->required();
+  // Only the command word is parsed here; everything after it (--chip K, --chain NAME, values)
+  // goes to the daemon untouched, in order.
+  ctl_->add_option("command", command_word_, "the command (its arguments follow it)")->required();
   ctl_->prefix_command();
 }
 
@@ -62,7 +64,7 @@ std::optional<int> ServeCommands::run() {
     return run_daemon(config, socket, std::cout, std::cerr);
   }
   if (ctl_ && *ctl_) {
-    std::vector<std::string> all = words_;
+    std::vector<std::string> all = {command_word_};
     for (const auto& extra : ctl_->remaining()) all.push_back(extra);
     // The daemon runs elsewhere: a relative trace file is meant from here.
     if (all.size() >= 3 && all[0] == "trace" && all[1] == "start" && !all[2].empty() && all[2][0] != '/' && all[2][0] != '-')

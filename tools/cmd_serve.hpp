@@ -27,7 +27,7 @@ class ServeCommands {
   bool virtual_time_ = false;
   std::string log_;
   std::string record_;
-  std::vector<std::string> words_;
+  std::string command_word_;  // the ctl command; its arguments come from remaining()
 };
 
 }  // namespace l6470emu

@@ -271,6 +271,12 @@ int run_control(Board& board, const std::string& command, std::string& out) {
   } else if (cmd == "trace") {
     // One native trace per chain; without --chain, `stop` ends every recording.
     if (a.words.size() == 2 && a.words[0] == "start") {
+      // A recording in progress (serve --record, an earlier ctl) is never ended behind its back.
+      if (const std::string now = board.recording_path(ci); !now.empty()) {
+        out = "ctl: " + board.chain_summary(ci) + " is already being recorded to " + now +
+              "; `ctl trace stop` ends that recording first\n";
+        return 1;
+      }
       if (const std::string error = board.start_recording(ci, a.words[1]); !error.empty()) {
         out = "ctl: " + error + "\n";
         return 1;

@@ -2,6 +2,8 @@
 #include "linux/serve/daemon.hpp"
 
 #include <poll.h>
+#include <pthread.h>
+#include <sys/stat.h>
 #include <signal.h>
 #include <sys/signalfd.h>
 #include <sys/socket.h>
@@ -11,7 +13,9 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <list>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -47,11 +51,39 @@ int connect_to(const std::string& path) {
   return s;
 }
 
+/// Connections served at once; more are refused (each one is a thread and a packet buffer).
+constexpr std::size_t kMaxClients = 256;
+/// Stack of a connection thread: serving a request needs little (buffers live on the heap).
+constexpr std::size_t kConnectionStack = 256 * 1024;
+
 struct Connection {
   int fd = -1;
-  std::thread thread;
+  pthread_t thread{};
   bool done = false;
 };
+
+/// Starts `body` on a thread with a small stack. Returns false (errno set) when it cannot.
+bool start_thread(pthread_t& thread, std::function<void()> body) {
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, kConnectionStack);
+  auto* task = new std::function<void()>(std::move(body));
+  const int r = pthread_create(
+      &thread, &attr,
+      [](void* p) -> void* {
+        std::unique_ptr<std::function<void()>> f(static_cast<std::function<void()>*>(p));
+        (*f)();
+        return nullptr;
+      },
+      task);
+  pthread_attr_destroy(&attr);
+  if (r != 0) {
+    delete task;
+    errno = r;
+    return false;
+  }
+  return true;
+}
 
 void serve_connection(Board& board, const ControlHandler& control, Connection& c) {
   Packet packet;
@@ -90,13 +122,25 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     err << "l6470emu serve: socket path too long or empty: " << socket_path << "\n";
     return 1;
   }
-  // A socket file nobody answers on is a leftover of a killed daemon: replace it.
-  if (const int probe = connect_to(socket_path); probe >= 0) {
-    close(probe);
-    err << "l6470emu serve: another daemon is already serving " << socket_path << "\n";
-    return 1;
+  // Only a stale socket of our own (a killed daemon's) is replaced; anything else at the path is
+  // someone else's: a regular file, a directory, a socket another user put there first.
+  if (struct stat st{}; lstat(socket_path.c_str(), &st) == 0) {
+    if (!S_ISSOCK(st.st_mode)) {
+      err << "l6470emu serve: " << socket_path << " exists and is not a socket; not touching it\n";
+      return 1;
+    }
+    if (st.st_uid != geteuid()) {
+      err << "l6470emu serve: " << socket_path << " belongs to user " << st.st_uid
+          << ", not to us; choose another path with --socket\n";
+      return 1;
+    }
+    if (const int probe = connect_to(socket_path); probe >= 0) {
+      close(probe);
+      err << "l6470emu serve: another daemon is already serving " << socket_path << "\n";
+      return 1;
+    }
+    unlink(socket_path.c_str());
   }
-  unlink(socket_path.c_str());
 
   // Signals arrive through a signalfd; every thread started from here on has them blocked.
   sigset_t mask;
@@ -108,8 +152,13 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   signal(SIGPIPE, SIG_IGN);
   const int sfd = signalfd(-1, &mask, SFD_CLOEXEC);
 
+  // The socket is 0600 from birth (whatever the umask): whoever can connect can record files as
+  // the daemon's user, so only that user (and root) may, and peers are checked again at accept.
   const int listener = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
-  if (listener < 0 || bind(listener, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 || listen(listener, 64) != 0) {
+  const mode_t old_umask = umask(0177);
+  const bool bound = listener >= 0 && bind(listener, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
+  umask(old_umask);
+  if (!bound || listen(listener, 64) != 0) {
     err << "l6470emu serve: cannot listen on " << socket_path << ": " << std::strerror(errno) << "\n";
     if (listener >= 0) close(listener);
     return 1;
@@ -144,6 +193,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
 
   std::list<Connection> connections;
   std::mutex connections_mutex;
+  bool warned_descriptors = false, warned_clients = false;
   for (;;) {
     pollfd fds[2] = {{listener, POLLIN, 0}, {sfd, POLLIN, 0}};
     const int n = poll(fds, 2, 1000);
@@ -154,7 +204,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
       std::lock_guard lock(connections_mutex);
       for (auto it = connections.begin(); it != connections.end();) {
         if (it->done) {
-          it->thread.join();
+          pthread_join(it->thread, nullptr);
           close(it->fd);
           it = connections.erase(it);
         } else {
@@ -164,15 +214,44 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     }
     if (!(fds[0].revents & POLLIN)) continue;
     const int c = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
-    if (c < 0) continue;
+    if (c < 0) {
+      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
+        // Out of descriptors: the listener stays readable, so wait instead of spinning.
+        if (!warned_descriptors) log.line("serve: out of file descriptors (" + std::string(std::strerror(errno)) +
+                                          "): new clients wait until some leave");
+        warned_descriptors = true;
+        poll(nullptr, 0, 100);
+      }
+      continue;
+    }
+    warned_descriptors = false;
+    ucred peer{};
+    socklen_t len = sizeof peer;
+    if (getsockopt(c, SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0 || (peer.uid != geteuid() && peer.uid != 0)) {
+      log.line("serve: refused a client of user " + std::to_string(peer.uid) + " (pid " + std::to_string(peer.pid) +
+               "): only user " + std::to_string(geteuid()) + " and root may use this daemon");
+      close(c);
+      continue;
+    }
     std::lock_guard lock(connections_mutex);
+    if (connections.size() >= kMaxClients) {
+      if (!warned_clients) log.line("serve: " + std::to_string(kMaxClients) + " clients connected; refusing more until some leave");
+      warned_clients = true;
+      close(c);
+      continue;
+    }
+    warned_clients = false;
     Connection& conn = connections.emplace_back();
     conn.fd = c;
-    conn.thread = std::thread([&board, &control, &conn, &connections_mutex] {
-      serve_connection(board, control, conn);
-      std::lock_guard l(connections_mutex);
-      conn.done = true;
-    });
+    if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex] {
+          serve_connection(board, control, conn);
+          std::lock_guard l(connections_mutex);
+          conn.done = true;
+        })) {
+      log.line("serve: cannot start a thread for a client (" + std::string(std::strerror(errno)) + "); refused");
+      close(c);
+      connections.pop_back();
+    }
   }
 
   out << "l6470emu serve: stopping\n";
@@ -184,7 +263,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     for (auto& c : connections) shutdown(c.fd, SHUT_RDWR);
   }
   for (auto& c : connections) {
-    if (c.thread.joinable()) c.thread.join();
+    pthread_join(c.thread, nullptr);
     close(c.fd);
   }
   for (std::size_t i = 0; i < board.chain_count(); ++i) {
