@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <climits>
 #include <cerrno>
 #include <sstream>
 
@@ -13,6 +15,9 @@
 #include "spi/message.hpp"
 
 namespace l6470emu {
+
+/// How often each kind of chip diagnostic is logged in full per chip.
+constexpr std::uint64_t kDiagnosticRepeats = 10;
 
 Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : log_(log), time_(config.time, host) {
   unsigned spi_minor = 0;
@@ -29,11 +34,21 @@ Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : l
     const std::size_t ci = chains_.size();
     for (std::size_t k = 0; k < cd->chain.size(); ++k) {
       const std::string where = cd->name + ": chip " + std::to_string(k) + ": ";
-      cd->chain.chip(k).set_diagnostic_sink([this, where](const Diagnostic& d) {
-        const char* kind = d.kind == DiagnosticKind::wrong_cmd     ? "WRONG_CMD"
-                           : d.kind == DiagnosticKind::notperf_cmd ? "NOTPERF_CMD"
-                                                                   : "ignored";
-        log_.line(where + kind + ": " + d.message);
+      // A driver looping on a bad command must not flood the log: each kind is shown
+      // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
+      cd->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {
+        const std::size_t i = d.kind == DiagnosticKind::wrong_cmd ? 0 : d.kind == DiagnosticKind::notperf_cmd ? 1 : 2;
+        const char* kind = i == 0 ? "WRONG_CMD" : i == 1 ? "NOTPERF_CMD" : "ignored";
+        const std::uint64_t n = ++seen[i];
+        if (n < kDiagnosticRepeats) {
+          log_.line(where + kind + ": " + d.message);
+        } else if (n == kDiagnosticRepeats) {
+          log_.line(where + kind + ": " + d.message + "  (further ones of this kind are counted, not shown)");
+        } else {
+          std::uint64_t p = kDiagnosticRepeats;
+          while (p < n && p <= UINT64_MAX / 10) p *= 10;
+          if (p == n) log_.line(where + kind + ": " + std::to_string(n) + " so far");
+        }
       });
     }
     nodes_.push_back({DeviceNode::Type::spidev, cc.path, cd->name, kSpidevMajor, spi_minor++, cc.bufsiz});
