@@ -350,6 +350,8 @@ struct Parser {
       if (value.back() == '/') return fail("trace " + q + " names a directory; give a file");
       cfg.trace = std::string(value);
     }
+    if ((k == "log" || k == "trace") && !cfg.trace.empty() && cfg.trace == cfg.log)
+      return fail("log= and trace= name the same file " + q + ": diagnostics would be mixed into the trace");
     // Combinations that would be silently ignored.
     auto time_given = board_keys.find(std::string_view("time"));
     if (time_given != board_keys.end()) {

@@ -197,6 +197,8 @@ TEST(BoardConfig, EmptyAndOutOfRangeChainValuesAreRefused) {
   EXPECT_EQ(error_of("chips=L6470 log=stdout"),
             "log=stdout would be a file of that name: write log=stderr, log=off, or log=./stdout if a file is meant");
   EXPECT_EQ(error_of("chips=L6470 trace=/tmp/"), "trace '/tmp/' names a directory; give a file");
+  EXPECT_EQ(error_of("chips=L6470 trace=run.t; log=run.t", 2),
+            "log= and trace= name the same file 'run.t': diagnostics would be mixed into the trace");
   EXPECT_EQ(error_of("socket=/tmp/" + std::string(103, 's')), "socket path is 108 bytes long; a Unix socket path has at most 107");
 }
 
