@@ -164,22 +164,24 @@ VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
   return me.end;
 }
 
-void VirtualScheduler::wait_in(const void* object, const std::function<void()>& block_fn) {
-  Wait w;
-  w.object = object;
-  w.interruptible = false;
+void VirtualScheduler::wait_in(const Wait& w, const std::function<void()>& block_fn) {
   Waiter me;
   me.w = &w;
   me.fd = t_wake.get();
+  bool counted = false;
   {
     Locked lock(m_);
-    me.seq = next_seq_++;
-    waiters_.push_back(&me);
-    --running_;
-    touch();
-    decide_locked(false);
+    if (!w.try_now || !w.try_now()) {  // else nothing to wait for: the call runs uncounted
+      counted = true;
+      me.seq = next_seq_++;
+      waiters_.push_back(&me);
+      --running_;
+      touch();
+      decide_locked(false);
+    }
   }
   block_fn();
+  if (!counted) return;
   {
     Locked lock(m_);
     if (!me.done.load(std::memory_order_acquire)) {

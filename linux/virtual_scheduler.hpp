@@ -83,9 +83,10 @@ class VirtualScheduler {
   /// Blocks the calling thread in `w` until it ends; may move time (when this thread was the last
   /// one running). Returns at once (timed_out) when the deadline is not in the future.
   End wait(const Wait& w);
-  /// Counts the calling thread as waiting for `object` while `block` runs (a real blocking call
-  /// that returns by itself, such as pthread_join); notify(object) marks it running again.
-  void wait_in(const void* object, const std::function<void()>& block);
+  /// Counts the calling thread as waiting for `w.object` while `block` runs (a real blocking call
+  /// that returns by itself, such as pthread_join); notify(object) marks it running again. When
+  /// `w.try_now` (checked under the lock) says the object is done already, `block` runs uncounted.
+  void wait_in(const Wait& w, const std::function<void()>& block);
 
   /// Ends the wait of the first waiter on `object` (all of them with `all`), in registration
   /// order, as notified. Returns how many were woken.

@@ -1,11 +1,14 @@
 // Replaced C library functions that act on open descriptors: ioctl, read, __read_chk and
 // write. Emulated descriptors go to the backend with the kernel's argument handling
-// (user memory copied in and out, EFAULT, the VFS's own ioctls); others go to the C library.
+// (user memory copied in and out, EFAULT, the VFS's own ioctls); others go to the C library
+// (but for virtual timerfds, whose reads intercept_timerfd.cpp answers).
 #include <errno.h>
+#include <fcntl.h>
 #include <linux/gpio.h>
 #include <linux/spi/spidev.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -16,6 +19,7 @@
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/user_memory.hpp"
+#include "linux/preload/virtual_time.hpp"
 #include "linux/spidev_rules.hpp"
 
 using namespace l6470emu;
@@ -126,13 +130,39 @@ long emulated_ioctl(FdEntry& e, unsigned long cmd, void* argp) {
   return generic_ioctl(e, cmd, argp);
 }
 
+// Virtual time: whether the first queued event may be read now. An event stamped later than
+// the program's time (an edge a spidev message caused, queued before the message's end) is
+// waited for in virtual time, as is the first one of a blocking read; the board's next edge wakes
+// the wait. Returns 0, or -1 with errno (EAGAIN for O_NONBLOCK, EINTR).
+int wait_for_record(VirtualHostTime& vt, int fd) {
+  const bool nonblocking = real::fcntl(fd, F_GETFL, 0) & O_NONBLOCK;
+  for (;;) {
+    const Tick t = vt.first_event_tick(fd);
+    if (t != kNever && t <= vt.tick_after(0)) return 0;
+    if (nonblocking) return static_cast<int>(fail(-EAGAIN));
+    const pollfd p{fd, static_cast<short>(t == kNever ? POLLIN : 0), 0};
+    VirtualScheduler::Wait w;
+    w.deadline = t;
+    w.fds = std::span<const pollfd>(&p, 1);
+    w.watches_board = true;
+    if (vt.wait(w) == VirtualScheduler::End::interrupted) return static_cast<int>(fail(-EINTR));
+  }
+}
+
 ssize_t read_records(int fd, FdEntry& e, void* buf, std::size_t count) {
   const std::size_t record = e.record.load();
   if (record == 0) return real::read(fd, buf, count);
   if (count < record) return fail(-EINVAL);
+  VirtualHostTime* vt = installed_virtual_time();
+  if (vt && wait_for_record(*vt, fd) < 0) return -1;
   std::size_t done = 0;
   auto* out = static_cast<std::uint8_t*>(buf);
   while (count - done >= record) {
+    // Virtual time: the records after the first stop at one stamped in the program's future.
+    if (vt && done > 0) {
+      const Tick t = vt->first_event_tick(fd);
+      if (t == kNever || t > vt->tick_after(0)) break;
+    }
     const ssize_t n = recv(fd, out + done, record, done == 0 ? 0 : MSG_DONTWAIT);
     if (n < 0) {
       if (done > 0) break;  // we have events; the queue is just empty now
@@ -188,6 +218,9 @@ __attribute__((visibility("default"))) int ioctl(int fd, unsigned long request, 
     return real::ioctl(fd, request, arg);
   Guard guard;
   try {
+    // Virtual time: reading a line's value in a loop is a busy wait like reading the clock.
+    if (e->kind != HandleKind::spidev)
+      if (VirtualHostTime* vt = installed_virtual_time()) vt->look();
     return static_cast<int>(emulated_ioctl(*e, request, arg));
   } catch (...) {
     errno = ENOMEM;
@@ -197,7 +230,11 @@ __attribute__((visibility("default"))) int ioctl(int fd, unsigned long request, 
 
 __attribute__((visibility("default"))) ssize_t read(int fd, void* buf, size_t count) {
   FdEntry* e = fd_entry(fd);
-  if (!e || inside()) return real::read(fd, buf, count);
+  if (!e || inside()) {
+    ssize_t r;
+    if (!e && read_virtual_timerfd(fd, buf, count, &r)) return r;
+    return real::read(fd, buf, count);
+  }
   Guard guard;
   try {
     return emulated_read(fd, *e, buf, count);

@@ -16,6 +16,7 @@
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
+#include "linux/preload/virtual_time.hpp"
 
 using namespace l6470emu;
 using namespace l6470emu::preload;
@@ -84,9 +85,11 @@ mode_t mode_arg(int flags, va_list ap) {
   return (flags & O_CREAT) || (flags & O_TMPFILE) == O_TMPFILE ? static_cast<mode_t>(va_arg(ap, int)) : 0;
 }
 
-// After a real close: drop our entry (and tell the board when no copy is left here).
+// After a real close: drop our entry (and tell the board when no copy is left here), and a
+// virtual timerfd's timer.
 void forget_fd(int fd) {
   if (FdEntry* e = fd_take(fd)) fd_release(e);
+  forget_virtual_timerfd(fd);
 }
 
 // A descriptor the C library just handed out must not look emulated (stale entry).
@@ -206,6 +209,7 @@ __attribute__((visibility("default"))) int close(int fd) {
   }
   FdEntry* e = fd_entry(fd) ? fd_take(fd) : nullptr;
   const int r = real::close(fd);
+  forget_virtual_timerfd(fd);
   if (e) {
     const int saved = errno;
     fd_release(e);
@@ -238,6 +242,7 @@ __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
   if (fd == fd2) return real::dup2(fd, fd2);
   FdEntry* old = fd_entry(fd2) ? fd_take(fd2) : nullptr;
   const int r = real::dup2(fd, fd2);
+  if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {
     if (r < 0)
       fd_store(fd2, old);
@@ -250,6 +255,7 @@ __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
 __attribute__((visibility("default"))) int dup3(int fd, int fd2, int flags) {
   FdEntry* old = (fd != fd2 && fd_entry(fd2)) ? fd_take(fd2) : nullptr;
   const int r = real::dup3(fd, fd2, flags);
+  if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {
     if (r < 0)
       fd_store(fd2, old);

@@ -1,5 +1,7 @@
-// Backend with the Board inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG).
+// Backend with the Board inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG); with
+// time=virtual the board's time becomes the program's own (virtual_time.hpp).
 #include "linux/preload/backend.hpp"
+#include "linux/preload/virtual_time.hpp"
 
 namespace l6470emu::preload {
 namespace {
@@ -10,6 +12,10 @@ class LocalBackend final : public Backend {
     if (!config.trace.empty())
       if (const std::string error = board_.start_recording_all(config.trace); !error.empty())
         log_.line("trace not recorded: " + error);
+    if (config.time.virtual_time) {
+      virtual_time_ = std::make_unique<VirtualHostTime>(board_, config.time);
+      install_virtual_time(virtual_time_.get());
+    }
   }
 
   const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
@@ -24,17 +30,27 @@ class LocalBackend final : public Backend {
   }
   long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override { return board_.spi_read(handle, rx); }
   long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override { return board_.spi_write(handle, tx); }
-  void before_fork() override { board_.mutex().lock(); }
-  void after_fork_parent() override { board_.mutex().unlock(); }
+  // The scheduler's lock before the board's: the scheduler moves the board while holding it.
+  void before_fork() override {
+    if (virtual_time_) virtual_time_->before_fork();
+    board_.mutex().lock();
+  }
+  void after_fork_parent() override {
+    board_.mutex().unlock();
+    if (virtual_time_) virtual_time_->after_fork_parent();
+  }
   void after_fork_child() override {
     board_.mutex().unlock();
     board_.forget_pump_after_fork();
     board_.forget_recordings_after_fork();
+    // The child goes on with its own copy of the board and of its virtual clock.
+    if (virtual_time_) virtual_time_->after_fork_child();
   }
 
  private:
   DiagnosticLog log_;
   Board board_;
+  std::unique_ptr<VirtualHostTime> virtual_time_;
 };
 
 }  // namespace

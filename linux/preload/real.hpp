@@ -3,11 +3,20 @@
 #pragma once
 
 #include <dirent.h>
+#include <poll.h>
+#include <pthread.h>
+#include <semaphore.h>
+#include <signal.h>
 #include <stdio.h>
+#include <sys/epoll.h>
+#include <sys/select.h>
 #include <sys/stat.h>
+#include <sys/time.h>
 #include <sys/types.h>
+#include <time.h>
 
 struct statx;
+struct itimerspec;
 
 namespace l6470emu::real {
 
@@ -37,5 +46,38 @@ struct dirent* readdir(DIR* d);
 int closedir(DIR* d);
 int scandir(const char* dir, struct dirent*** list, int (*filter)(const struct dirent*),
             int (*compar)(const struct dirent**, const struct dirent**));
+
+// Time and waits (virtual host time).
+int clock_gettime(clockid_t clock, struct timespec* ts);
+int gettimeofday(struct timeval* tv, void* tz);
+time_t time(time_t* t);
+int timespec_get(struct timespec* ts, int base);
+int nanosleep(const struct timespec* req, struct timespec* rem);
+int clock_nanosleep(clockid_t clock, int flags, const struct timespec* req, struct timespec* rem);
+int usleep(useconds_t us);
+unsigned sleep(unsigned seconds);
+int select(int n, fd_set* r, fd_set* w, fd_set* e, struct timeval* timeout);
+int pselect(int n, fd_set* r, fd_set* w, fd_set* e, const struct timespec* timeout, const sigset_t* mask);
+int poll(struct pollfd* fds, nfds_t n, int timeout_ms);
+int ppoll(struct pollfd* fds, nfds_t n, const struct timespec* timeout, const sigset_t* mask);
+int epoll_wait(int epfd, struct epoll_event* events, int max, int timeout_ms);
+int epoll_pwait(int epfd, struct epoll_event* events, int max, int timeout_ms, const sigset_t* mask);
+int epoll_pwait2(int epfd, struct epoll_event* events, int max, const struct timespec* timeout, const sigset_t* mask);
+int epoll_ctl(int epfd, int op, int fd, struct epoll_event* event);
+int pthread_cond_wait(pthread_cond_t* c, pthread_mutex_t* m);
+int pthread_cond_timedwait(pthread_cond_t* c, pthread_mutex_t* m, const struct timespec* abstime);
+int pthread_cond_clockwait(pthread_cond_t* c, pthread_mutex_t* m, clockid_t clock, const struct timespec* abstime);
+int pthread_cond_signal(pthread_cond_t* c);
+int pthread_cond_broadcast(pthread_cond_t* c);
+int sem_wait(sem_t* s);
+int sem_timedwait(sem_t* s, const struct timespec* abstime);
+int sem_clockwait(sem_t* s, clockid_t clock, const struct timespec* abstime);
+int sem_trywait(sem_t* s);
+int sem_post(sem_t* s);
+int pthread_create(pthread_t* t, const pthread_attr_t* attr, void* (*fn)(void*), void* arg);
+int pthread_join(pthread_t t, void** result);
+int timerfd_create(int clock, int flags);
+int timerfd_settime(int fd, int flags, const struct itimerspec* value, struct itimerspec* old);
+int timerfd_gettime(int fd, struct itimerspec* value);
 
 }  // namespace l6470emu::real

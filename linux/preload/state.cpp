@@ -73,6 +73,8 @@ __attribute__((constructor)) void load_config() {
   g_log = new DiagnosticLog(g_config->log);
   pthread_atfork(atfork_prepare, atfork_parent, atfork_child);
   g_active.store(true, std::memory_order_release);
+  // Virtual time is the program's clock from its start, not from its first open of a device.
+  if (g_config->time.virtual_time && g_config->socket.empty()) backend();
 }
 
 }  // namespace

@@ -70,7 +70,9 @@ class Worker {
     });
   }
   void join() {
-    s_.wait_in(this, [this] { t_.join(); });
+    VirtualScheduler::Wait w;
+    w.object = this;
+    s_.wait_in(w, [this] { t_.join(); });
   }
   ~Worker() {
     if (t_.joinable()) t_.join();

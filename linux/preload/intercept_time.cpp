@@ -1,0 +1,167 @@
+// Replaced C library clock reads and sleeps for virtual host time: clock_gettime, gettimeofday,
+// time, timespec_get, nanosleep, clock_nanosleep, usleep, sleep. Each public symbol has its own
+// wrapper (glibc's sleep and time reach the kernel through internal aliases, not through these).
+// In wall mode, and for CPU-time clocks, every call goes straight to the C library.
+#include <errno.h>
+#include <sys/time.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "linux/preload/real.hpp"
+#include "linux/preload/virtual_time.hpp"
+
+using namespace l6470emu;
+using namespace l6470emu::preload;
+
+namespace {
+
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+
+timespec to_timespec(std::int64_t ns) {
+  if (ns < 0) ns = 0;
+  return {static_cast<time_t>(ns / kNsPerSecond), static_cast<long>(ns % kNsPerSecond)};
+}
+
+bool valid(const timespec& ts) { return ts.tv_nsec >= 0 && ts.tv_nsec < kNsPerSecond; }
+
+std::int64_t to_ns(const timespec& ts) {
+  // Far-future values saturate (a deadline after the year 2262 is no deadline).
+  if (ts.tv_sec >= INT64_MAX / kNsPerSecond - 1) return INT64_MAX / 2;
+  return std::int64_t{ts.tv_sec} * kNsPerSecond + ts.tv_nsec;
+}
+
+// clock_nanosleep on a virtual clock: 0 or an error number (EINTR with `rem` for relative sleeps).
+int virtual_sleep(VirtualHostTime& vt, clockid_t clock, int flags, const timespec* req, timespec* rem) {
+  if (!valid(*req) || (!(flags & TIMER_ABSTIME) && req->tv_sec < 0)) return EINVAL;
+  const bool absolute = flags & TIMER_ABSTIME;
+  const std::int64_t start = vt.now_ns(clock);
+  const std::int64_t deadline_ns = absolute ? to_ns(*req) : start + to_ns(*req);
+  VirtualScheduler::Wait w;
+  w.deadline = absolute ? vt.tick_at(clock, deadline_ns) : vt.tick_after(to_ns(*req));
+  if (vt.wait(w) != VirtualScheduler::End::interrupted) return 0;
+  if (!absolute && rem) *rem = to_timespec(deadline_ns - vt.now_ns(clock));
+  return EINTR;
+}
+
+}  // namespace
+
+extern "C" {
+
+__attribute__((visibility("default"))) int clock_gettime(clockid_t clock, struct timespec* ts) noexcept {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt || !VirtualHostTime::is_virtual_clock(clock) || is_null(ts)) return real::clock_gettime(clock, ts);
+  Guard guard;
+  try {
+    vt->look();
+    *ts = to_timespec(vt->now_ns(clock));
+    return 0;
+  } catch (...) {
+    return real::clock_gettime(clock, ts);
+  }
+}
+
+__attribute__((visibility("default"))) int gettimeofday(struct timeval* tv, void* tz) noexcept {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt || is_null(tv)) return real::gettimeofday(tv, tz);
+  Guard guard;
+  try {
+    if (tz) real::gettimeofday(nullptr, tz);
+    vt->look();
+    const std::int64_t ns = vt->now_ns(CLOCK_REALTIME);
+    tv->tv_sec = static_cast<time_t>(ns / kNsPerSecond);
+    tv->tv_usec = static_cast<suseconds_t>(ns % kNsPerSecond / 1000);
+    return 0;
+  } catch (...) {
+    return real::gettimeofday(tv, tz);
+  }
+}
+
+__attribute__((visibility("default"))) time_t time(time_t* t) noexcept {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt) return real::time(t);
+  Guard guard;
+  try {
+    vt->look();
+    const time_t s = static_cast<time_t>(vt->now_ns(CLOCK_REALTIME) / kNsPerSecond);
+    if (t) *t = s;
+    return s;
+  } catch (...) {
+    return real::time(t);
+  }
+}
+
+__attribute__((visibility("default"))) int timespec_get(struct timespec* ts, int base) noexcept {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt || base != TIME_UTC || is_null(ts)) return real::timespec_get(ts, base);
+  Guard guard;
+  try {
+    vt->look();
+    *ts = to_timespec(vt->now_ns(CLOCK_REALTIME));
+    return base;
+  } catch (...) {
+    return real::timespec_get(ts, base);
+  }
+}
+
+__attribute__((visibility("default"))) int clock_nanosleep(clockid_t clock, int flags, const struct timespec* req,
+                                                           struct timespec* rem) {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt || is_null(req) || (clock != CLOCK_MONOTONIC && clock != CLOCK_REALTIME && clock != CLOCK_BOOTTIME &&
+                      clock != CLOCK_TAI))
+    return real::clock_nanosleep(clock, flags, req, rem);
+  Guard guard;
+  try {
+    return virtual_sleep(*vt, clock, flags, req, rem);
+  } catch (...) {
+    return real::clock_nanosleep(clock, flags, req, rem);
+  }
+}
+
+__attribute__((visibility("default"))) int nanosleep(const struct timespec* req, struct timespec* rem) {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt || is_null(req)) return real::nanosleep(req, rem);
+  Guard guard;
+  try {
+    const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, req, rem);
+    if (r == 0) return 0;
+    errno = r;
+    return -1;
+  } catch (...) {
+    return real::nanosleep(req, rem);
+  }
+}
+
+__attribute__((visibility("default"))) int usleep(useconds_t us) {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt) return real::usleep(us);
+  Guard guard;
+  try {
+    const timespec req = to_timespec(std::int64_t{us} * 1000);
+    const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, nullptr);
+    if (r == 0) return 0;
+    errno = r;
+    return -1;
+  } catch (...) {
+    return real::usleep(us);
+  }
+}
+
+__attribute__((visibility("default"))) unsigned sleep(unsigned seconds) {
+  VirtualHostTime* vt = virtual_time();
+  if (!vt) return real::sleep(seconds);
+  Guard guard;
+  try {
+    const timespec req{static_cast<time_t>(seconds), 0};
+    timespec rem{};
+    const int saved = errno;
+    if (virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, &rem) == 0) {
+      errno = saved;
+      return 0;
+    }
+    return static_cast<unsigned>(rem.tv_sec) + (rem.tv_nsec >= 500'000'000 ? 1 : 0);  // as glibc rounds
+  } catch (...) {
+    return real::sleep(seconds);
+  }
+}
+
+}  // extern "C"

@@ -1,0 +1,125 @@
+// Virtual host time in the preload library (time=virtual, emulator in process): the program's
+// clocks read the board's time and its waits are VirtualScheduler waits. What is not covered
+// (vDSO-direct reads, raw system calls, POSIX timers, alarm) is listed in docs/linux.md.
+#pragma once
+
+#include <time.h>
+
+#include <atomic>
+#include <cstdint>
+
+#include "linux/board.hpp"
+#include "linux/config.hpp"
+#include "linux/preload/state.hpp"
+#include "linux/virtual_scheduler.hpp"
+
+namespace l6470emu::preload {
+
+/// The process's virtual time: clock conversions, covered waits, the busy-wait rule, and the
+/// board's wait for bus time.
+class VirtualHostTime {
+ public:
+  /// Makes `board`'s time the program's; `config` gives the idle grace. Counts the threads that
+  /// exist already (/proc/self/task) as running.
+  VirtualHostTime(Board& board, const TimeConfig& config);
+  ~VirtualHostTime();
+  VirtualHostTime(const VirtualHostTime&) = delete;
+  VirtualHostTime& operator=(const VirtualHostTime&) = delete;
+
+  VirtualScheduler& scheduler() { return scheduler_; }
+
+  /// Whether `clock` follows virtual time: the MONOTONIC, BOOTTIME, REALTIME and TAI families
+  /// (CPU-time clocks stay real).
+  static bool is_virtual_clock(clockid_t clock);
+  /// What `clock` (a virtual one) reads now, ns.
+  std::int64_t now_ns(clockid_t clock) const;
+  /// What `clock` reads at `tick`, ns.
+  std::int64_t ns_at(clockid_t clock, Tick tick) const;
+  /// The first tick at which `clock` reads `ns` or later (an absolute deadline on that clock).
+  Tick tick_at(clockid_t clock, std::int64_t ns) const;
+  /// The first tick at least `ns` from now (a relative timeout; <= 0 is now).
+  Tick tick_after(std::int64_t ns) const;
+
+  /// The tick of the first event queued on emulated line `fd` (kNever: none queued). The board
+  /// stamps an edge a spidev message causes with the message's end, and queues it before the
+  /// program's time gets there: a reader must not see it earlier than that tick.
+  Tick first_event_tick(int fd) const;
+
+  /// A covered wait of the calling thread (ends its busy-wait count).
+  VirtualScheduler::End wait(const VirtualScheduler::Wait& w);
+  /// A look at time that does not block (a clock read, a zero-timeout poll, a gpio value read).
+  /// After kSpinLooks of them in a row without a covered wait, each one first waits a quantum
+  /// of virtual time that doubles from 1 µs to 1 ms: a thread spinning on the clock or on a pin
+  /// lets time pass, deterministically, instead of hanging.
+  void look();
+
+  static constexpr int kSpinLooks = 1000;
+  static constexpr Tick kFirstQuantum = 4;      ///< 1 µs
+  static constexpr Tick kLastQuantum = 4000;    ///< 1 ms
+
+  /// fork(): the scheduler's lock is held across it; the child keeps one thread.
+  void before_fork();
+  void after_fork_parent();
+  void after_fork_child();
+
+ private:
+  class BusWaiter final : public BoardTime::Waiter {
+   public:
+    explicit BusWaiter(VirtualHostTime& vt) : vt_(vt) {}
+    void wait_until(Tick tick) override;
+
+   private:
+    VirtualHostTime& vt_;
+  };
+
+  std::int64_t offset_ns(clockid_t clock) const;
+
+  Board& board_;
+  BoardTime& time_;
+  std::int64_t boottime_offset_ns_;  // real BOOTTIME - MONOTONIC at the start
+  std::int64_t tai_offset_ns_;       // real TAI - REALTIME at the start
+  VirtualScheduler scheduler_;
+  BusWaiter bus_waiter_{*this};
+};
+
+namespace detail {
+extern std::atomic<VirtualHostTime*> g_virtual_time;
+}
+
+/// The process's virtual time, or nullptr in wall mode and for calls from inside the library:
+/// the first thing every replaced time function checks (one atomic load in wall mode).
+inline VirtualHostTime* virtual_time() {
+  VirtualHostTime* vt = detail::g_virtual_time.load(std::memory_order_acquire);
+  return vt && !inside() ? vt : nullptr;
+}
+/// The process's virtual time even from inside the library (nullptr in wall mode).
+inline VirtualHostTime* installed_virtual_time() { return detail::g_virtual_time.load(std::memory_order_acquire); }
+
+/// Whether `p` is null, for arguments glibc's headers declare nonnull (the compiler would drop
+/// a plain test; a program may still pass NULL).
+inline bool is_null(const void* p) {
+  asm("" : "+r"(p));
+  return p == nullptr;
+}
+
+/// Makes `vt` the process's virtual time (LocalBackend, once).
+void install_virtual_time(VirtualHostTime* vt);
+
+// ---- hooks between the intercept_* files ----------------------------------------------
+
+/// intercept_sync.cpp: thread accounting set up (the thread-exit key), and fork hooks of its table.
+void init_thread_tracking();
+void thread_table_before_fork();
+void thread_table_after_fork();
+/// intercept_timerfd.cpp: a virtual timer expired (the scheduler's fire hook).
+void fire_virtual_timerfd(int fd);
+/// intercept_timerfd.cpp: read() of a virtual timerfd. False: `fd` is not one.
+bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result);
+/// intercept_timerfd.cpp: `fd` was closed (or replaced by dup2): forget its timer.
+void forget_virtual_timerfd(int fd);
+void timerfd_table_before_fork();
+void timerfd_table_after_fork();
+/// intercept_poll.cpp: whether descriptor `fd` is an emulated gpio line with edge events.
+bool is_emulated_line(int fd);
+
+}  // namespace l6470emu::preload
