@@ -484,28 +484,44 @@ struct Parser {
 
 }  // namespace
 
-std::string shown_text(std::string_view text, std::size_t max_bytes) {
-  std::string out;
-  const std::size_t n = std::min(text.size(), max_bytes);
-  out.reserve(n + 8);
+namespace {
+
+// shown_text, and whether it had to cut.
+std::string show(std::string_view text, std::size_t max_chars, bool& cut) {
   static constexpr char kHex[] = "0123456789abcdef";
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (is_control(c) || c >= 0x80 || c == '\\') {
+  std::string out;
+  out.reserve(std::min(text.size(), max_chars) + 4);
+  cut = false;
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    const bool escape = is_control(c) || c >= 0x80 || c == '\\';
+    if (out.size() + (escape ? 4 : 1) > max_chars) {
+      cut = true;
+      out += "\u2026";
+      break;
+    }
+    if (escape) {
       out += "\\x";
       out += kHex[c >> 4];
       out += kHex[c & 15];
     } else {
-      out += static_cast<char>(c);
+      out += ch;
     }
   }
-  if (text.size() > max_bytes) out += "\u2026";
   return out;
 }
 
+}  // namespace
+
+std::string shown_text(std::string_view text, std::size_t max_chars) {
+  bool cut = false;
+  return show(text, max_chars, cut);
+}
+
 std::string quoted_text(std::string_view text) {
-  std::string out = "'" + shown_text(text) + "'";
-  if (text.size() > kQuotedTextBytes) out += " (" + std::to_string(text.size()) + " bytes)";
+  bool cut = false;
+  std::string out = "'" + show(text, kQuotedTextChars, cut) + "'";
+  if (cut) out += " (" + std::to_string(text.size()) + " bytes)";
   return out;
 }
 

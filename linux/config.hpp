@@ -73,12 +73,12 @@ inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
 /// and parses it. A directory, a device or an unreadable file is a ConfigError saying so.
 ParseResult load_board_config_file(const std::string& path);
 
-/// How many bytes of a user's text an error message shows.
-inline constexpr std::size_t kQuotedTextBytes = 60;
+/// How many characters of a user's text an error message shows.
+inline constexpr std::size_t kQuotedTextChars = 60;
 
-/// User text made safe for a one-line message: at most `max_bytes` bytes of it, control
-/// characters, backslash and non-ASCII bytes as \xNN, and "…" when cut.
-std::string shown_text(std::string_view text, std::size_t max_bytes = kQuotedTextBytes);
+/// User text made safe for a one-line message: control characters, backslash and non-ASCII
+/// bytes written as \xNN, cut to at most `max_chars` characters plus "…" when longer.
+std::string shown_text(std::string_view text, std::size_t max_chars = kQuotedTextChars);
 
 /// shown_text in single quotes, followed by " (N bytes)" when cut.
 std::string quoted_text(std::string_view text);

@@ -222,6 +222,10 @@ TEST(BoardConfig, QuotedUserTextIsCappedAndControlCharactersEscaped) {
   EXPECT_EQ(error_of("chips=" + huge), "unknown chip variant '" + std::string(60, 'z') + "\u2026' (900000 bytes) (known: " +
                                            known_variant_names() + ")");
   EXPECT_EQ(error_of("chips=L6470 log=a\x01" "b"), "control character in 'log=a\\x01b' (a board description is plain text)");
+  std::string escaped;  // escapes count in the 60 characters shown, and are never cut in half
+  for (int i = 0; i < 15; ++i) escaped += "\\x01";
+  EXPECT_EQ(error_of("chips=" + std::string(100, '\x01')),
+            "control character in 'chips=" + escaped.substr(0, 52) + "\u2026' (106 bytes) (a board description is plain text)");
   EXPECT_EQ(error_of(std::string("chips=L6470 bus=1\0", 18)),
             "control character in 'bus=1\\x00' (a board description is plain text)");
   EXPECT_EQ(error_of("chips=L\xc3\xa9" "6470"), "unknown chip variant 'L\\xc3\\xa96470' (did you mean L6470? known: " +
