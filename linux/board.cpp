@@ -2,6 +2,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/eventfd.h>
+#include <sys/random.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -75,6 +76,9 @@ Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : l
     chains_.push_back(std::move(cd));
   }
   wake_fd_ = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  std::uint64_t seed = 0;
+  if (getrandom(&seed, sizeof seed, 0) != static_cast<ssize_t>(sizeof seed)) seed = static_cast<std::uint64_t>(monotonic_ns());
+  handle_ids_.seed(seed);
 }
 
 Board::~Board() {
@@ -102,7 +106,9 @@ NewFile Board::make_handle(HandleKind kind, std::size_t dev, bool cloexec, std::
   if (!cloexec) fcntl(sv[1], F_SETFD, 0);
   fcntl(sv[0], F_SETFL, O_NONBLOCK);
   out = std::make_unique<Handle>();
-  out->id = next_handle_++;
+  // Handles are unguessable: a daemon client can only name files it was given (a fork()ed
+  // child inherits them), never another program's by counting.
+  do out->id = handle_ids_(); while (out->id == 0 || handles_.count(out->id));
   out->kind = kind;
   out->fd = sv[0];
   out->dev = dev;

@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <random>
 #include <span>
 #include <string>
 #include <thread>
@@ -214,7 +215,7 @@ class Board {
   std::vector<std::unique_ptr<GpioDev>> gpios_;
   std::vector<int> node_target_;  // node index -> chain or gpio index
   std::unordered_map<std::uint64_t, std::unique_ptr<Handle>> handles_;
-  std::uint64_t next_handle_ = 1;
+  std::mt19937_64 handle_ids_;  // seeded from getrandom(): handle ids are capabilities
   MessageObserver observer_;
 
   std::mutex m_;

@@ -1,0 +1,80 @@
+// A fault soak of `l6470emu serve` (bounded in time): 50 preload clients read through one
+// daemon while some are killed with SIGKILL mid-message and others throw garbage at the socket.
+// The daemon keeps serving, the survivors' answers stay exact, and the recording made throughout
+// replays clean after the daemon is stopped with SIGTERM, and after SIGKILL.
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <memory>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "run_program.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+constexpr int kClients = 50;
+constexpr int kKilled = 10;
+constexpr int kGarbage = 4;
+constexpr const char* kReads = "1500";
+
+class DaemonSoak : public ::testing::TestWithParam<int> {
+ protected:
+  void SetUp() override {
+    const std::string why = missing_prerequisites();
+    if (!why.empty()) GTEST_SKIP() << why;
+  }
+};
+
+TEST_P(DaemonSoak, SurvivorsStayExactAndTheRecordingReplaysClean) {
+  const int stop_signal = GetParam();
+  const std::string trace = temp_socket_path("soak") + ".trace";
+  ServeDaemon d("bus=0 cs=0 chips=L6470", {"--record", trace, "--log", "off"});
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  ASSERT_EQ(run_program({system_python(), script("set_mark.py"), "0", "0", "0x12345"}, d.env()).status, 0);
+
+  std::vector<std::unique_ptr<Background>> readers, garbage;
+  for (int i = 0; i < kClients; ++i)
+    readers.push_back(std::make_unique<Background>(
+        std::vector<std::string>{client("spidev_reader"), "/dev/spidev0.0", kReads, "0x03", "0x12345"}, d.env()));
+  for (int i = 0; i < kGarbage; ++i)
+    garbage.push_back(std::make_unique<Background>(
+        std::vector<std::string>{system_python(), script("garbage_client.py"), d.socket(), std::to_string(i), "4"}));
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  for (int i = 0; i < kKilled; ++i) readers[static_cast<std::size_t>(i * (kClients / kKilled))]->stop(SIGKILL);
+
+  int survivors = 0;
+  for (int i = 0; i < kClients; ++i) {
+    if (i % (kClients / kKilled) == 0 && i / (kClients / kKilled) < kKilled) continue;
+    const RunResult r = readers[static_cast<std::size_t>(i)]->wait(120);
+    EXPECT_EQ(r.out, std::string("reads=") + kReads + " torn=0\n") << "client " << i << ": " << r.err;
+    ++survivors;
+  }
+  EXPECT_EQ(survivors, kClients - kKilled);
+  for (auto& g : garbage) {
+    const RunResult r = g->wait(30);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.rfind("sent=", 0), 0u) << r.out;
+  }
+  // Still serving, and the killed clients' files were released.
+  const RunResult after = run_program({client("spidev_reader"), "/dev/spidev0.0", "10", "0x03", "0x12345"}, d.env());
+  EXPECT_EQ(after.out, "reads=10 torn=0\n") << after.err;
+  EXPECT_NE(d.ctl({"dump"}).out.find("spidev0.0: 0 open"), std::string::npos);
+
+  const RunResult stopped = d.process().stop(stop_signal, 30);
+  if (stop_signal == SIGTERM) EXPECT_EQ(stopped.status, 0) << stopped.err;
+  unlink(d.socket().c_str());
+  const RunResult replay = run_program({l6470emu_program(), "replay", trace}, {}, 120);
+  EXPECT_EQ(replay.status, 0) << replay.out << replay.err;
+  EXPECT_NE(replay.out.find(": matched"), std::string::npos) << replay.out;
+  unlink(trace.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(StoppedBySigtermAndBySigkill, DaemonSoak, ::testing::Values(SIGTERM, SIGKILL),
+                         [](const auto& info) { return info.param == SIGTERM ? "Sigterm" : "Sigkill"; });
+
+}  // namespace
+}  // namespace l6470emu::test
