@@ -14,12 +14,21 @@ case "$what" in
       exec /usr/bin/python3 scripts/demo_preload.py "${@:2}"
     ;;
   test)
-    scripts/setup.sh build
-    echo "== tests (RelWithDebInfo) =="
-    ctest --test-dir build --output-on-failure -j"$(nproc)"
-    echo "== tests under AddressSanitizer + UndefinedBehaviorSanitizer =="
-    scripts/setup.sh build-asan -DL6470EMU_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
-    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    # Each stage prints how long it took, and the whole run its total (CI's budget: 45 minutes).
+    started=$SECONDS
+    stage() {
+      local name=$1 t=$SECONDS
+      shift
+      echo "== $name =="
+      "$@"
+      echo "== $name: $((SECONDS - t)) s (total $((SECONDS - started)) s) =="
+    }
+    stage "set up and build (RelWithDebInfo)" scripts/setup.sh build
+    stage "tests (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j"$(nproc)"
+    stage "build with AddressSanitizer + UndefinedBehaviorSanitizer" \
+      scripts/setup.sh build-asan -DL6470EMU_SANITIZE=ON -DCMAKE_BUILD_TYPE=Debug
+    stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer" env \
+      ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       ctest --test-dir build-asan --output-on-failure -j"$(nproc)"
     ;;
   *)
