@@ -65,6 +65,18 @@ void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> r
   const std::size_t n = ring_.size();
   std::uint8_t* ring = ring_.data();
   std::size_t head = head_;
+  if (tx.size() >= n) {
+    // At least a whole chain's worth: MISO is the ring's bytes then tx delayed by n, and the
+    // ring keeps tx's last n bytes, wherever the head ends up.
+    const std::size_t size = tx.size();
+    for (std::size_t i = 0; i < n; ++i) rx[i] = ring[(head + i) % n];
+    std::memcpy(rx.data() + n, tx.data(), size - n);
+    const std::size_t new_head = (head + size) % n;
+    for (std::size_t i = 0; i < n; ++i) ring[(new_head + i) % n] = tx[size - n + i];
+    head_ = new_head;
+    bytes_in_frame_ += size;
+    return;
+  }
   for (std::size_t i = 0; i < tx.size();) {
     const std::size_t run = std::min(tx.size() - i, n - head);
     std::memcpy(rx.data() + i, ring + head, run);

@@ -157,8 +157,11 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
                         std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
   thread_local std::vector<std::uint8_t> wire_tx, wire_rx;
   thread_local std::vector<SpiTransfer> transfers;
+  // Wire buffers for the transfers that have a buffer; bufferless ones (zeros out, nothing in)
+  // need none, however long they are.
   std::size_t total = 0;
-  for (const auto& x : xfers) total += x.len;
+  for (const auto& x : xfers)
+    if (x.tx_buf || x.rx_buf) total += x.len;
   wire_tx.assign(total, 0);
   wire_rx.assign(total, 0);
   const bool lsb_first = (s.mode & SPI_LSB_FIRST) != 0;
@@ -170,7 +173,7 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
       to_wire(tx.data() + tx_off, wire_tx.data() + off, x.len, w, lsb_first);
       tx_off += x.len;
     }
-    off += x.len;
+    if (x.tx_buf || x.rx_buf) off += x.len;
   }
 
   BusTiming timing;
@@ -194,6 +197,17 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
     for (const auto& x : xfers) {
       const std::uint32_t hz = speed_of(x);
       const unsigned w = word_bytes(x.bits_per_word ? x.bits_per_word : s.bits_per_word);
+      if (!x.tx_buf && !x.rx_buf) {
+        // Bufferless: zeros out, MISO dropped; its word delays are time inside the transfer.
+        SpiTransfer t;
+        t.len = x.len;
+        t.speed_hz = hz;
+        t.delay_usecs = x.delay_usecs;
+        t.cs_change = x.cs_change != 0;
+        if (x.word_delay_usecs && x.len > w) t.gap_ticks = ((x.len + w - 1) / w - 1) * ticks_from_us(x.word_delay_usecs);
+        transfers.push_back(t);
+        continue;
+      }
       if (x.word_delay_usecs && x.len > w) {
         // One sub-transfer per word, the word delay between them, CS held.
         for (std::size_t k = 0; k < x.len; k += w) {
@@ -230,7 +244,7 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
       from_wire(wire_rx.data() + off, rx.data() + rx_off, x.len, w, lsb_first);
       rx_off += x.len;
     }
-    off += x.len;
+    if (x.tx_buf || x.rx_buf) off += x.len;
   }
 }
 

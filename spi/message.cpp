@@ -20,12 +20,27 @@ void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const B
     if (!dev.selected()) dev.select();
     const std::uint32_t speed = t.speed_hz ? t.speed_hz : timing.default_speed_hz;
     const Tick per_byte = transfer_ticks(1, speed);
-    for (std::uint32_t k = 0; k < t.len; ++k) {
-      const std::uint8_t out = t.tx.empty() ? 0 : t.tx[k];
-      dev.advance_to(dev.now() + per_byte);
-      const std::uint8_t in = dev.exchange(out);
-      if (!t.rx.empty()) t.rx[k] = in;
+    if (t.tx.empty() && t.rx.empty()) {
+      // No buffers (the kernel allows up to INT_MAX bytes of them): zeros out, MISO dropped,
+      // a block at a time; the bytes carry no time of their own inside a frame, so the block's
+      // time passes first.
+      static constexpr std::uint8_t kZeros[4096] = {};
+      std::uint8_t sink[sizeof kZeros];
+      for (std::uint32_t k = 0; k < t.len;) {
+        const std::uint32_t block = std::min<std::uint32_t>(t.len - k, sizeof kZeros);
+        dev.advance_to(dev.now() + per_byte * block);
+        dev.exchange(std::span<const std::uint8_t>(kZeros, block), std::span<std::uint8_t>(sink, block));
+        k += block;
+      }
+    } else {
+      for (std::uint32_t k = 0; k < t.len; ++k) {
+        const std::uint8_t out = t.tx.empty() ? 0 : t.tx[k];
+        dev.advance_to(dev.now() + per_byte);
+        const std::uint8_t in = dev.exchange(out);
+        if (!t.rx.empty()) t.rx[k] = in;
+      }
     }
+    if (t.gap_ticks) dev.advance_to(dev.now() + t.gap_ticks);
     if (t.delay_usecs) dev.advance_to(dev.now() + ticks_from_us(t.delay_usecs));
     const bool raise = last ? !t.cs_change : t.cs_change;
     if (raise) {

@@ -20,6 +20,7 @@ struct SpiTransfer {
   std::uint32_t speed_hz = 0;        ///< 0 = the device default
   std::uint16_t delay_usecs = 0;     ///< wait after the transfer, before CS changes
   bool cs_change = false;            ///< deselect after this transfer (or stay selected after the last)
+  Tick gap_ticks = 0;                ///< extra time inside the transfer, after its bytes (word delays)
 };
 
 /// Bus timing used to turn bytes into ticks.

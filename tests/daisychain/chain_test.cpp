@@ -310,5 +310,32 @@ TEST(Standby, DiscardsCommandsAddressedToTheChip) {
   EXPECT_EQ(chain.chip(0).peek(Reg::KVAL_RUN), 0x29u);
 }
 
+TEST(ChainShift, ABlockOfBytesShiftsExactlyAsTheSameBytesOneByOne) {
+  std::uint32_t seed = 12345;
+  auto next = [&] { return static_cast<std::uint8_t>((seed = seed * 1103515245u + 12345u) >> 16); };
+  for (std::size_t chips : {1u, 2u, 3u, 8u}) {
+    for (std::size_t len = 0; len <= 40; ++len) {
+      for (std::size_t lead = 0; lead < chips + 2; ++lead) {  // bytes already in the frame: any head
+        Chain block(chips), single(chips);
+        block.select();
+        single.select();
+        for (std::size_t i = 0; i < lead; ++i) {
+          const std::uint8_t b = next();
+          block.exchange(b);
+          single.exchange(b);
+        }
+        std::vector<std::uint8_t> tx(len), rx_block(len), rx_single(len);
+        for (auto& b : tx) b = next();
+        block.exchange(tx, rx_block);
+        for (std::size_t i = 0; i < len; ++i) rx_single[i] = single.exchange(tx[i]);
+        EXPECT_EQ(rx_block, rx_single) << chips << " chips, " << len << " bytes after " << lead;
+        for (std::size_t k = 0; k < chips; ++k)
+          EXPECT_EQ(block.shift_register(k), single.shift_register(k)) << chips << " chips, chip " << k;
+        EXPECT_EQ(block.bytes_in_frame(), single.bytes_in_frame());
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace l6470emu

@@ -237,5 +237,28 @@ TEST(BoardPacing, ABusyEdgeCarriesTheHostClockAtTheTickItHappened) {
   }
 }
 
+TEST(BoardBus, ABufferlessTransferOfTwoGigabytesTakesItsBusTimeWithoutTheMemoryOrTheWork) {
+  FakeHostClock clock;
+  DiagnosticLog log("off");
+  Board board(config_of("bus=0 cs=0 chips=L6470 mode=3; time=virtual"), log, clock);
+  const NewFile f = board.open(0, true);
+  spi_ioc_transfer x{};
+  x.len = 0x7FFFFFF0;  // the kernel's limit (INT_MAX in total); no tx_buf, no rx_buf: zeros out
+  x.speed_hz = 5'000'000;
+  EXPECT_EQ(board.spi_message(f.handle, {&x, 1}, {}, {}), 0x7FFFFFF0);
+  EXPECT_EQ(board.now(0), Tick{0x7FFFFFF0} * transfer_ticks(1, 5'000'000) + ticks_from_us(10));
+  std::vector<std::uint8_t> rx(3);
+  std::vector<spi_ioc_transfer> get_status(3);
+  const std::uint8_t tx[3] = {0xD0, 0, 0};
+  for (int i = 0; i < 3; ++i) {
+    get_status[i].tx_buf = get_status[i].rx_buf = 1;
+    get_status[i].len = 1;
+    get_status[i].cs_change = i < 2;
+  }
+  ASSERT_EQ(board.spi_message(f.handle, get_status, tx, rx), 3);
+  EXPECT_EQ(rx[1] << 8 | rx[2], 0x7C03);  // the zeros were NOPs: power-up STATUS, UVLO latched
+  ::close(f.fd);
+}
+
 }  // namespace
 }  // namespace l6470emu::test
