@@ -9,7 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
   gcc python3 python3-spidev python3-libgpiod gpiod libgpiod-dev umockdev
-  sigrok-cli
+  sigrok-cli clang libclang-rt-14-dev
 )
 
 missing=()

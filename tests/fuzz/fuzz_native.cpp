@@ -1,0 +1,82 @@
+// libFuzzer harness of the native trace reader (spi/trace_native.cpp), from memory and from a
+// file (the streaming path must read the same events or fail on the same line), plus the
+// format dispatcher and the in-process VCD exporter (spi/export_vcd.hpp) on what it reads. The
+// VCD *reader* is sigrok-cli, a separate program: not fuzzed here.
+#include <sys/mman.h>
+#include <unistd.h>
+
+#include "fuzz_support.hpp"
+#include "spi/export_vcd.hpp"
+
+using namespace l6470emu;
+
+namespace {
+
+/// The input as a file (a memfd, named through /proc) for the streaming reader.
+std::string as_file(const std::uint8_t* data, std::size_t size, int& fd) {
+  fd = memfd_create("fuzz.trace", MFD_CLOEXEC);
+  if (fd < 0) return {};
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  return "/proc/self/fd/" + std::to_string(fd);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fuzz::count_input(size);
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  std::string memory_error;
+  Trace from_memory;
+  try {
+    from_memory = read_native_trace(text, "fuzz.trace");
+  } catch (const TraceError& e) {
+    fuzz::check_error_line(e, "fuzz.trace");
+    memory_error = e.what();
+  }
+
+  // The streaming reader on the same bytes.
+  int fd = -1;
+  const std::string path = as_file(data, size, fd);
+  if (!path.empty()) {
+    std::string file_error;
+    Trace from_file;
+    try {
+      NativeTraceReader r(path);
+      from_file.header = r.header();
+      TraceEvent e;
+      while (r.next(e)) from_file.write(e);
+    } catch (const TraceError& e) {
+      file_error = e.what();
+    }
+    ::close(fd);
+    // Same message apart from the file's name.
+    auto strip = [](const std::string& m, const std::string& name) {
+      return m.rfind(name, 0) == 0 ? m.substr(name.size()) : m;
+    };
+    FUZZ_CHECK(strip(memory_error, "fuzz.trace") == strip(file_error, path),
+               "reading from memory and from a file differ:\n  %.300s\n  %.300s", memory_error.c_str(),
+               file_error.c_str());
+    if (memory_error.empty()) fuzz::check_same_events(from_memory, from_file, "memory vs file");
+  }
+
+  // The dispatcher on what detection says (any format).
+  try {
+    const TraceFormat f = detect_trace_format(text.substr(0, 64 * 1024), "fuzz.trace");
+    if (f != TraceFormat::native) (void)import_trace(text, "fuzz.trace", f);
+  } catch (const TraceError& e) {
+    fuzz::check_error_line(e, "fuzz.trace");
+  }
+
+  if (!memory_error.empty()) return 0;
+  fuzz::check_trace(from_memory);
+  fuzz::check_native_round_trip(from_memory);
+  fuzz::decode_and_replay(from_memory);
+  fuzz::NullStream out;
+  export_vcd(from_memory, out, VcdOptions{static_cast<unsigned>(size % 3 == 0 ? 1 : size % 3 == 1 ? 10 : 100)});
+  return 0;
+}
