@@ -12,6 +12,7 @@ namespace {
 
 using detail::FrameBuilder;
 using detail::LineCursor;
+using detail::printable;
 using detail::quote;
 
 enum class Event { none, transfer_start, transfer_stop, set_cs, message_start, message_done };
@@ -72,7 +73,7 @@ class FtraceImporter {
       } else if (device_.empty()) {
         device_ = std::string(p.device);
       } else if (p.device != device_) {
-        fail(lines, "events of several SPI devices (" + device_ + " and " + std::string(p.device) +
+        fail(lines, "events of several SPI devices (" + printable(device_) + " and " + printable(p.device) +
                         "): choose one with --select");
       }
       if (any_time && p.time < last_time)
@@ -134,7 +135,11 @@ class FtraceImporter {
     std::size_t begin = end;
     while (begin > 0 && line[begin - 1] != ' ' && line[begin - 1] != '\t' && line[begin - 1] != ']') --begin;
     const std::string_view ts = line.substr(begin, end - begin);
-    if (!parse_source_time(ts, 0, p.time)) fail(lines, "timestamp " + quote(ts) + " is not a time in seconds");
+    switch (parse_source_time_checked(ts, 0, p.time)) {
+      case TimeParse::ok: break;
+      case TimeParse::out_of_range: fail(lines, "timestamp " + quote(ts) + " is out of range");
+      case TimeParse::malformed: fail(lines, "timestamp " + quote(ts) + " is not a time in seconds");
+    }
     p.device = token(p.rest);
     if (p.device.rfind("spi", 0) != 0) fail(lines, "device " + quote(p.device) + " is not spiB.C");
     return true;
@@ -232,7 +237,7 @@ class FtraceImporter {
     for (char c : len_tok.substr(4)) {
       if (c < '0' || c > '9') fail(lines, "expected len=N, found " + quote(len_tok));
       len = len * 10 + static_cast<unsigned long>(c - '0');
-      if (len > 1'000'000) fail(lines, "transfer length " + std::string(len_tok.substr(4)) + " is too large");
+      if (len > 1'000'000) fail(lines, "transfer length " + quote(len_tok.substr(4)) + " is too large");
     }
     byte_list(lines, tx_tok, "tx", tx_);
     byte_list(lines, rx_tok, "rx", rx_);

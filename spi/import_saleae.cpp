@@ -13,6 +13,7 @@ namespace {
 
 using detail::FrameBuilder;
 using detail::LineCursor;
+using detail::printable;
 using detail::quote;
 
 /// Splits a CSV line into `fields` (outer quotes removed); false on an unterminated quote.
@@ -144,17 +145,30 @@ class SaleaeImporter {
 
   /// Splits a data row and checks its width.
   void row(const LineCursor& lines, std::string_view line) {
-    if (!split_csv(line, fields_)) fail(lines, "unterminated quote in the row " + std::string(line.substr(0, 60)));
+    if (!split_csv(line, fields_)) fail(lines, "unterminated quote in the row " + printable(line));
     if (fields_.size() != columns_)
       fail(lines, std::to_string(fields_.size()) + " fields, the header has " + std::to_string(columns_) + " (" +
-                      header_line_ + ")");
+                      printable(header_line_) + ")");
   }
 
   SourceTime time_field(const LineCursor& lines, int col, const char* what) {
     SourceTime t;
-    if (!parse_source_time(fields_[static_cast<std::size_t>(col)], 0, t))
-      fail(lines, std::string(what) + " " + quote(fields_[static_cast<std::size_t>(col)]) + " is not a time in seconds");
+    const std::string_view text = fields_[static_cast<std::size_t>(col)];
+    switch (parse_source_time_checked(text, 0, t)) {
+      case TimeParse::ok: break;
+      case TimeParse::out_of_range: fail(lines, std::string(what) + " " + quote(text) + " is out of range");
+      case TimeParse::malformed: fail(lines, std::string(what) + " " + quote(text) + " is not a time in seconds");
+    }
     return t;
+  }
+
+  /// The duration column: a time in seconds, not negative, at most 10^6 s (no CS frame or byte is longer).
+  SourceTime duration_field(const LineCursor& lines) {
+    const SourceTime d = time_field(lines, col_duration_, "duration");
+    const std::string_view text = fields_[static_cast<std::size_t>(col_duration_)];
+    if (d < SourceTime{}) fail(lines, "duration " + quote(text) + " is negative");
+    if (d > SourceTime{1'000'000, 0}) fail(lines, "duration " + quote(text) + " is out of range (more than 10^6 s)");
+    return d;
   }
 
   /// Appends the MOSI/MISO bytes of the current row to the frame being built.
@@ -221,7 +235,7 @@ class SaleaeImporter {
       const std::string_view type = fields_[static_cast<std::size_t>(col_type_)];
       const SourceTime t = time_field(lines, col_start_, "start_time");
       SourceTime duration;
-      if (col_duration_ >= 0) duration = time_field(lines, col_duration_, "duration");
+      if (col_duration_ >= 0) duration = duration_field(lines);
       if (type == "result") {
         if (!has_enable) {
           take_bytes(lines);

@@ -1,5 +1,6 @@
-// Shared pieces of the importers (internal to spi/): lines with their numbers, and a
-// builder that turns capture times into ticks while checking that time goes forward.
+// Shared pieces of the readers (internal to spi/): lines with their numbers, quoting input
+// in messages, and a builder that turns capture times into ticks while checking that time
+// goes forward.
 #pragma once
 
 #include <cstdint>
@@ -45,14 +46,37 @@ class LineCursor {
   bool unterminated_ = false;
 };
 
-/// `s` in double quotes, cut at 40 characters, for messages.
-inline std::string quote(std::string_view s) {
-  std::string q = "\"";
-  q.append(s.substr(0, 40));
-  if (s.size() > 40) q += "...";
-  q += '"';
+/// Longest stretch of input a message quotes (bytes; a longer one is cut and ends in "…").
+inline constexpr std::size_t kQuoteMax = 60;
+
+/// Input text for a message: cut after kQuoteMax bytes (never inside a UTF-8 sequence) with
+/// "…" appended, control characters as \xNN, so that one bad token of a huge or binary file
+/// still gives one short, printable line.
+inline std::string printable(std::string_view s) {
+  std::size_t n = s.size();
+  if (n > kQuoteMax) {
+    n = kQuoteMax;
+    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // a UTF-8 continuation byte
+  }
+  std::string q;
+  q.reserve(n + 4);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x20 || c == 0x7F) {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      q += "\\x";
+      q += kHex[c >> 4];
+      q += kHex[c & 15];
+    } else {
+      q += static_cast<char>(c);
+    }
+  }
+  if (n < s.size()) q += "\xE2\x80\xA6";  // "…" in UTF-8
   return q;
 }
+
+/// printable(s) in double quotes.
+inline std::string quote(std::string_view s) { return '"' + printable(s) + '"'; }
 
 /// Appends frames to a Trace in capture order: times become ticks counted from the first
 /// frame's start (rounded to nearest); going backwards or overlapping frames is an error.

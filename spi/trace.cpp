@@ -117,6 +117,10 @@ std::unique_ptr<TraceReader> Trace::reader() const { return std::make_unique<Tra
 // ---------------------------------------------------------------- time
 
 bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
+  return parse_source_time_checked(text, unit_exp10, out) == TimeParse::ok;
+}
+
+TimeParse parse_source_time_checked(std::string_view text, int unit_exp10, SourceTime& out) {
   std::size_t i = 0;
   bool negative = false;
   if (i < text.size() && (text[i] == '-' || text[i] == '+')) negative = text[i++] == '-';
@@ -134,7 +138,7 @@ bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
       break;
     }
   }
-  if (digit_count == 0) return false;
+  if (digit_count == 0) return TimeParse::malformed;
   const std::size_t digits_end = i;
   if (point == std::string_view::npos) point = digit_count;
   long exponent = 0;
@@ -145,12 +149,16 @@ bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
     std::size_t exp_digits = 0;
     for (; i < text.size() && text[i] >= '0' && text[i] <= '9'; ++i, ++exp_digits) {
       exponent = exponent * 10 + (text[i] - '0');
-      if (exponent > 100000) return false;
+      if (exponent > 100000) {
+        // Too many exponent digits to be a time; still tell a number from garbage.
+        while (i < text.size() && text[i] >= '0' && text[i] <= '9') ++i;
+        return i == text.size() ? TimeParse::out_of_range : TimeParse::malformed;
+      }
     }
-    if (exp_digits == 0) return false;
+    if (exp_digits == 0) return TimeParse::malformed;
     if (exp_negative) exponent = -exponent;
   }
-  if (i != text.size()) return false;
+  if (i != text.size()) return TimeParse::malformed;
 
   // Digit k (0-based over the mantissa) stands for 10^(point - 1 - k + exponent + unit) seconds.
   static constexpr std::int64_t kPow10[] = {1,          10,          100,          1000,          10000,
@@ -167,12 +175,12 @@ bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
     if (p >= 0) {
       // seconds += d * 10^p; only sane captures (below 10^18 s) are accepted.
       if (p > 17) {
-        if (d != 0) return false;
+        if (d != 0) return TimeParse::out_of_range;
         continue;
       }
       std::int64_t add = d;
       for (long q = 0; q < p; ++q) add *= 10;
-      if (seconds > 9'000'000'000'000'000'000 - add) return false;
+      if (seconds > 9'000'000'000'000'000'000 - add) return TimeParse::out_of_range;
       seconds += add;
     } else if (p >= -12) {
       ps += d * kPow10[12 + p];
@@ -193,13 +201,14 @@ bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out) {
     }
   }
   out = {seconds, ps};
-  return true;
+  return TimeParse::ok;
 }
 
 bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out) {
   if (t < origin) return false;
+  // 104 days: no capture is that long (compared so that nothing overflows: both are within ±9e18 s).
+  if (t.seconds - 9'000'000 > origin.seconds) return false;
   const std::int64_t ds = t.seconds - origin.seconds;
-  if (ds > 9'000'000) return false;  // 104 days: no capture is that long
   const std::int64_t ps = ds * 1'000'000'000'000 + (t.picoseconds - origin.picoseconds);
   constexpr std::int64_t kPsPerTick = 250'000;
   out = static_cast<Tick>((ps + kPsPerTick / 2) / kPsPerTick);

@@ -168,8 +168,17 @@ struct SourceTime {
   friend auto operator<=>(const SourceTime&, const SourceTime&) = default;
 };
 
-/// Parses a decimal number ("1.25", "-0.5", "1.2e-05", "12345.678901") in units of
-/// 10^unit_exp10 seconds (0 = s, -6 = µs), rounding beyond 1 ps to nearest. False if malformed.
+/// How parsing a capture time went.
+enum class TimeParse : std::uint8_t {
+  ok,
+  malformed,     ///< not a decimal number
+  out_of_range,  ///< a number, but beyond ±9·10^18 s (or with an exponent beyond ±100000)
+};
+
+/// Parses a decimal number ("1.25", "-0.5", ".5", "1.2e-05", "12345.678901") in units of
+/// 10^unit_exp10 seconds (0 = s, -6 = µs), rounding beyond 1 ps to nearest.
+TimeParse parse_source_time_checked(std::string_view text, int unit_exp10, SourceTime& out);
+/// parse_source_time_checked() == TimeParse::ok.
 bool parse_source_time(std::string_view text, int unit_exp10, SourceTime& out);
 
 /// Ticks from `origin` to `t`, rounded to nearest; false when t < origin or the span is too long.

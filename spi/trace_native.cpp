@@ -2,6 +2,11 @@
 // with one flush per event. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
 
+#include "spi/import_support.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <ostream>
@@ -26,12 +31,23 @@ std::string_view next_token(std::string_view& rest) {
   return tok;
 }
 
-std::string quoted(std::string_view s) {
-  std::string q = "\"";
-  q.append(s.substr(0, 40));
-  if (s.size() > 40) q += "...";
-  q += '"';
-  return q;
+std::string quoted(std::string_view s) { return detail::quote(s); }
+
+/// Whether a first word that is not a time was meant as one ("-1", ".5", "nan", "inf").
+bool looks_like_a_time(std::string_view w) {
+  if (w[0] == '-' || w[0] == '+' || w[0] == '.') return true;
+  std::string lower;
+  for (char c : w.substr(0, 9)) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  return lower == "nan" || lower == "inf" || lower == "infinity";
+}
+
+/// A time as the file wrote it (digits and a point, already checked), or as ticks when that is long.
+std::string as_written(std::string_view tok, Tick tick) {
+  return tok.size() <= detail::kQuoteMax ? std::string(tok) : format_seconds(tick);
+}
+
+std::string bad_time(std::string_view tok) {
+  return "bad timestamp " + quoted(tok) + " (seconds from 0, e.g. 0.00100300)";
 }
 
 bool parse_uint(std::string_view s, unsigned long max, unsigned long& out) {
@@ -55,8 +71,18 @@ NativeTraceReader::NativeTraceReader(const std::string& path) {
   header_.format = "native";
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) throw TraceError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-  buffer_.resize(kChunk);
-  read_header();
+  // A small file gets a small buffer (it grows for a line longer than the buffer).
+  struct stat st {};
+  const bool sized = fstat(fileno(file_), &st) == 0 && S_ISREG(st.st_mode) && st.st_size >= 0;
+  buffer_.resize(sized ? std::clamp<std::size_t>(static_cast<std::size_t>(st.st_size) + 1, 4096, kChunk) : kChunk);
+  try {
+    read_header();
+  } catch (...) {
+    // No destructor runs for a constructor that throws: close the file here.
+    std::fclose(file_);
+    file_ = nullptr;
+    throw;
+  }
 }
 
 NativeTraceReader::NativeTraceReader(std::string_view text, std::string name) : text_(text) {
@@ -160,6 +186,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (time_tok.empty() || time_tok[0] == '#') return false;
   if (time_tok[0] < '0' || time_tok[0] > '9') {
     if (time_tok == "chain") fail("'chain' must come before the first event");
+    if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
     fail("unknown line " + quoted(line) + " (expected '<time> frame|pin|fault ...')");
   }
 
@@ -170,7 +197,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     std::size_t i = 0;
     for (; i < time_tok.size() && time_tok[i] >= '0' && time_tok[i] <= '9'; ++i) {
       whole = whole * 10 + static_cast<std::uint64_t>(time_tok[i] - '0');
-      if (whole > 1'000'000'000'000ull) fail("time " + quoted(time_tok) + " is too large");
+      if (whole > 1'000'000'000'000ull) fail("timestamp " + quoted(time_tok) + " is too large (at most 10^12 s)");
     }
     std::uint64_t frac_ticks = 0;
     if (i < time_tok.size() && time_tok[i] == '.') {
@@ -189,15 +216,15 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
           round_up = d >= 5;
         }
       }
-      if (digits == 0) fail("time " + quoted(time_tok) + " is not a number of seconds");
+      if (digits == 0) fail(bad_time(time_tok));
       ps += round_up ? 1 : 0;
       frac_ticks = (ps + 125'000) / 250'000;
     }
-    if (i != time_tok.size()) fail("time " + quoted(time_tok) + " is not a number of seconds");
+    if (i != time_tok.size()) fail(bad_time(time_tok));
     tick = whole * kTicksPerSecond + frac_ticks;
   }
   if (any_event_ && tick < last_tick_)
-    fail("time " + std::string(time_tok) + " s goes backwards (the previous event was at " + format_seconds(last_tick_) +
+    fail("time " + as_written(time_tok, tick) + " s goes backwards (the previous event was at " + format_seconds(last_tick_) +
          " s)");
 
   e = TraceEvent{};
@@ -207,7 +234,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (kind == "frame") {
     e.kind = TraceEventKind::frame;
     if (tick < last_frame_end_)
-      fail("frame at " + std::string(time_tok) + " s starts before the previous frame ended (" +
+      fail("frame at " + as_written(time_tok, tick) + " s starts before the previous frame ended (" +
            format_seconds(last_frame_end_) + " s)");
     mosi_.clear();
     miso_.clear();

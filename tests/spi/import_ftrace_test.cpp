@@ -99,5 +99,10 @@ TEST(FtraceImport, RejectsBadInputWithOneLineErrors) {
             "/sys/kernel/tracing/events/spi/enable)");
 }
 
+TEST(FtraceImport, RefusesATimestampOutOfRange) {
+  EXPECT_EQ(error_of("     stepper-812     [002] .....  1e999: spi_transfer_stop: spi0.0 01 len=1 tx=[21] rx=[00]\n"),
+            "trace.txt:1: timestamp \"1e999\" is out of range");
+}
+
 }  // namespace
 }  // namespace l6470emu

@@ -175,5 +175,37 @@ TEST(SaleaeImport, RejectsBadInputWithOneLineErrors) {
   EXPECT_EQ(error_of(kHeader), "capture.csv: no SPI frames in the file");
 }
 
+TEST(SaleaeImport, RefusesANegativeDuration) {
+  const std::string open = "\"SPI\",\"enable\",0.1,2e-08,,\n";
+  EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,-1,0xD0,0x00\n"),
+            "capture.csv:3: duration \"-1\" is negative");
+  EXPECT_EQ(error_of(kHeader + "\"SPI\",\"result\",0.1,-1e-06,0xD0,0x00\n"), "capture.csv:2: duration \"-1e-06\" is negative");
+  EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e300,0xD0,0x00\n"),
+            "capture.csv:3: duration \"1e300\" is out of range");
+}
+
+TEST(SaleaeImport, AcceptsTimesWithALeadingDotAsSaleaeWritesThem) {
+  const Trace t = import_saleae_csv(kHeader +
+                                        "\"SPI\",\"enable\",.5,2e-08,,\n"
+                                        "\"SPI\",\"result\",.5000002,1.6e-06,0xD0,0x00\n"
+                                        "\"SPI\",\"disable\",.500006,.00000002,,\n",
+                                    "dot.csv");
+  ASSERT_EQ(t.frame_count(), 1u);
+  EXPECT_DOUBLE_EQ(t[0].source_time, 0.5);
+  EXPECT_EQ(t[0].duration, 24u);  // 6 µs
+  const Trace logic1 = import_saleae_csv("Time [s],Packet ID,MOSI,MISO\n.25,0,0xD0,0x00\n", "l1.csv");
+  EXPECT_DOUBLE_EQ(logic1[0].source_time, 0.25);
+}
+
+TEST(SaleaeImport, QuotesAHugeBadValueShortAndEscaped) {
+  const std::string open = "\"SPI\",\"enable\",0.1,2e-08,,\n";
+  const std::string huge(10'000'000, 'Z');
+  const std::string e = error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0x" + huge + ",0x00\n");
+  EXPECT_LT(e.size(), 200u);
+  EXPECT_EQ(e, "capture.csv:3: MOSI \"0x" + std::string(58, 'Z') + "\u2026\" is not a byte");
+  EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0x\x1b[2J\x07,0x00\n"),
+            "capture.csv:3: MOSI \"0x\\x1B[2J\\x07\" is not a byte");
+}
+
 }  // namespace
 }  // namespace l6470emu

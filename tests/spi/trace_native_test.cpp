@@ -1,6 +1,7 @@
 // The native trace format (docs/trace-format.md): exact times, round trips, streaming
 // across read chunks, flushing event by event, and one-line errors for malformed lines.
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -209,6 +210,41 @@ TEST(NativeTrace, CannotOpenAMissingFileSaysSo) {
   } catch (const TraceError& e) {
     EXPECT_EQ(std::string(e.what()), "/nonexistent/x.trace: cannot open: No such file or directory");
   }
+}
+
+TEST(NativeTrace, SaysBadTimestampForNanInfAndNegativeTimes) {
+  const std::string head = "l6470emu-trace 1\n";
+  for (const char* t : {"nan", "inf", "-1", "-inf", "+5", ".5", "1.", "1.2.3", "1e5"})
+    EXPECT_EQ(error_of(head + t + " frame D0\n"),
+              "t.trace:2: bad timestamp \"" + std::string(t) + "\" (seconds from 0, e.g. 0.00100300)")
+        << t;
+  EXPECT_EQ(error_of(head + "9999999999999 frame D0\n"),
+            "t.trace:2: timestamp \"9999999999999\" is too large (at most 10^12 s)");
+}
+
+TEST(NativeTrace, QuotesAHugeBadTokenShortAndEscapesControlCharacters) {
+  const std::string head = "l6470emu-trace 1\n";
+  const std::string e = error_of(head + "0 frame " + std::string(10'000'000, 'Q') + "\n");
+  EXPECT_EQ(e, "t.trace:2: MOSI \"" + std::string(60, 'Q') + "\u2026\" is not a byte (two hex digits)");
+  EXPECT_EQ(error_of(head + "0 frame D0 \x1b]0;owned\x07\n"),
+            "t.trace:2: MOSI \"\\x1B]0;owned\\x07\" is not a byte (two hex digits)");
+  // A cut never splits a UTF-8 character.
+  const std::string mu = error_of(head + "0 pin 0 " + std::string(59, 'a') + "\u00b5\u00b5 1\n");
+  EXPECT_NE(mu.find(std::string(59, 'a') + "\u2026"), std::string::npos) << mu;
+}
+
+TEST(NativeTrace, ClosesItsFileWhenTheHeaderIsMalformed) {
+  TempDir dir;
+  const std::string path = dir.file("bad.trace");
+  std::ofstream(path) << "not a trace\n";
+  auto open_descriptors = [] {
+    int n = 0;
+    for (int fd = 0; fd < 4096; ++fd) n += fcntl(fd, F_GETFD) != -1;
+    return n;
+  };
+  const int before = open_descriptors();
+  for (int i = 0; i < 50; ++i) EXPECT_THROW(NativeTraceReader r(path), TraceError);
+  EXPECT_EQ(open_descriptors(), before);
 }
 
 }  // namespace

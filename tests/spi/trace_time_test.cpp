@@ -70,5 +70,23 @@ TEST(HexBytes, MarksUnknownBytes) {
   EXPECT_EQ(hex_bytes(b, known), "0A ?? 12");
 }
 
+TEST(SourceTime, TellsANumberOutOfRangeFromOneThatIsMalformed) {
+  SourceTime t;
+  EXPECT_EQ(parse_source_time_checked("1e308", -6, t), TimeParse::out_of_range);
+  EXPECT_EQ(parse_source_time_checked("-1e19", 0, t), TimeParse::out_of_range);
+  EXPECT_EQ(parse_source_time_checked("1e9999999", 0, t), TimeParse::out_of_range);
+  EXPECT_EQ(parse_source_time_checked("1e9999999x", 0, t), TimeParse::malformed);
+  EXPECT_EQ(parse_source_time_checked("nan", 0, t), TimeParse::malformed);
+  EXPECT_EQ(parse_source_time_checked(".5", 0, t), TimeParse::ok);
+  EXPECT_EQ(t, (SourceTime{0, 500'000'000'000}));
+}
+
+TEST(TicksBetween, RefusesSpansTooLongWithoutOverflowing) {
+  Tick t = 0;
+  EXPECT_FALSE(ticks_between(parse("-9e17"), parse("9e17"), t));
+  EXPECT_FALSE(ticks_between(parse("0"), parse("9000001"), t));
+  EXPECT_TRUE(ticks_between(parse("0"), parse("9000000"), t));
+}
+
 }  // namespace
 }  // namespace l6470emu
