@@ -72,5 +72,47 @@ TEST(SigrokImport, RejectsBadInputWithOneLineErrors) {
   EXPECT_EQ(error_of(doc({})), "spi.json: no spi decoder annotations (run sigrok-cli -P spi:...:cs=CS --protocol-decoder-jsontrace)");
 }
 
+TEST(SigrokImport, RefusesATimestampOutOfRange) {
+  EXPECT_EQ(error_of(doc({"{\"ph\": \"B\", \"ts\": 1e308, \"pid\": \"spi-1\", \"tid\": \"MOSI transfer\", \"name\": \"21\"}",
+                          "{\"ph\": \"E\", \"ts\": 1e308, \"pid\": \"spi-1\", \"tid\": \"MOSI transfer\", \"name\": \"21\"}"})),
+            "spi.json:2: \"ts\" \"1e308\" is out of range (a time in microseconds)");
+  // Beyond a double: nlohmann-json's own overflow error, still with the line.
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n{\"ph\": \"B\", \"ts\": 1e999}]}"), "spi.json:2: number \"1e999\" is out of range");
+}
+
+TEST(SigrokImport, RefusesDeepNestingWithAnErrorInsteadOfACrash) {
+  // 200000 nested arrays crashed the recursive reader before nlohmann-json's SAX parser.
+  EXPECT_EQ(error_of("{\"traceEvents\": [{\"args\": " + std::string(200'000, '[')),
+            "spi.json:1: JSON nested deeper than 512 levels (not a sigrok-cli trace)");
+  EXPECT_EQ(error_of(std::string(200'000, '[') + std::string(200'000, ']')),
+            "spi.json:1: the array of events holds something other than event objects");
+  // Nesting a real trace has (and a little more in "args") is fine.
+  std::string nested = "{\"traceEvents\": [{\"ph\": \"B\", \"ts\": 1, \"pid\": \"spi-1\", \"tid\": \"MOSI data\", "
+                       "\"name\": \"21\", \"args\": " + std::string(400, '[') + std::string(400, ']') + "}, " +
+                       ev("E", 2.0, "MOSI data", "21") + "]}";
+  EXPECT_EQ(import_sigrok_json(nested, "n.json").frame_count(), 1u);
+}
+
+TEST(SigrokImport, NamesTheLineOfASyntaxErrorFromItsByteOffset) {
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n" + ev("B", 1.0, "MOSI transfer", "21") + ",\n\n{\"ph\" \"E\"}]}"),
+            "spi.json:4: malformed JSON: unexpected string literal; expected ':' at \"\"E\"\"");
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n{\"ph\": \"B\",\n\"ts\": \"1.0\"}]}"), "spi.json:3: \"ts\" must be a number");
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n{\"ph\": 1}]}"), "spi.json:2: \"ph\" must be a string");
+  EXPECT_EQ(error_of("{\"traceEvents\": {}}"), "spi.json:1: \"traceEvents\" must be an array of events");
+  EXPECT_EQ(error_of("{\"other\": []}"),
+            "spi.json: no \"traceEvents\" array (expected sigrok-cli --protocol-decoder-jsontrace output)");
+  EXPECT_EQ(error_of("{\"traceEvents\": [\n\"x\"]}"), "spi.json:2: \"traceEvents\" holds something other than event objects");
+  EXPECT_EQ(error_of("{\"traceEvents\": []}\n\n[]"), "spi.json:3: malformed JSON: unexpected '['; expected end of input");
+}
+
+TEST(SigrokImport, SaysWhatATruncatedFileWasCutShortIn) {
+  const std::string head = "{\"traceEvents\": [\n" + ev("B", 1.0, "MOSI transfer", "21");
+  EXPECT_EQ(error_of(head), "spi.json:2: unexpected end of file, expected ',' (truncated file?)");
+  EXPECT_EQ(error_of(head + ",\n"), "spi.json:3: unexpected end of file, expected a value (truncated file?)");
+  EXPECT_EQ(error_of(head + ",\n{\"ph\""), "spi.json:3: unexpected end of file, expected ':' (truncated file?)");
+  EXPECT_EQ(error_of(head + ",\n{\"ph\": \"E"), "spi.json:3: unterminated string (truncated file?)");
+  EXPECT_EQ(error_of(head + ",\n{"), "spi.json:3: unexpected end of file, expected '\"' (truncated file?)");
+}
+
 }  // namespace
 }  // namespace l6470emu

@@ -45,5 +45,19 @@ TEST(ImportTrace, RefusesALogicCaptureWithoutSigrokAndAnUnknownFormat) {
   }
 }
 
+TEST(TraceFormatDetection, SendsDeeplyNestedJsonToTheSigrokReaderWhichRefusesItCleanly) {
+  // Whatever the file's name, JSON with "traceEvents" is read as sigrok's trace; 200000 nested
+  // arrays once overflowed the stack of the reader.
+  const std::string deep = "{\"traceEvents\": [{\"args\": " + std::string(200'000, '[');
+  const TraceFormat f = detect_trace_format(deep.substr(0, 65536), "capture.csv");
+  ASSERT_EQ(f, TraceFormat::sigrok);
+  try {
+    import_trace(deep, "capture.csv", f);
+    ADD_FAILURE() << "no error";
+  } catch (const TraceError& e) {
+    EXPECT_STREQ(e.what(), "capture.csv:1: JSON nested deeper than 512 levels (not a sigrok-cli trace)");
+  }
+}
+
 }  // namespace
 }  // namespace l6470emu
