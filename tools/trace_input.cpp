@@ -1,12 +1,18 @@
 // Trace files for the CLI: format detection on the first 64 KiB, sigrok-cli as a child
-// process (posix_spawnp, stdout through a pipe, stderr to a temporary file).
+// process (fork/exec, stdout through a pipe, stderr to a temporary file, a time limit, and
+// killed with us).
 #include "tools/trace_input.hpp"
 
-#include <spawn.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -17,8 +23,6 @@
 
 #include "daisychain/chain_spec.hpp"
 #include "spi/trace_native.hpp"
-
-extern char** environ;
 
 namespace l6470emu {
 namespace {
@@ -57,6 +61,15 @@ TraceFormat format_of(const std::string& path, const TraceInputOptions& options)
 
 }  // namespace
 
+static std::chrono::seconds sigrok_time_limit(const std::string& path, const TraceInputOptions& options) {
+  if (options.sigrok_time_limit.count() > 0) return options.sigrok_time_limit;
+  // sigrok-cli decodes a VCD at roughly 1 MB/s on a slow machine: 1 s per 100 kB leaves room,
+  // and no capture gets less than 30 s.
+  struct stat st {};
+  const std::uintmax_t size = ::stat(path.c_str(), &st) == 0 && st.st_size > 0 ? static_cast<std::uintmax_t>(st.st_size) : 0;
+  return std::chrono::seconds(std::max<std::uintmax_t>(30, size / 100'000));
+}
+
 std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOptions& options) {
   std::vector<std::string> args = {options.sigrok_cli};
   if (!ends_with(path, ".sr")) {
@@ -68,43 +81,94 @@ std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOpti
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  const auto limit = sigrok_time_limit(path, options);
 
   int out_pipe[2];
-  if (pipe(out_pipe) != 0) throw TraceError(path, 0, std::string("pipe: ") + std::strerror(errno));
+  if (pipe2(out_pipe, O_CLOEXEC) != 0) throw TraceError(path, 0, std::string("pipe: ") + std::strerror(errno));
   char err_path[] = "/tmp/l6470emu-sigrok-XXXXXX";
-  const int err_fd = mkstemp(err_path);
-  if (err_fd < 0) throw TraceError(path, 0, std::string("mkstemp: ") + std::strerror(errno));
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, out_pipe[1], 1);
-  posix_spawn_file_actions_adddup2(&actions, err_fd, 2);
-  posix_spawn_file_actions_addclose(&actions, out_pipe[0]);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  close(out_pipe[1]);
-  std::string out;
-  if (rc == 0) {
-    char buf[1 << 16];
-    for (;;) {
-      const ssize_t got = read(out_pipe[0], buf, sizeof buf);
-      if (got > 0) out.append(buf, static_cast<std::size_t>(got));
-      else if (got == 0 || errno != EINTR) break;
-    }
+  const int err_fd = mkostemp(err_path, O_CLOEXEC);
+  if (err_fd < 0) {
+    close(out_pipe[0]);
+    close(out_pipe[1]);
+    throw TraceError(path, 0, std::string("mkstemp: ") + std::strerror(errno));
   }
-  close(out_pipe[0]);
+  // A pipe that reports whether exec failed (it closes on a successful exec).
+  int exec_pipe[2];
+  if (pipe2(exec_pipe, O_CLOEXEC) != 0) {
+    close(out_pipe[0]);
+    close(out_pipe[1]);
+    close(err_fd);
+    unlink(err_path);
+    throw TraceError(path, 0, std::string("pipe: ") + std::strerror(errno));
+  }
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // The child: only async-signal-safe calls until exec. sigrok-cli dies with us (SIGKILL of
+    // l6470emu must not leave it running), and gets our stdout pipe and the stderr file.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);  // the parent died before prctl
+    dup2(out_pipe[1], 1);
+    dup2(err_fd, 2);
+    execvp(argv[0], argv.data());
+    const int e = errno;
+    [[maybe_unused]] const ssize_t n = write(exec_pipe[1], &e, sizeof e);
+    _exit(127);
+  }
+  const int fork_errno = errno;
+  close(out_pipe[1]);
+  close(exec_pipe[1]);
+  auto cleanup = [&] {
+    close(out_pipe[0]);
+    close(exec_pipe[0]);
+    close(err_fd);
+    unlink(err_path);
+  };
+  if (pid < 0) {
+    cleanup();
+    throw TraceError(path, 0, std::string("fork: ") + std::strerror(fork_errno));
+  }
+  int exec_errno = 0;
+  if (read(exec_pipe[0], &exec_errno, sizeof exec_errno) == static_cast<ssize_t>(sizeof exec_errno)) {
+    waitpid(pid, nullptr, 0);
+    cleanup();
+    throw TraceError(path, 0, "cannot run " + options.sigrok_cli + " (" + std::strerror(exec_errno) +
+                                  "): install the sigrok-cli package to read logic captures");
+  }
+
+  // Its output, until it closes stdout or the time limit passes.
+  std::string out;
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  bool timed_out = false;
+  char buf[1 << 16];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) {
+      timed_out = true;
+      break;
+    }
+    pollfd p{out_pipe[0], POLLIN, 0};
+    const int r = poll(&p, 1, static_cast<int>(std::min<std::int64_t>(left.count(), 1000)));
+    if (r < 0 && errno != EINTR) break;
+    if (r <= 0) continue;
+    const ssize_t got = read(out_pipe[0], buf, sizeof buf);
+    if (got > 0) out.append(buf, static_cast<std::size_t>(got));
+    else if (got == 0 || errno != EINTR) break;
+  }
+  if (timed_out) kill(pid, SIGKILL);
   int status = 0;
-  if (rc == 0) waitpid(pid, &status, 0);
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
   std::string err;
   {
     std::ifstream e(err_path);
     std::getline(e, err);
   }
-  close(err_fd);
-  unlink(err_path);
-  if (rc != 0)
-    throw TraceError(path, 0, "cannot run " + options.sigrok_cli + " (" + std::strerror(rc) +
-                                  "): install the sigrok-cli package to read logic captures");
+  cleanup();
+  if (timed_out)
+    throw TraceError(path, 0, "sigrok-cli did not finish within " + std::to_string(limit.count()) +
+                                  " s and was stopped (a malformed capture, or one too long: cut it, or give "
+                                  "-I vcd:compress=N to sigrok-cli yourself)");
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw TraceError(path, 0, "sigrok-cli failed" + (err.empty() ? std::string() : ": " + err));
   if (out.empty()) throw TraceError(path, 0, "sigrok-cli decoded nothing (check the channel names: --sigrok-decoder)");

@@ -3,6 +3,7 @@
 // choosing the chain to run it through. No replay or decode logic here.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -21,6 +22,8 @@ struct TraceInputOptions {
   /// sigrok-cli's spi decoder with its channel names, for VCD and .sr captures (mode 3).
   std::string sigrok_decoder = "spi:clk=SCK:mosi=MOSI:miso=MISO:cs=CS:cpol=1:cpha=1";
   std::string sigrok_cli = "sigrok-cli";  ///< the program to run
+  /// How long sigrok-cli may take before it is stopped; 0 = by the file's size (1 s per 100 kB, at least 30 s).
+  std::chrono::seconds sigrok_time_limit{0};
 };
 
 /// A trace file, opened: native traces are streamed from disk on every pass (any length),
@@ -47,7 +50,8 @@ class TraceFile {
 };
 
 /// Runs sigrok-cli's spi decoder over a logic capture (VCD or .sr) and returns its JSON
-/// trace. Throws TraceError when sigrok-cli is missing or fails (with its message).
+/// trace. Throws TraceError when sigrok-cli is missing, fails (with its message) or takes
+/// longer than the time limit (it is killed then). sigrok-cli is killed too if this process dies.
 std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOptions& options);
 
 /// The chain a trace runs through: `spec` when given, else the trace's own chain line, else
