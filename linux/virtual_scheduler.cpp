@@ -54,6 +54,19 @@ class Locked {
   std::unique_lock<std::mutex> lock_;
 };
 
+// Runs `f` when the scope ends, also when a cancelled thread unwinds through it.
+template <typename F>
+class OnExit {
+ public:
+  explicit OnExit(F f) : f_(std::move(f)) {}
+  ~OnExit() { f_(); }
+  OnExit(const OnExit&) = delete;
+  OnExit& operator=(const OnExit&) = delete;
+
+ private:
+  F f_;
+};
+
 timespec to_timespec(std::int64_t ns) {
   return {static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
 }
@@ -62,10 +75,13 @@ timespec to_timespec(std::int64_t ns) {
 
 struct VirtualScheduler::Waiter {
   const Wait* w = nullptr;
+  pthread_t owner = pthread_self();
   int fd = -1;  // the waiting thread's wake-up eventfd
   std::uint64_t seq = 0;
   std::atomic<bool> done{false};
   End end = End::timed_out;
+  bool deciding = false;  // its own thread is deciding: no need to wake it through the eventfd
+  bool woken = false;     // the eventfd was written for it
 };
 
 VirtualScheduler::VirtualScheduler(Hooks hooks, std::int64_t idle_ns, int threads)
@@ -91,13 +107,29 @@ VirtualScheduler::End VirtualScheduler::wait(const Wait& w) {
     waiters_.push_back(&me);
     --running_;
     touch();
+    me.deciding = true;
     decide_locked(false);
+    me.deciding = false;
   }
+  const OnExit leave([&] { leave_wait(me); });
   if (w.after_register && !w.after_register()) {
     Locked lock(m_);
     if (!me.done.load(std::memory_order_acquire)) end_locked(me, End::aborted);
   }
   return block(me);
+}
+
+void VirtualScheduler::leave_wait(Waiter& me) {
+  {
+    Locked lock(m_);
+    if (!me.done.load(std::memory_order_acquire)) {  // a thread cancelled in its wait, or wait_in
+      me.done.store(true, std::memory_order_release);
+      ++running_;
+    }
+    remove_locked(me);
+    touch();
+  }
+  if (me.woken) t_wake.drain();
 }
 
 VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
@@ -155,12 +187,6 @@ VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
       decide_locked(true);
     }
   }
-  {
-    Locked lock(m_);
-    remove_locked(me);
-    touch();
-  }
-  t_wake.drain();
   return me.end;
 }
 
@@ -180,27 +206,20 @@ void VirtualScheduler::wait_in(const Wait& w, const std::function<void()>& block
       decide_locked(false);
     }
   }
+  const OnExit leave([&] {
+    if (counted) leave_wait(me);
+  });
   block_fn();
-  if (!counted) return;
-  {
-    Locked lock(m_);
-    if (!me.done.load(std::memory_order_acquire)) {
-      me.done.store(true, std::memory_order_release);
-      ++running_;
-    }
-    remove_locked(me);
-    touch();
-  }
-  t_wake.drain();
 }
 
 void VirtualScheduler::end_locked(Waiter& w, End how) {
   w.end = how;
   w.done.store(true, std::memory_order_release);
   ++running_;
-  if (w.fd >= 0) {
+  if (w.fd >= 0 && !w.deciding) {
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(w.fd, &one, sizeof one);
+    w.woken = true;
   }
 }
 
@@ -281,6 +300,18 @@ int VirtualScheduler::notify(const void* object, bool all) {
     ++n;
     if (!all) break;
   }
+  return n;
+}
+
+int VirtualScheduler::interrupt(pthread_t thread) {
+  if (t_holds_lock) return 0;
+  Locked lock(m_);
+  int n = 0;
+  for (Waiter* w : waiters_)
+    if (!w->done.load(std::memory_order_relaxed) && pthread_equal(w->owner, thread)) {
+      end_locked(*w, End::interrupted);
+      ++n;
+    }
   return n;
 }
 

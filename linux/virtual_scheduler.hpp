@@ -5,6 +5,7 @@
 #pragma once
 
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
 
 #include <atomic>
@@ -91,6 +92,9 @@ class VirtualScheduler {
   /// Ends the wait of the first waiter on `object` (all of them with `all`), in registration
   /// order, as notified. Returns how many were woken.
   int notify(const void* object, bool all);
+  /// Ends the waits of thread `thread` as interrupted (pthread_cancel: the thread then acts on
+  /// the cancellation as it leaves). Returns how many were ended.
+  int interrupt(pthread_t thread);
   /// Hands one unit of `object` (a semaphore post) to its first waiter. False: nobody waits on
   /// it (or this thread already holds the scheduler's lock: a post from a signal handler), and the
   /// caller posts for real.
@@ -123,6 +127,7 @@ class VirtualScheduler {
   struct Waiter;
 
   End block(Waiter& me);
+  void leave_wait(Waiter& me);
   void decide_locked(bool forced);
   bool wake_ready_locked();
   void end_locked(Waiter& w, End how);

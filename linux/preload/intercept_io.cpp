@@ -231,10 +231,24 @@ __attribute__((visibility("default"))) int ioctl(int fd, unsigned long request, 
 __attribute__((visibility("default"))) ssize_t read(int fd, void* buf, size_t count) {
   FdEntry* e = fd_entry(fd);
   if (!e || inside()) {
-    ssize_t r;
-    if (!e && read_virtual_timerfd(fd, buf, count, &r)) return r;
+    if (!e && virtual_timerfds_exist() && !inside()) {
+      ssize_t r = 0;
+      if (as_cancellation_point([&]() __attribute__((noinline)) { return read_virtual_timerfd(fd, buf, count, &r); }))
+        return r;
+    }
     return real::read(fd, buf, count);
   }
+  // Virtual time: a read of gpio events may wait, a cancellation point acted on out here.
+  if (installed_virtual_time())
+    return as_cancellation_point([&]() __attribute__((noinline)) -> ssize_t {
+      Guard guard;
+      try {
+        return emulated_read(fd, *e, buf, count);
+      } catch (...) {
+        errno = ENOMEM;
+        return -1;
+      }
+    });
   Guard guard;
   try {
     return emulated_read(fd, *e, buf, count);

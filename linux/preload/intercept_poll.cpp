@@ -175,12 +175,14 @@ void __chk_fail(void) __attribute__((noreturn));
 __attribute__((visibility("default"))) int poll(struct pollfd* fds, nfds_t n, int timeout_ms) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::poll(fds, n, timeout_ms);
-  Guard guard;
-  try {
-    return virtual_poll(*vt, fds, n, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
-  } catch (...) {
-    return real::poll(fds, n, timeout_ms);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_poll(*vt, fds, n, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
+    } catch (...) {
+      return real::poll(fds, n, timeout_ms);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int __poll_chk(struct pollfd* fds, nfds_t n, int timeout_ms, size_t fdslen) {
@@ -192,12 +194,14 @@ __attribute__((visibility("default"))) int ppoll(struct pollfd* fds, nfds_t n, c
                                                  const sigset_t* mask) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || (timeout && !valid(*timeout))) return real::ppoll(fds, n, timeout, mask);
-  Guard guard;
-  try {
-    return virtual_poll(*vt, fds, n, timeout ? to_ns(*timeout) : -1, mask);
-  } catch (...) {
-    return real::ppoll(fds, n, timeout, mask);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_poll(*vt, fds, n, timeout ? to_ns(*timeout) : -1, mask);
+    } catch (...) {
+      return real::ppoll(fds, n, timeout, mask);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int __ppoll_chk(struct pollfd* fds, nfds_t n, const struct timespec* timeout,
@@ -210,60 +214,70 @@ __attribute__((visibility("default"))) int select(int nfds, fd_set* r, fd_set* w
   VirtualHostTime* vt = virtual_time();
   if (!vt || nfds < 0 || (timeout && (timeout->tv_sec < 0 || timeout->tv_usec < 0 || timeout->tv_usec >= 1'000'000)))
     return real::select(nfds, r, w, e, timeout);
-  Guard guard;
-  try {
-    const std::int64_t ns = timeout ? (std::int64_t{timeout->tv_sec} * 1'000'000 + timeout->tv_usec) * 1000 : -1;
-    return virtual_select(*vt, nfds, r, w, e, ns, nullptr, timeout);
-  } catch (...) {
-    return real::select(nfds, r, w, e, timeout);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      const std::int64_t ns = timeout ? (std::int64_t{timeout->tv_sec} * 1'000'000 + timeout->tv_usec) * 1000 : -1;
+      return virtual_select(*vt, nfds, r, w, e, ns, nullptr, timeout);
+    } catch (...) {
+      return real::select(nfds, r, w, e, timeout);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int pselect(int nfds, fd_set* r, fd_set* w, fd_set* e,
                                                    const struct timespec* timeout, const sigset_t* mask) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || nfds < 0 || (timeout && !valid(*timeout))) return real::pselect(nfds, r, w, e, timeout, mask);
-  Guard guard;
-  try {
-    return virtual_select(*vt, nfds, r, w, e, timeout ? to_ns(*timeout) : -1, mask, nullptr);
-  } catch (...) {
-    return real::pselect(nfds, r, w, e, timeout, mask);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_select(*vt, nfds, r, w, e, timeout ? to_ns(*timeout) : -1, mask, nullptr);
+    } catch (...) {
+      return real::pselect(nfds, r, w, e, timeout, mask);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int epoll_wait(int epfd, struct epoll_event* events, int max, int timeout_ms) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || max <= 0) return real::epoll_wait(epfd, events, max, timeout_ms);
-  Guard guard;
-  try {
-    return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
-  } catch (...) {
-    return real::epoll_wait(epfd, events, max, timeout_ms);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
+    } catch (...) {
+      return real::epoll_wait(epfd, events, max, timeout_ms);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int epoll_pwait(int epfd, struct epoll_event* events, int max, int timeout_ms,
                                                        const sigset_t* mask) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || max <= 0) return real::epoll_pwait(epfd, events, max, timeout_ms, mask);
-  Guard guard;
-  try {
-    return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, mask);
-  } catch (...) {
-    return real::epoll_pwait(epfd, events, max, timeout_ms, mask);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, mask);
+    } catch (...) {
+      return real::epoll_pwait(epfd, events, max, timeout_ms, mask);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int epoll_pwait2(int epfd, struct epoll_event* events, int max,
                                                         const struct timespec* timeout, const sigset_t* mask) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || max <= 0 || (timeout && !valid(*timeout))) return real::epoll_pwait2(epfd, events, max, timeout, mask);
-  Guard guard;
-  try {
-    return virtual_epoll(*vt, epfd, events, max, timeout ? to_ns(*timeout) : -1, mask);
-  } catch (...) {
-    return real::epoll_pwait2(epfd, events, max, timeout, mask);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_epoll(*vt, epfd, events, max, timeout ? to_ns(*timeout) : -1, mask);
+    } catch (...) {
+      return real::epoll_pwait2(epfd, events, max, timeout, mask);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int epoll_ctl(int epfd, int op, int fd, struct epoll_event* event) noexcept {

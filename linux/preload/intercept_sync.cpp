@@ -1,7 +1,7 @@
 // Replaced thread and in-process synchronisation calls for virtual host time: pthread_create and
 // pthread_join (the scheduler counts threads and sees joins), condition variables (waits with
 // virtual timeouts; signal/broadcast hand the wake-up over deterministically) and semaphores
-// (sem_post hands the unit to the first waiter). Mutexes, rwlocks and process-shared objects used
+// (sem_post hands the unit to the first waiter; sem_trywait only informs the busy-wait rule). Mutexes, rwlocks and process-shared objects used
 // from another process are not virtualised. In wall mode every call goes to the C library.
 #include <errno.h>
 #include <pthread.h>
@@ -205,49 +205,71 @@ __attribute__((visibility("default"))) int pthread_create(pthread_t* t, const pt
 __attribute__((visibility("default"))) int pthread_join(pthread_t t, void** result) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::pthread_join(t, result);
-  Guard guard;
-  std::shared_ptr<Joinable> joinable;
-  {
-    std::lock_guard lock(g_threads_mutex);
-    if (const auto it = g_threads->find(t); it != g_threads->end()) {
-      joinable = std::move(it->second);
-      g_threads->erase(it);
+  // A cancellation of the joining thread is acted on once the joined thread has ended.
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    std::shared_ptr<Joinable> joinable;
+    {
+      std::lock_guard lock(g_threads_mutex);
+      if (const auto it = g_threads->find(t); it != g_threads->end()) {
+        joinable = std::move(it->second);
+        g_threads->erase(it);
+      }
     }
-  }
-  if (!joinable) return real::pthread_join(t, result);  // a thread the library did not see start
-  int r = 0;
-  try {
-    VirtualScheduler::Wait w;
-    w.object = joinable.get();
-    w.try_now = [&] { return joinable->exited.load(std::memory_order_acquire); };
-    vt->scheduler().wait_in(w, [&] { r = real::pthread_join(t, result); });
-  } catch (...) {
-    r = real::pthread_join(t, result);
-  }
+    if (!joinable) return real::pthread_join(t, result);  // a thread the library did not see start
+    int r = 0;
+    try {
+      VirtualScheduler::Wait w;
+      w.object = joinable.get();
+      w.try_now = [&] { return joinable->exited.load(std::memory_order_acquire); };
+      vt->scheduler().wait_in(w, [&] { r = real::pthread_join(t, result); });
+    } catch (...) {
+      r = real::pthread_join(t, result);
+    }
+    return r;
+  });
+}
+
+__attribute__((visibility("default"))) int pthread_cancel(pthread_t t) noexcept {
+  const int r = real::pthread_cancel(t);
+  // A covered wait holds cancellation off (the library's own frames cannot be unwound): end the
+  // thread's wait, so that it acts on the request as it leaves.
+  if (r == 0)
+    if (VirtualHostTime* vt = virtual_time()) {
+      Guard guard;
+      try {
+        vt->scheduler().interrupt(t);
+      } catch (...) {
+      }
+    }
   return r;
 }
 
 __attribute__((visibility("default"))) int pthread_cond_wait(pthread_cond_t* c, pthread_mutex_t* m) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::pthread_cond_wait(c, m);
-  Guard guard;
-  try {
-    return cond_wait(*vt, c, m, CLOCK_REALTIME, nullptr);
-  } catch (...) {
-    return real::pthread_cond_wait(c, m);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return cond_wait(*vt, c, m, CLOCK_REALTIME, nullptr);
+    } catch (...) {
+      return real::pthread_cond_wait(c, m);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int pthread_cond_timedwait(pthread_cond_t* c, pthread_mutex_t* m,
                                                                   const struct timespec* abstime) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || is_null(abstime)) return real::pthread_cond_timedwait(c, m, abstime);
-  Guard guard;
-  try {
-    return cond_wait(*vt, c, m, cond_clock(c), abstime);
-  } catch (...) {
-    return real::pthread_cond_timedwait(c, m, abstime);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return cond_wait(*vt, c, m, cond_clock(c), abstime);
+    } catch (...) {
+      return real::pthread_cond_timedwait(c, m, abstime);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int pthread_cond_clockwait(pthread_cond_t* c, pthread_mutex_t* m, clockid_t clock,
@@ -255,12 +277,14 @@ __attribute__((visibility("default"))) int pthread_cond_clockwait(pthread_cond_t
   VirtualHostTime* vt = virtual_time();
   if (!vt || is_null(abstime) || (clock != CLOCK_MONOTONIC && clock != CLOCK_REALTIME))
     return real::pthread_cond_clockwait(c, m, clock, abstime);
-  Guard guard;
-  try {
-    return cond_wait(*vt, c, m, clock, abstime);
-  } catch (...) {
-    return real::pthread_cond_clockwait(c, m, clock, abstime);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return cond_wait(*vt, c, m, clock, abstime);
+    } catch (...) {
+      return real::pthread_cond_clockwait(c, m, clock, abstime);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int pthread_cond_signal(pthread_cond_t* c) noexcept {
@@ -288,35 +312,48 @@ __attribute__((visibility("default"))) int pthread_cond_broadcast(pthread_cond_t
 __attribute__((visibility("default"))) int sem_wait(sem_t* s) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::sem_wait(s);
-  Guard guard;
-  try {
-    return sem_wait_virtual(*vt, s, CLOCK_REALTIME, nullptr);
-  } catch (...) {
-    return real::sem_wait(s);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, nullptr);
+    } catch (...) {
+      return real::sem_wait(s);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int sem_timedwait(sem_t* s, const struct timespec* abstime) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || is_null(abstime)) return real::sem_timedwait(s, abstime);
-  Guard guard;
-  try {
-    return sem_wait_virtual(*vt, s, CLOCK_REALTIME, abstime);
-  } catch (...) {
-    return real::sem_timedwait(s, abstime);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, abstime);
+    } catch (...) {
+      return real::sem_timedwait(s, abstime);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int sem_clockwait(sem_t* s, clockid_t clock, const struct timespec* abstime) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || is_null(abstime) || (clock != CLOCK_MONOTONIC && clock != CLOCK_REALTIME))
     return real::sem_clockwait(s, clock, abstime);
-  Guard guard;
-  try {
-    return sem_wait_virtual(*vt, s, clock, abstime);
-  } catch (...) {
-    return real::sem_clockwait(s, clock, abstime);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return sem_wait_virtual(*vt, s, clock, abstime);
+    } catch (...) {
+      return real::sem_clockwait(s, clock, abstime);
+    }
+  });
+}
+
+// Not a wait: only the busy-wait rule's count learns that the clock read before it was part of
+// a lock acquisition (CPython), not a look at the time.
+__attribute__((visibility("default"))) int sem_trywait(sem_t* s) noexcept {
+  if (VirtualHostTime* vt = virtual_time()) vt->unlook();
+  return real::sem_trywait(s);
 }
 
 __attribute__((visibility("default"))) int sem_post(sem_t* s) noexcept {

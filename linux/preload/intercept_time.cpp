@@ -109,59 +109,67 @@ __attribute__((visibility("default"))) int clock_nanosleep(clockid_t clock, int 
   if (!vt || is_null(req) || (clock != CLOCK_MONOTONIC && clock != CLOCK_REALTIME && clock != CLOCK_BOOTTIME &&
                       clock != CLOCK_TAI))
     return real::clock_nanosleep(clock, flags, req, rem);
-  Guard guard;
-  try {
-    return virtual_sleep(*vt, clock, flags, req, rem);
-  } catch (...) {
-    return real::clock_nanosleep(clock, flags, req, rem);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      return virtual_sleep(*vt, clock, flags, req, rem);
+    } catch (...) {
+      return real::clock_nanosleep(clock, flags, req, rem);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int nanosleep(const struct timespec* req, struct timespec* rem) {
   VirtualHostTime* vt = virtual_time();
   if (!vt || is_null(req)) return real::nanosleep(req, rem);
-  Guard guard;
-  try {
-    const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, req, rem);
-    if (r == 0) return 0;
-    errno = r;
-    return -1;
-  } catch (...) {
-    return real::nanosleep(req, rem);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, req, rem);
+      if (r == 0) return 0;
+      errno = r;
+      return -1;
+    } catch (...) {
+      return real::nanosleep(req, rem);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) int usleep(useconds_t us) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::usleep(us);
-  Guard guard;
-  try {
-    const timespec req = to_timespec(std::int64_t{us} * 1000);
-    const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, nullptr);
-    if (r == 0) return 0;
-    errno = r;
-    return -1;
-  } catch (...) {
-    return real::usleep(us);
-  }
+  return as_cancellation_point([&]() __attribute__((noinline)) -> int {
+    Guard guard;
+    try {
+      const timespec req = to_timespec(std::int64_t{us} * 1000);
+      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, nullptr);
+      if (r == 0) return 0;
+      errno = r;
+      return -1;
+    } catch (...) {
+      return real::usleep(us);
+    }
+  });
 }
 
 __attribute__((visibility("default"))) unsigned sleep(unsigned seconds) {
   VirtualHostTime* vt = virtual_time();
   if (!vt) return real::sleep(seconds);
-  Guard guard;
-  try {
-    const timespec req{static_cast<time_t>(seconds), 0};
-    timespec rem{};
-    const int saved = errno;
-    if (virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, &rem) == 0) {
-      errno = saved;
-      return 0;
+  return as_cancellation_point([&]() __attribute__((noinline)) -> unsigned {
+    Guard guard;
+    try {
+      const timespec req{static_cast<time_t>(seconds), 0};
+      timespec rem{};
+      const int saved = errno;
+      if (virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, &rem) == 0) {
+        errno = saved;
+        return 0;
+      }
+      return static_cast<unsigned>(rem.tv_sec) + (rem.tv_nsec >= 500'000'000 ? 1 : 0);  // as glibc rounds
+    } catch (...) {
+      return real::sleep(seconds);
     }
-    return static_cast<unsigned>(rem.tv_sec) + (rem.tv_nsec >= 500'000'000 ? 1 : 0);  // as glibc rounds
-  } catch (...) {
-    return real::sleep(seconds);
-  }
+  });
 }
 
 }  // extern "C"

@@ -102,6 +102,8 @@ void fire_virtual_timerfd(int fd) {
   if (t.expiry_ns >= 0 && t.expiry_ns <= vt->now_ns(CLOCK_MONOTONIC)) signal(fd, t);
 }
 
+bool virtual_timerfds_exist() { return g_count.load(std::memory_order_acquire) > 0; }
+
 bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result) {
   if (g_count.load(std::memory_order_acquire) == 0) return false;
   VirtualHostTime* vt = virtual_time();

@@ -100,6 +100,7 @@ L6470EMU_REAL(int, sem_trywait, (sem_t*))
 L6470EMU_REAL(int, sem_post, (sem_t*))
 L6470EMU_REAL(int, pthread_create, (pthread_t*, const pthread_attr_t*, void* (*)(void*), void*))
 L6470EMU_REAL(int, pthread_join, (pthread_t, void**))
+L6470EMU_REAL(int, pthread_cancel, (pthread_t))
 L6470EMU_REAL(int, timerfd_create, (int, int))
 L6470EMU_REAL(int, timerfd_settime, (int, int, const struct itimerspec*, struct itimerspec*))
 L6470EMU_REAL(int, timerfd_gettime, (int, struct itimerspec*))
@@ -223,6 +224,7 @@ int pthread_create(pthread_t* t, const pthread_attr_t* attr, void* (*fn)(void*),
   return get_pthread_create()(t, attr, fn, arg);
 }
 int pthread_join(pthread_t t, void** result) { return get_pthread_join()(t, result); }
+int pthread_cancel(pthread_t t) { return get_pthread_cancel()(t); }
 int timerfd_create(int clock, int flags) { return get_timerfd_create()(clock, flags); }
 int timerfd_settime(int fd, int flags, const struct itimerspec* value, struct itimerspec* old) {
   return get_timerfd_settime()(fd, flags, value, old);

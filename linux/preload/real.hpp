@@ -76,6 +76,7 @@ int sem_trywait(sem_t* s);
 int sem_post(sem_t* s);
 int pthread_create(pthread_t* t, const pthread_attr_t* attr, void* (*fn)(void*), void* arg);
 int pthread_join(pthread_t t, void** result);
+int pthread_cancel(pthread_t t);
 int timerfd_create(int clock, int flags);
 int timerfd_settime(int fd, int flags, const struct itimerspec* value, struct itimerspec* old);
 int timerfd_gettime(int fd, struct itimerspec* value);

@@ -3,6 +3,7 @@
 #include "linux/preload/virtual_time.hpp"
 
 #include <dirent.h>
+#include <pthread.h>
 #include <sys/socket.h>
 
 #include <algorithm>
@@ -35,10 +36,8 @@ int count_threads() {
   return std::max(n, 1);
 }
 
-// The busy-wait rule's count of looks at time since the calling thread's last covered wait, and
-// the quantum it waits next.
-thread_local int t_looks = 0;
-thread_local Tick t_quantum = 0;
+// The busy-wait rule's count of looks at time since the calling thread's last covered wait.
+thread_local std::int64_t t_looks = 0;
 
 VirtualScheduler::Hooks scheduler_hooks(Board& board) {
   VirtualScheduler::Hooks h;
@@ -131,25 +130,35 @@ Tick VirtualHostTime::first_event_tick(int fd) const {
 
 VirtualScheduler::End VirtualHostTime::wait(const VirtualScheduler::Wait& w) {
   t_looks = 0;
-  t_quantum = 0;
   return scheduler_.wait(w);
 }
 
 void VirtualHostTime::look() {
   if (++t_looks <= kSpinLooks) return;
-  const Tick q = t_quantum ? t_quantum : kFirstQuantum;
-  t_quantum = std::min(q * 2, kLastQuantum);
+  const std::int64_t doublings = std::min<std::int64_t>((t_looks - kSpinLooks - 1) / kLooksPerDoubling, 12);
+  if (doublings == 12) t_looks = kSpinLooks + 12 * kLooksPerDoubling;  // no overflow in a long spin
+  const Tick quantum = std::min(kFirstQuantum << doublings, kLastQuantum);
   VirtualScheduler::Wait w;
-  w.deadline = time_.now() + q;
+  w.deadline = time_.now() + quantum;
   w.interruptible = false;
+  int cancel_state;  // a clock read is no cancellation point
+  pthread_setcancelstate(PTHREAD_CANCEL_DISABLE, &cancel_state);
   scheduler_.wait(w);
+  pthread_setcancelstate(cancel_state, nullptr);
+}
+
+void VirtualHostTime::unlook() {
+  if (t_looks > 0) --t_looks;
 }
 
 void VirtualHostTime::BusWaiter::wait_until(Tick tick) {
   VirtualScheduler::Wait w;
   w.deadline = tick;
   w.interruptible = false;  // a spidev transfer finishes whatever signal arrives
-  vt_.wait(w);
+  int cancel_state;          // and ioctl is no cancellation point
+  pthread_setcancelstate(PTHREAD_CANCEL_DISABLE, &cancel_state);
+  while (vt_.time_.now() < tick) vt_.wait(w);  // (pthread_cancel ends covered waits early)
+  pthread_setcancelstate(cancel_state, nullptr);
 }
 
 void VirtualHostTime::before_fork() {

@@ -3,6 +3,7 @@
 // (vDSO-direct reads, raw system calls, POSIX timers, alarm) is listed in docs/linux.md.
 #pragma once
 
+#include <pthread.h>
 #include <time.h>
 
 #include <atomic>
@@ -49,11 +50,16 @@ class VirtualHostTime {
   VirtualScheduler::End wait(const VirtualScheduler::Wait& w);
   /// A look at time that does not block (a clock read, a zero-timeout poll, a gpio value read).
   /// After kSpinLooks of them in a row without a covered wait, each one first waits a quantum
-  /// of virtual time that doubles from 1 µs to 1 ms: a thread spinning on the clock or on a pin
-  /// lets time pass, deterministically, instead of hanging.
+  /// of virtual time: 1 µs, doubling every kLooksPerDoubling looks up to 1 ms. A thread spinning
+  /// on the clock or on a pin lets time pass, deterministically, instead of hanging; a thread
+  /// that merely reads the clock often is not disturbed below kSpinLooks.
   void look();
+  /// The clock read just made belongs to a lock operation, not a look (CPython 3.11 reads the
+  /// clock before every lock acquisition, then calls sem_trywait or a covered wait).
+  void unlook();
 
-  static constexpr int kSpinLooks = 1000;
+  static constexpr std::int64_t kSpinLooks = 10'000;
+  static constexpr std::int64_t kLooksPerDoubling = 1'000;
   static constexpr Tick kFirstQuantum = 4;      ///< 1 µs
   static constexpr Tick kLastQuantum = 4000;    ///< 1 ms
 
@@ -102,6 +108,22 @@ inline bool is_null(const void* p) {
   return p == nullptr;
 }
 
+/// Runs `body` (a covered wait, with its Guard and exception handling inside, never inlined) as
+/// the C library's cancellation point it replaces: a pending pthread_cancel is acted on before
+/// and after it, from the caller's frame, and held off while `body` runs (pthread_cancel ends a
+/// covered wait instead). Forced unwinding must never cross the library's own frames: their
+/// cleanups would run on the library's static copy of the unwinder, which aborts.
+template <typename F>
+[[gnu::always_inline]] inline auto as_cancellation_point(F&& body) {
+  pthread_testcancel();
+  int state = 0;
+  pthread_setcancelstate(PTHREAD_CANCEL_DISABLE, &state);
+  const auto r = body();
+  pthread_setcancelstate(state, nullptr);
+  pthread_testcancel();
+  return r;
+}
+
 /// Makes `vt` the process's virtual time (LocalBackend, once).
 void install_virtual_time(VirtualHostTime* vt);
 
@@ -113,6 +135,8 @@ void thread_table_before_fork();
 void thread_table_after_fork();
 /// intercept_timerfd.cpp: a virtual timer expired (the scheduler's fire hook).
 void fire_virtual_timerfd(int fd);
+/// intercept_timerfd.cpp: whether any virtual timerfd exists (cheap).
+bool virtual_timerfds_exist();
 /// intercept_timerfd.cpp: read() of a virtual timerfd. False: `fd` is not one.
 bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result);
 /// intercept_timerfd.cpp: `fd` was closed (or replaced by dup2): forget its timer.

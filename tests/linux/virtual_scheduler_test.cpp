@@ -296,6 +296,22 @@ TEST(VirtualScheduler, ASignalHandlerInterruptsAnInterruptibleWait) {
   sigaction(SIGUSR1, &old, nullptr);
 }
 
+TEST(VirtualScheduler, InterruptingAThreadEndsItsWaitWithoutMovingTime) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);
+  End end = End::aborted;
+  Worker waiter(s, [&] {
+    VirtualScheduler::Wait w;  // no deadline, nothing to notify it: only interrupt() ends it
+    w.interruptible = false;
+    end = s.wait(w);
+  });
+  wait_until_waiting(s, 1);
+  EXPECT_EQ(s.interrupt(waiter.handle()), 1);
+  waiter.join();
+  EXPECT_EQ(end, End::interrupted);
+  EXPECT_TRUE(board.jumps.empty());
+}
+
 TEST(VirtualScheduler, ManyThreadsSleepingInALoopSeeTheSameTimesEveryRun) {
   std::vector<std::string> first;
   for (int round = 0; round < 5; ++round) {

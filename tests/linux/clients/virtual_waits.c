@@ -75,6 +75,24 @@ static void* block_in_read(void* arg) {
 
 static void on_alarm(int sig) { (void)sig; }
 
+static void unlock_mutex(void* m) { pthread_mutex_unlock((pthread_mutex_t*)m); }
+
+static void* sleep_long(void* arg) {
+  (void)arg;
+  struct timespec d = ts_of(1000000000000LL);
+  nanosleep(&d, NULL);
+  return NULL;
+}
+
+static void* wait_forever(void* arg) {
+  (void)arg;
+  pthread_mutex_lock(&mutex);
+  pthread_cleanup_push(unlock_mutex, &mutex);
+  for (;;) pthread_cond_wait(&cond, &mutex);
+  pthread_cleanup_pop(1);
+  return NULL;
+}
+
 int main(void) {
   int64_t t0;
   check(pipe(pipe_fds) == 0, "pipe");
@@ -226,6 +244,25 @@ int main(void) {
   t0 = now();
   pthread_join(th, NULL);
   printf("join_of_a_sleeper=%lld\n", (long long)(now() - t0));
+
+  /* pthread_cancel ends covered waits (a sleep, a condition wait that re-takes its mutex for the
+     cleanup handler) without moving time. */
+  pthread_t victims[2];
+  pthread_create(&victims[0], NULL, sleep_long, NULL);
+  pthread_create(&victims[1], NULL, wait_forever, NULL);
+  d = ts_of(1000);
+  nanosleep(&d, NULL); /* both are waiting by now: this sleep alone ended */
+  t0 = now();
+  int cancelled = 0;
+  for (int i = 0; i < 2; i++) pthread_cancel(victims[i]);
+  for (int i = 0; i < 2; i++) {
+    void* res = NULL;
+    pthread_join(victims[i], &res);
+    cancelled += res == PTHREAD_CANCELED;
+  }
+  check(pthread_mutex_trylock(&mutex) == 0, "mutex released by the cleanup handler");
+  pthread_mutex_unlock(&mutex);
+  printf("cancelled=%d after=%lld\n", cancelled, (long long)(now() - t0));
 
   /* A real SIGALRM (timers stay real) interrupts a virtual sleep that cannot end: another thread
      is blocked in a call the library does not cover, and the config turns the idle grace off. */
