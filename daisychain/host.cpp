@@ -6,13 +6,19 @@
 
 namespace l6470emu {
 
+void ChainHost::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  bus_.advance_to(bus_.now() + frame_gap_);
+  bus_.select();
+  bus_.exchange(tx, rx);
+  bus_.deselect();
+}
+
 std::uint8_t ChainHost::frame_byte(std::size_t k, std::uint8_t byte) {
   const std::size_t n = chain_.size();
   tx_.assign(n, 0x00);
   rx_.assign(n, 0x00);
   tx_.at(k) = byte;
-  chain_.advance_to(chain_.now() + frame_gap_);
-  chain_.frame(tx_, rx_);
+  frame(tx_, rx_);
   return rx_[k];
 }
 
@@ -35,8 +41,7 @@ std::vector<std::vector<std::uint8_t>> ChainHost::send_all(const std::vector<std
       const std::size_t pad = len - per_chip[k].size();
       if (f >= pad) tx_[k] = per_chip[k][f - pad];
     }
-    chain_.advance_to(chain_.now() + frame_gap_);
-    chain_.frame(tx_, rx_);
+    frame(tx_, rx_);
     frames.push_back(rx_);
   }
   return frames;

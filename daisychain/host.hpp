@@ -9,6 +9,7 @@
 
 #include "core/registers.hpp"
 #include "daisychain/chain.hpp"
+#include "spi/spi_device.hpp"
 
 namespace l6470emu {
 
@@ -16,7 +17,10 @@ namespace l6470emu {
 class ChainHost {
  public:
   /// `frame_gap` ticks pass between frames (CS high time plus the frame itself).
-  explicit ChainHost(Chain& chain, Tick frame_gap = 8) : chain_(chain), frame_gap_(frame_gap) {}
+  explicit ChainHost(Chain& chain, Tick frame_gap = 8) : ChainHost(chain, chain, frame_gap) {}
+  /// Frames go through `bus` (e.g. a RecordingChain over `chain`); `chain` answers register
+  /// look-ups. Both must outlive the host.
+  ChainHost(Chain& chain, SpiDevice& bus, Tick frame_gap = 8) : chain_(chain), bus_(bus), frame_gap_(frame_gap) {}
 
   /// Sends `bytes` to chip `k`, one frame per byte (others get NOP), and returns
   /// what chip k's slot of MISO carried in each frame.
@@ -46,18 +50,20 @@ class ChainHost {
   void hard_hiz(std::size_t k);
 
   /// Lets `ticks` of virtual time pass.
-  void wait(Tick ticks) { chain_.advance_to(chain_.now() + ticks); }
+  void wait(Tick ticks) { bus_.advance_to(bus_.now() + ticks); }
   /// Lets `ms` milliseconds of virtual time pass.
   void wait_ms(std::uint64_t ms) { wait(ticks_from_ms(ms)); }
 
   Chain& chain() { return chain_; }
 
  private:
+  void frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   std::uint8_t frame_byte(std::size_t k, std::uint8_t byte);
   void send_value(std::size_t k, std::uint8_t opcode, std::uint32_t value, unsigned bytes);
   std::uint32_t read_answer(std::size_t k, std::uint8_t opcode, unsigned bytes);
 
   Chain& chain_;
+  SpiDevice& bus_;
   Tick frame_gap_;
   std::vector<std::uint8_t> tx_, rx_;
 };
