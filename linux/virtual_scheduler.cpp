@@ -28,6 +28,7 @@ struct ThreadWakeFd {
   int fd = -1;
   ~ThreadWakeFd() {
     if (fd >= 0) ::close(fd);
+    fd = -1;  // a wait after this (another key's destructor) makes a new one, never reuses the number
   }
   int get() {
     if (fd < 0) fd = eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);

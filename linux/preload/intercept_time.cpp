@@ -38,6 +38,10 @@ int virtual_sleep(VirtualHostTime& vt, clockid_t clock, int flags, const timespe
   const std::int64_t deadline_ns = absolute ? to_ns(*req) : start + to_ns(*req);
   VirtualScheduler::Wait w;
   w.deadline = absolute ? vt.tick_at(clock, deadline_ns) : vt.tick_after(to_ns(*req));
+  if (w.deadline <= vt.tick_after(0)) {  // a zero sleep (a yield, sleep(0) in a loop): a look at time
+    vt.look();
+    return 0;
+  }
   if (vt.wait(w) != VirtualScheduler::End::interrupted) return 0;
   if (!absolute && rem) *rem = to_timespec(deadline_ns - vt.now_ns(clock));
   return EINTR;

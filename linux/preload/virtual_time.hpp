@@ -48,7 +48,8 @@ class VirtualHostTime {
 
   /// A covered wait of the calling thread (ends its busy-wait count).
   VirtualScheduler::End wait(const VirtualScheduler::Wait& w);
-  /// A look at time that does not block (a clock read, a zero-timeout poll, a gpio value read).
+  /// A look at time that does not block (a clock read, a zero-length sleep, a zero-timeout poll,
+  /// a gpio value read).
   /// After kSpinLooks of them in a row without a covered wait, each one first waits a quantum
   /// of virtual time: 1 µs, doubling every kLooksPerDoubling looks up to 1 ms. A thread spinning
   /// on the clock or on a pin lets time pass, deterministically, instead of hanging; a thread
