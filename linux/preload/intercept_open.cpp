@@ -94,12 +94,13 @@ void forget_fd(int fd) {
 
 // A descriptor the C library just handed out must not look emulated (stale entry).
 int fresh(int fd) {
-  if (fd >= 0 && fd_entry(fd)) forget_fd(fd);
+  if (fd >= 0 && fd_entry(fd) && !in_vfork_child()) forget_fd(fd);
   return fd;
 }
 
 int dup_entry(int from, int to) {
   if (to < 0) return to;
+  if ((fd_entry(from) || fd_entry(to)) && in_vfork_child()) return to;  // the parent's table
   if (FdEntry* e = fd_entry(from)) {
     e->refs.fetch_add(1, std::memory_order_acq_rel);
     fd_store(to, e);
@@ -204,10 +205,11 @@ __attribute__((visibility("default"))) FILE* fopen64(const char* path, const cha
 
 __attribute__((visibility("default"))) int close(int fd) {
   if (protected_fd_is(fd)) {  // the host closes the daemon connection (closefrom-style clean-up)
+    if (in_vfork_child()) return real::close(fd);  // its own descriptor; the memory is the parent's
     real_close_protected(fd);
     return 0;
   }
-  FdEntry* e = fd_entry(fd) ? fd_take(fd) : nullptr;
+  FdEntry* e = fd_entry(fd) && !in_vfork_child() ? fd_take(fd) : nullptr;
   const int r = real::close(fd);
   forget_virtual_timerfd(fd);
   if (e) {
@@ -220,7 +222,7 @@ __attribute__((visibility("default"))) int close(int fd) {
 
 __attribute__((visibility("default"))) int close_range(unsigned first, unsigned last, int flags) {
   const int r = static_cast<int>(syscall(SYS_close_range, first, last, flags));
-  if (r == 0 && !(flags & CLOSE_RANGE_CLOEXEC)) {
+  if (r == 0 && !(flags & CLOSE_RANGE_CLOEXEC) && !in_vfork_child()) {
     const int saved = errno;
     for (unsigned fd = first; fd <= last && fd < (1u << 16); ++fd) {
       if (protected_fd_is(static_cast<int>(fd))) real_close_protected(static_cast<int>(fd));
@@ -240,7 +242,7 @@ __attribute__((visibility("default"))) int dup(int fd) { return dup_entry(fd, re
 
 __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
   if (fd == fd2) return real::dup2(fd, fd2);
-  FdEntry* old = fd_entry(fd2) ? fd_take(fd2) : nullptr;
+  FdEntry* old = fd_entry(fd2) && !in_vfork_child() ? fd_take(fd2) : nullptr;
   const int r = real::dup2(fd, fd2);
   if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {
@@ -253,7 +255,7 @@ __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
 }
 
 __attribute__((visibility("default"))) int dup3(int fd, int fd2, int flags) {
-  FdEntry* old = (fd != fd2 && fd_entry(fd2)) ? fd_take(fd2) : nullptr;
+  FdEntry* old = (fd != fd2 && fd_entry(fd2) && !in_vfork_child()) ? fd_take(fd2) : nullptr;
   const int r = real::dup3(fd, fd2, flags);
   if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {

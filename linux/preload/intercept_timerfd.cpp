@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <sys/eventfd.h>
 #include <sys/timerfd.h>
+#include <unistd.h>
 
 #include <mutex>
 #include <unordered_map>
@@ -32,6 +33,7 @@ struct VirtualTimer {
 std::mutex g_mutex;
 std::unordered_map<int, VirtualTimer>* g_timers = nullptr;  // never freed
 std::atomic<int> g_count{0};                                // timers in the table (cheap "none" test)
+std::atomic<pid_t> g_owner_pid{0};                          // the process the table belongs to
 
 bool valid(const timespec& ts) { return ts.tv_sec >= 0 && ts.tv_nsec >= 0 && ts.tv_nsec < kNsPerSecond; }
 
@@ -159,6 +161,10 @@ bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result)
 
 void forget_virtual_timerfd(int fd) {
   if (g_count.load(std::memory_order_acquire) == 0) return;
+  // A vfork()ed child (posix_spawn, CPython's subprocess) closes descriptors before exec in its
+  // parent's memory: the parent's timers are not its to forget. (A fork()ed child has its own
+  // copy, and the fork handlers made it the owner.)
+  if (getpid() != g_owner_pid.load(std::memory_order_acquire)) return;
   bool found = false;
   {
     std::lock_guard lock(g_mutex);
@@ -173,7 +179,10 @@ void forget_virtual_timerfd(int fd) {
 }
 
 void timerfd_table_before_fork() { g_mutex.lock(); }
-void timerfd_table_after_fork() { g_mutex.unlock(); }
+void timerfd_table_after_fork() {
+  g_owner_pid.store(getpid(), std::memory_order_release);
+  g_mutex.unlock();
+}
 
 }  // namespace l6470emu::preload
 
@@ -191,7 +200,10 @@ __attribute__((visibility("default"))) int timerfd_create(int clock, int flags) 
   Guard guard;
   try {
     std::lock_guard lock(g_mutex);
-    if (!g_timers) g_timers = new std::unordered_map<int, VirtualTimer>();
+    if (!g_timers) {
+      g_timers = new std::unordered_map<int, VirtualTimer>();
+      g_owner_pid.store(getpid(), std::memory_order_release);
+    }
     const int fd = eventfd(0, flags);  // TFD_CLOEXEC == EFD_CLOEXEC, TFD_NONBLOCK == EFD_NONBLOCK
     if (fd < 0) return -1;
     VirtualTimer t;

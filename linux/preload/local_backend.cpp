@@ -1,5 +1,7 @@
 // Backend with the Board inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG); with
 // time=virtual the board's time becomes the program's own (virtual_time.hpp).
+#include <mutex>
+
 #include "linux/preload/backend.hpp"
 #include "linux/preload/virtual_time.hpp"
 
@@ -8,18 +10,23 @@ namespace {
 
 class LocalBackend final : public Backend {
  public:
-  explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_) {
-    if (!config.trace.empty())
-      if (const std::string error = board_.start_recording_all(config.trace); !error.empty())
-        log_.line("trace not recorded: " + error);
+  explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_), trace_(config.trace) {
     if (config.time.virtual_time) {
+      // Made when the program starts (its clock is the board's from then on): the trace starts
+      // with the first open of a device, so that a child that never opens one (a shell, a
+      // helper program, inheriting the environment) does not truncate its parent's trace.
       virtual_time_ = std::make_unique<VirtualHostTime>(board_, config.time);
       install_virtual_time(virtual_time_.get());
+    } else {
+      start_trace();
     }
   }
 
   const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
-  NewFile open(std::size_t device, bool cloexec) override { return board_.open(device, cloexec); }
+  NewFile open(std::size_t device, bool cloexec) override {
+    if (virtual_time_) std::call_once(trace_started_, [this] { start_trace(); });
+    return board_.open(device, cloexec);
+  }
   void closed(std::uint64_t handle) override { board_.closed(handle); }
   long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created, bool) override {
     return board_.ioctl(handle, cmd, arg, created);
@@ -48,8 +55,16 @@ class LocalBackend final : public Backend {
   }
 
  private:
+  void start_trace() {
+    if (trace_.empty()) return;
+    if (const std::string error = board_.start_recording_all(trace_); !error.empty())
+      log_.line("trace not recorded: " + error);
+  }
+
   DiagnosticLog log_;
   Board board_;
+  std::string trace_;
+  std::once_flag trace_started_;
   std::unique_ptr<VirtualHostTime> virtual_time_;
 };
 

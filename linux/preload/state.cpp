@@ -35,6 +35,10 @@ std::atomic<bool> g_overflow_used{false};
 
 const std::vector<DeviceNode> kNoNodes;
 
+// The process the descriptor table belongs to: a vfork()ed child runs in its parent's memory
+// until it execs (fork() handlers do not run for it), and must leave the table alone.
+std::atomic<pid_t> g_pid{0};
+
 void atfork_prepare() {
   if (Backend* b = g_backend.load()) b->before_fork();
 }
@@ -42,6 +46,7 @@ void atfork_parent() {
   if (Backend* b = g_backend.load()) b->after_fork_parent();
 }
 void atfork_child() {
+  g_pid.store(getpid(), std::memory_order_release);
   if (Backend* b = g_backend.load()) b->after_fork_child();
 }
 
@@ -71,6 +76,7 @@ __attribute__((constructor)) void load_config() {
   if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) g_config->log = log;
   if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) g_config->trace = trace;
   g_log = new DiagnosticLog(g_config->log);
+  g_pid.store(getpid(), std::memory_order_release);
   pthread_atfork(atfork_prepare, atfork_parent, atfork_child);
   g_active.store(true, std::memory_order_release);
   // Virtual time is the program's clock from its start, not from its first open of a device.
@@ -82,6 +88,11 @@ __attribute__((constructor)) void load_config() {
 Guard::Guard() { ++t_depth; }
 Guard::~Guard() { --t_depth; }
 bool inside() { return t_depth > 0; }
+
+bool in_vfork_child() {
+  const pid_t owner = g_pid.load(std::memory_order_acquire);
+  return owner != 0 && getpid() != owner;
+}
 
 bool active() { return g_active.load(std::memory_order_acquire); }
 

@@ -49,6 +49,10 @@ class Guard {
 };
 /// Whether the calling thread is inside the preload library already.
 bool inside();
+/// Whether this is a vfork()ed child running in its parent's memory before exec (posix_spawn,
+/// CPython's subprocess): it must not change the parent's descriptor table. A system call:
+/// ask only before changing the table.
+bool in_vfork_child();
 
 /// The daemon connection's descriptor: close() of it by the host is noticed.
 void protect_fd(int fd);

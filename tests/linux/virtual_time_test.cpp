@@ -226,6 +226,25 @@ TEST_F(VirtualTime, AForkedChildSleepsOnItsOwnCopyOfTheClock) {
   EXPECT_EQ(f.at("parent_elapsed_ns"), "500000000");
 }
 
+TEST_F(VirtualTime, AChildProcessGetsItsOwnClockAndLeavesTheParentsDevicesAndTraceAlone) {
+  const std::string path = temp_socket_path("virtual-subprocess") + ".trace";
+  Env e = env();
+  e.emplace_back("L6470EMU_TRACE", path);
+  const RunResult r = python({"subprocess"}, e);
+  const std::string trace = slurp(path);
+  std::remove(path.c_str());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto f = fields(r.out);
+  EXPECT_EQ(f.at("status_before"), "0x7C03");  // power-up: HiZ, UVLO latched
+  EXPECT_EQ(f.at("child_slept_ns"), "5000000000");  // the child's own virtual clock
+  EXPECT_EQ(f.at("status_after"), "0x7E03");  // the same open device, after the child closed its copies
+  EXPECT_EQ(f.at("elapsed_ns"), "1500072000");  // 1.5 s of sleeps and six one-byte messages
+  // The child (which opened no device) did not start a trace of its own over the parent's.
+  EXPECT_EQ(trace.rfind("l6470emu-trace 1\nchain L6470\n0.00000000 pin 0 BUSY 1\n", 0), 0u) << trace;
+  EXPECT_NE(trace.find("\n0.50000000 frame 2.00us D0 | 00\n"), std::string::npos) << trace;
+  EXPECT_NE(trace.find("\n1.50003600 frame 2.00us D0 | 00\n"), std::string::npos) << trace;
+}
+
 TEST_F(VirtualTime, WithoutTimeVirtualTheProgramsClockAndSleepsStayReal) {
   const auto t0 = std::chrono::steady_clock::now();
   const RunResult r = run_program({system_python(), "-c",

@@ -7,6 +7,7 @@ chosen by the first argument; prints key=value lines for the test.
   threads              thread A waits on BUSY edge events while thread B moves, sleeps and polls STATUS
   idle                 a thread blocked reading a pipe while the main thread sleeps 5 s
   fork                 a forked child sleeps 10 s on its own copy of the clock; the parent waits for it
+  subprocess           a Python child started with subprocess between two GetStatus of the parent
 """
 import os
 import sys
@@ -81,6 +82,19 @@ def signed22(v):
 def move(forward, microsteps):
     cmd(0x40 | forward, (microsteps >> 16) & 0xFF, (microsteps >> 8) & 0xFF, microsteps & 0xFF)
 
+
+if scenario == "subprocess":  # the device is opened after a sleep, the trace starts then
+    time.sleep(0.5)
+    print(f"status_before=0x{get_status():04X}")
+    import subprocess
+
+    child = subprocess.run(
+        [sys.executable, "-c", "import time; t = time.monotonic_ns(); time.sleep(5); print(time.monotonic_ns() - t)"],
+        capture_output=True, text=True)
+    print(f"child_slept_ns={child.stdout.strip()}")
+    time.sleep(1)
+    print(f"status_after=0x{get_status():04X} elapsed_ns={time.monotonic_ns() - t_start}")
+    sys.exit(0)
 
 get_status()  # clear the power-up UVLO
 
