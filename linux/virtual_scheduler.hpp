@@ -1,7 +1,5 @@
-// The scheduler of virtual host time (time=virtual): which threads of a program are blocked in a
-// covered wait and, when every one is, the jump of virtual time to the earliest wake-up (the rule
-// of Go's testing/synctest). It blocks and wakes threads itself (one eventfd per thread, ppoll);
-// it interposes nothing: the preload library's intercept_* files turn libc calls into its waits.
+// The scheduler of virtual host time: which threads wait in a covered wait and, when all do, the
+// jump of virtual time to the earliest wake-up (Go's testing/synctest rule). Interposes nothing.
 #pragma once
 
 #include <poll.h>

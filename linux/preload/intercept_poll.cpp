@@ -1,10 +1,6 @@
-// Replaced descriptor multiplexing for virtual host time: select, pselect, poll, ppoll (and their
-// _FORTIFY_SOURCE variants), epoll_wait, epoll_pwait, epoll_pwait2, and epoll_ctl (to know which
-// epoll sets hold emulated gpio lines). A timeout runs on virtual time; readiness is the
-// kernel's, looked at with zero-timeout calls; a wait on an emulated line also ends at the
-// board's next edge, and an edge event is not readable before its own tick (poll and select;
-// an epoll set may report it up to one spidev message early). In wall mode every call goes
-// straight to the C library.
+// select, pselect, poll, ppoll (and _chk variants), epoll_wait/_pwait/_pwait2 with their timeouts on
+// virtual time, and waits on emulated gpio lines that end at the board's next edge (an event is
+// not readable before its tick; epoll may see it one message early). Wall mode: the C library's.
 #include <errno.h>
 #include <poll.h>
 #include <sys/epoll.h>

@@ -1,8 +1,6 @@
-// Replaced thread and in-process synchronisation calls for virtual host time: pthread_create and
-// pthread_join (the scheduler counts threads and sees joins), condition variables (waits with
-// virtual timeouts; signal/broadcast hand the wake-up over deterministically) and semaphores
-// (sem_post hands the unit to the first waiter; sem_trywait only informs the busy-wait rule). Mutexes, rwlocks and process-shared objects used
-// from another process are not virtualised. In wall mode every call goes to the C library.
+// pthread_create/join, condition variables and semaphores for virtual time: threads counted, waits
+// with virtual timeouts, signal/post handed to the first waiter. Not virtualised: mutexes, rwlocks,
+// objects shared with another process. Wall mode: the C library's.
 #include <errno.h>
 #include <pthread.h>
 #include <semaphore.h>

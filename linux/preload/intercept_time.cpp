@@ -1,7 +1,6 @@
-// Replaced C library clock reads and sleeps for virtual host time: clock_gettime, gettimeofday,
-// time, timespec_get, nanosleep, clock_nanosleep, usleep, sleep. Each public symbol has its own
-// wrapper (glibc's sleep and time reach the kernel through internal aliases, not through these).
-// In wall mode, and for CPU-time clocks, every call goes straight to the C library.
+// Clock reads and sleeps on virtual time (clock_gettime, gettimeofday, time, timespec_get, nanosleep,
+// clock_nanosleep, usleep, sleep), one wrapper per public symbol: glibc calls itself through
+// internal aliases. CPU-time clocks, and every call in wall mode, go to the C library.
 #include <errno.h>
 #include <sys/time.h>
 #include <time.h>

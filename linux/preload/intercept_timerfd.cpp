@@ -1,8 +1,6 @@
-// timerfd on virtual time: timerfd_create on a virtual clock makes an eventfd the scheduler
-// writes when the timer expires (so poll, select and epoll see it like a timerfd), and read(),
-// timerfd_settime and timerfd_gettime work out expirations from virtual time. A dup() of such a
-// descriptor is not recognised (it reads as an eventfd); TFD_TIMER_CANCEL_ON_SET and
-// TFD_IOC_SET_TICKS are not modelled.
+// timerfd on virtual clocks: an eventfd the scheduler writes when the timer expires (so poll,
+// select and epoll see it), expirations worked out from virtual time. Not modelled: a dup() of it
+// (reads as an eventfd), TFD_TIMER_CANCEL_ON_SET, TFD_IOC_SET_TICKS.
 #include <errno.h>
 #include <fcntl.h>
 #include <sys/eventfd.h>
