@@ -34,7 +34,7 @@ struct Run {
 Run run_workload(const std::string& chain) {
   char out_path[] = "/tmp/l6470emu-host-time-XXXXXX";
   const int fd = mkstemp(out_path);
-  std::vector<std::string> env_strings = {"LD_PRELOAD=" L6470EMU_PRELOAD, "L6470EMU_CHAIN=" + chain, "L6470EMU_LOG=off"};
+  std::vector<std::string> env_strings = {"LD_PRELOAD=" L6470EMU_PRELOAD, "L6470EMU_CHAIN=" + chain};
   for (char** e = environ; *e; ++e)
     if (std::strncmp(*e, "LD_PRELOAD=", 11) != 0 && std::strncmp(*e, "L6470EMU_", 9) != 0) env_strings.push_back(*e);
   std::vector<char*> envp;
@@ -107,12 +107,24 @@ int main(int argc, char** argv) {
   std::printf("%-48s %11.3fs %10s\n", "time=virtual, again", v2.wall_s, "-");
   if (!virtual_only) std::printf("%-48s %11.3fs %10s\n", "time=wall", w.wall_s, "-");
   std::printf("virtual runs identical: %s\n", v1.out == v2.out ? "yes (every line, durations included)" : "NO");
+  if (v1.out != v2.out) {
+    std::istringstream a(v1.out), b(v2.out);
+    for (std::string la, lb; std::getline(a, la) && std::getline(b, lb);)
+      if (la != lb) {
+        std::printf("  first difference:\n    %s\n    %s\n", la.c_str(), lb.c_str());
+        break;
+      }
+  }
   if (!virtual_only) {
     const auto finals_w = lines_starting(w.out, "final");
-    // host_seconds differs by scheduling in wall time; the motor's state must not.
+    // host_seconds and durations differ by scheduling in wall time; the motor's states must not.
     auto state = [](const std::string& l) { return l.substr(0, l.find(" host_seconds")); };
-    std::printf("final state wall vs virtual: %s\n",
-                !finals_w.empty() && !finals_v.empty() && state(finals_w[0]) == state(finals_v[0]) ? "identical" : "DIFFERENT");
+    bool same = !finals_w.empty() && !finals_v.empty() && state(finals_w[0]) == state(finals_v[0]);
+    const auto mw = lines_starting(w.out, "move"), mv = lines_starting(v1.out, "move");
+    same = same && mw.size() == mv.size();
+    for (std::size_t i = 0; same && i < mw.size(); ++i) same = field(mw[i], "abs_pos") == field(mv[i], "abs_pos");
+    std::printf("motor state wall vs virtual (after each move, after the run, at the end): %s\n",
+                same ? "identical" : "DIFFERENT");
     if (!finals_w.empty()) std::printf("  wall:    %s\n", finals_w[0].c_str());
   }
   if (!finals_v.empty()) std::printf("  virtual: %s\n", finals_v[0].c_str());

@@ -60,13 +60,18 @@ for i, (forward, full_steps, how) in enumerate(plan):
     t0 = time.monotonic()
     cmd(0x40 | forward, (n >> 16) & 0xFF, (n >> 8) & 0xFF, n & 0xFF)
     released = wait_released(how)
-    print(f"move {i} dir={forward} full_steps={full_steps} wait={how} seconds={released - t0:.6f}")
+    pos = get_param(0x01, 3)
+    print(f"move {i} dir={forward} full_steps={full_steps} wait={how} seconds={released - t0:.6f} "
+          f"abs_pos={pos - (1 << 22) if pos & 0x200000 else pos}")
     time.sleep(6.0)  # the host does something else between moves
 spd = round(200 * 250e-9 * 2**28)
 cmd(0x51, (spd >> 16) & 0xFF, (spd >> 8) & 0xFF, spd & 0xFF)  # Run forward at 200 step/s
 time.sleep(5.0)
 speed = get_param(0x04, 3)
 cmd(0xB0)  # SoftStop
+while not get_status() & 0x0002:
+    time.sleep(0.01)
+cmd(0x70)  # GoHome: where the Run stopped depends on the host's sleep to the microsecond; home does not
 while not get_status() & 0x0002:
     time.sleep(0.01)
 # Spend the rest of 60 s of host time idling in small sleeps, as a polling loop would.
