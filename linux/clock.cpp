@@ -70,7 +70,7 @@ BoardTime::BoardTime(const TimeConfig& config, HostClock& host)
     : host_(host),
       virtual_(config.virtual_time),
       scale_(config.virtual_time ? 1.0 : (config.scale > 0 ? config.scale : 1.0)),
-      origin_ns_(host.monotonic_ns()),
+      origin_ns_(config.virtual_time ? kVirtualMonotonicOrigin : host.monotonic_ns()),
       realtime_offset_ns_(host.realtime_ns() - origin_ns_) {}
 
 Tick BoardTime::now() const {

@@ -34,10 +34,16 @@ HostClock& real_host_clock();
 /// CLOCK_MONOTONIC in nanoseconds, read as real_host_clock() does.
 std::int64_t monotonic_ns();
 
+/// Where the host's CLOCK_MONOTONIC stands at tick 0 in virtual mode (ns): a fixed 1000 s, not
+/// the real clock, so that a program's readings — and what it computes and prints from them,
+/// down to the rounding of a float — are the same every run. REALTIME still starts at the real
+/// time of the start.
+inline constexpr std::int64_t kVirtualMonotonicOrigin = 1'000'000'000'000;
+
 /// The board's time. Wall mode: tick = (host CLOCK_MONOTONIC - origin) × scale / 250 ns, and a
 /// host thread waits for a tick by sleeping until the host time it maps to. Virtual mode: the
 /// tick only moves when set_now() moves it (bus time, waits, `ctl advance`); the host's clocks
-/// read as origin + tick × 250 ns, so host and board agree exactly in both modes.
+/// read as kVirtualMonotonicOrigin + tick × 250 ns, so host and board agree exactly in both modes.
 class BoardTime {
  public:
   /// Something that makes a host thread wait for virtual time (the preload's scheduler).
