@@ -2,33 +2,19 @@
 polling and waiting on BUSY around moves, through Debian's python3-spidev and python3-libgpiod
 (one L6470 at its power-up profile). Prints one line per move (how it waited, the host-measured
 duration) and the final state; run under the preload in wall or virtual time."""
+import os
+import sys
 import time
 
 import gpiod
-import spidev
 
-s = spidev.SpiDev()
-s.open(0, 0)
-s.mode = 3
-s.max_speed_hz = 5000000
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "linux", "scripts"))
+from dspin_spidev import Dspin  # noqa: E402
+
+chip = Dspin(hz=5000000)
 busy = gpiod.Chip("gpiochip0").find_line("BUSY")
 busy.request(consumer="bench", type=gpiod.LINE_REQ_EV_BOTH_EDGES)
-
-
-def cmd(*bs):
-    return [s.xfer2([b])[0] for b in bs]
-
-
-def get_status():
-    r = cmd(0xD0, 0, 0)
-    return r[1] << 8 | r[2]
-
-
-def get_param(address, nbytes):
-    v = 0
-    for b in cmd(0x20 | address, *([0] * nbytes))[1:]:
-        v = v << 8 | b
-    return v
+cmd, get_status, get_param = chip.cmd, chip.get_status, chip.get_param
 
 
 def wait_released(how):

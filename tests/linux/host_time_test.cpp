@@ -14,16 +14,6 @@
 namespace l6470emu::test {
 namespace {
 
-/// key=value words of a program's output.
-std::map<std::string, std::string> fields(const std::string& out) {
-  std::map<std::string, std::string> m;
-  std::istringstream in(out);
-  std::string w;
-  while (in >> w)
-    if (const auto eq = w.find('='); eq != std::string::npos) m[w.substr(0, eq)] = w.substr(eq + 1);
-  return m;
-}
-
 double seconds(Tick t) { return static_cast<double>(t) / static_cast<double>(kTicksPerSecond); }
 
 /// Runs each scenario in process (param false) or through a daemon (param true).
@@ -45,7 +35,7 @@ class HostTime : public ::testing::TestWithParam<bool> {
     argv.insert(argv.end(), args.begin(), args.end());
     const RunResult r = run_program(argv, env(), 60);
     EXPECT_EQ(r.status, 0) << r.out << r.err;
-    return fields(r.out);
+    return key_values(r.out);
   }
 
   static constexpr const char* kChain = "bus=0 cs=0 chips=L6470 log=off";
@@ -79,7 +69,7 @@ TEST_P(HostTime, ACDriverPollingAMoveSeesBusyReleasedAfterTheProfileDuration) {
   for (const char* hz : {"10000", "5000000"}) {
     const RunResult r = run_program({client("poll_move"), "/dev/spidev0.0", "200", hz}, env(), 60);
     ASSERT_EQ(r.status, 0) << r.out << r.err;
-    expect_move_seen_to_last_its_profile(fields(r.out), 200, 0.003);
+    expect_move_seen_to_last_its_profile(key_values(r.out), 200, 0.003);
   }
 }
 

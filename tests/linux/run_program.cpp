@@ -148,6 +148,14 @@ RunResult ServeDaemon::ctl(const std::vector<std::string>& words) const {
   return run_program(argv);
 }
 
+std::map<std::string, std::string> key_values(const std::string& out) {
+  std::map<std::string, std::string> m;
+  std::istringstream in(out);
+  for (std::string w; in >> w;)
+    if (const auto eq = w.find('='); eq != std::string::npos) m[w.substr(0, eq)] = w.substr(eq + 1);
+  return m;
+}
+
 std::string build_dir() { return L6470EMU_BINARY_DIR; }
 std::string preload_library() { return build_dir() + "/libl6470emu-preload.so"; }
 std::string l6470emu_program() { return build_dir() + "/l6470emu"; }

@@ -4,6 +4,7 @@
 
 #include <sys/types.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -64,6 +65,9 @@ class ServeDaemon {
   std::unique_ptr<Background> process_;
   bool ready_ = false;
 };
+
+/// The key=value words of a program's output (the test scripts and clients print their results so).
+std::map<std::string, std::string> key_values(const std::string& out);
 
 /// Paths of what the tests run.
 std::string build_dir();

@@ -18,16 +18,6 @@
 namespace l6470emu::test {
 namespace {
 
-/// key=value words of a program's output.
-std::map<std::string, std::string> fields(const std::string& out) {
-  std::map<std::string, std::string> m;
-  std::istringstream in(out);
-  std::string w;
-  while (in >> w)
-    if (const auto eq = w.find('='); eq != std::string::npos) m[w.substr(0, eq)] = w.substr(eq + 1);
-  return m;
-}
-
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> parts;
   std::istringstream in(s);
@@ -81,7 +71,7 @@ TEST_F(VirtualTime, PySpidevRunsOneSecondAtFullSpeedInAFractionOfASecondAndReads
   const std::uint32_t spd = 0x4000;  // 244 step/s, below the power-up MAX_SPEED (0x041 = 992 step/s)
   const RunResult r = python({"run-sleep", std::to_string(spd)});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   EXPECT_EQ(f.at("slept_ns"), "1000000000");  // time.sleep(1), on the program's own clock
   const long long latch_ns = std::stoll(f.at("latch_ns"));
   ASSERT_EQ(latch_ns % 250, 0);
@@ -105,7 +95,7 @@ TEST_F(VirtualTime, AScriptThatSleepsSixtySecondsAroundMovesFinishesInWellUnderI
   double wall_s = 0;
   const RunResult r = python({"sleep-around-moves"}, env(), &wall_s);
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   const long long elapsed = std::stoll(f.at("elapsed_ns"));
   EXPECT_GE(elapsed, 60'000'000'000LL);
   EXPECT_LT(elapsed, 60'010'000'000LL);  // 60 s of sleeps plus the bus time of 12 x 8 messages
@@ -116,7 +106,7 @@ TEST_F(VirtualTime, AScriptThatSleepsSixtySecondsAroundMovesFinishesInWellUnderI
 TEST_F(VirtualTime, ACProgramSeesEveryKindOfTimedWaitLastExactlyTheTimeItAskedFor) {
   const RunResult r = run_program({client("virtual_waits")}, env(), 30);
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   const std::map<std::string, std::string> expected = {
       {"clock_nanosleep_abstime", "1250000"},
       {"clock_nanosleep_realtime_relative", "2000000"},
@@ -177,7 +167,7 @@ TEST_F(VirtualTime, AThreadedLibgpiodProgramRunsTheSameTwiceAndSeesEachEdgeAtIts
 
   // Thread A's events: each read at exactly the time it is stamped with; the edges at the end of
   // the moves (found by the board between bus messages) at the ticks the trace records.
-  const auto f = fields(out[0]);
+  const auto f = key_values(out[0]);
   const std::vector<std::string> events = split(f.at("events"), ',');
   ASSERT_EQ(events.size(), 6u) << out[0];
   std::vector<long long> rising;
@@ -210,7 +200,7 @@ TEST_F(VirtualTime, AThreadBlockedOutsideAnyCoveredCallHoldsTimeOnlyForTheIdleGr
   double wall_s = 0;
   const RunResult r = python({"idle"}, env("idle=0.2"), &wall_s);
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   EXPECT_EQ(f.at("slept_ns"), "5000000000");  // the jump still lands on the sleep's own deadline
   EXPECT_EQ(f.at("reader_got"), "x");
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -221,7 +211,7 @@ TEST_F(VirtualTime, AThreadBlockedOutsideAnyCoveredCallHoldsTimeOnlyForTheIdleGr
 TEST_F(VirtualTime, AForkedChildSleepsOnItsOwnCopyOfTheClock) {
   const RunResult r = python({"fork"});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   EXPECT_EQ(f.at("child_slept_ns"), "10000000000");
   EXPECT_EQ(f.at("parent_elapsed_ns"), "500000000");
 }
@@ -234,7 +224,7 @@ TEST_F(VirtualTime, AChildProcessGetsItsOwnClockAndLeavesTheParentsDevicesAndTra
   const std::string trace = slurp(path);
   std::remove(path.c_str());
   ASSERT_EQ(r.status, 0) << r.out << r.err;
-  const auto f = fields(r.out);
+  const auto f = key_values(r.out);
   EXPECT_EQ(f.at("status_before"), "0x7C03");  // power-up: HiZ, UVLO latched
   EXPECT_EQ(f.at("child_slept_ns"), "5000000000");  // the child's own virtual clock
   EXPECT_EQ(f.at("status_after"), "0x7E03");  // the same open device, after the child closed its copies
@@ -253,7 +243,7 @@ TEST_F(VirtualTime, WithoutTimeVirtualTheProgramsClockAndSleepsStayReal) {
                                   {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", "bus=0 cs=0 chips=L6470"}});
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_GE(std::stoll(fields(r.out).at("slept_ns")), 200'000'000);
+  EXPECT_GE(std::stoll(key_values(r.out).at("slept_ns")), 200'000'000);
   EXPECT_GE(wall_s, 0.2);
 }
 

@@ -10,42 +10,11 @@ run, chosen by the first argument; prints key=value lines for the test.
 import sys
 import time
 
-import spidev
+from dspin_spidev import Dspin
 
-s = spidev.SpiDev()
-s.open(0, 0)
-s.mode = 3
-s.max_speed_hz = 5000000
-
-
-def cmd(*bs):
-    return [s.xfer2([b])[0] for b in bs]
-
-
-def get_status():
-    r = cmd(0xD0, 0, 0)
-    return r[1] << 8 | r[2]
-
-
-def get_param(address, nbytes):
-    v = 0
-    for b in cmd(0x20 | address, *([0] * nbytes))[1:]:
-        v = v << 8 | b
-    return v
-
-
-def abs_pos():
-    v = get_param(0x01, 3)
-    return v - (1 << 22) if v & 0x200000 else v
-
-
-def move(forward, microsteps):
-    cmd(0x40 | forward, (microsteps >> 16) & 0xFF, (microsteps >> 8) & 0xFF, microsteps & 0xFF)
-
-
-def run(forward, spd):
-    cmd(0x50 | forward, (spd >> 16) & 0xFF, (spd >> 8) & 0xFF, spd & 0xFF)
-
+chip = Dspin(hz=5000000)
+s = chip.spi
+cmd, get_status, get_param, abs_pos, move, run = chip.cmd, chip.get_status, chip.get_param, chip.abs_pos, chip.move, chip.run
 
 SPD_200 = round(200 * 250e-9 * 2**28)  # 200 full steps/s in 2^-28 step/tick
 scenario = sys.argv[1]

@@ -49,38 +49,11 @@ if scenario == "fork":
     print(f"parent_elapsed_ns={time.monotonic_ns() - t0}")
     sys.exit(0)
 
-import spidev  # noqa: E402
+from dspin_spidev import Dspin, signed22  # noqa: E402
 
-s = spidev.SpiDev()
-s.open(0, 0)
-s.mode = 3
-s.max_speed_hz = 4000000
-spi_lock = threading.Lock()
-
-
-def cmd(*bs):
-    with spi_lock:
-        return [s.xfer2([b])[0] for b in bs]
-
-
-def get_status():
-    r = cmd(0xD0, 0, 0)
-    return r[1] << 8 | r[2]
-
-
-def get_param(address, nbytes):
-    v = 0
-    for b in cmd(0x20 | address, *([0] * nbytes))[1:]:
-        v = v << 8 | b
-    return v
-
-
-def signed22(v):
-    return v - (1 << 22) if v & 0x200000 else v
-
-
-def move(forward, microsteps):
-    cmd(0x40 | forward, (microsteps >> 16) & 0xFF, (microsteps >> 8) & 0xFF, microsteps & 0xFF)
+chip = Dspin(hz=4000000, lock=True)
+s = chip.spi
+cmd, get_status, get_param, move = chip.cmd, chip.get_status, chip.get_param, chip.move
 
 
 if scenario == "subprocess":  # the device is opened after a sleep, the trace starts then
