@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's two commands:
 #   scripts/quickstart.sh demo   set up (Debian packages, build) and run the demo
-#   scripts/quickstart.sh test   set up and run the whole test suite, then again under ASan+UBSan
+#   scripts/quickstart.sh test   set up and run the whole test suite, then again under ASan+UBSan,
+#                                then a bounded fuzz pass of every input parser
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-}
@@ -30,6 +31,7 @@ case "$what" in
     stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer" env \
       ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       ctest --test-dir build-asan --output-on-failure -j"$(nproc)"
+    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, 8 harnesses x 45 s)" scripts/fuzz.sh 45
     ;;
   *)
     echo "usage: scripts/quickstart.sh demo|test" >&2
