@@ -34,7 +34,8 @@ int update_readme(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"l6470emu: register-level emulator of the ST L6470-family SPI motion engines"};
+  CLI::App app{"l6470emu: register-level emulator of the ST L6470-family SPI motion engines", "l6470emu"};
+  app.set_version_flag("--version", std::string("l6470emu ") + L6470EMU_VERSION);
   app.require_subcommand(1);
 
   std::size_t chips = 3;

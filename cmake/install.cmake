@@ -1,0 +1,77 @@
+# Installation (GNUInstallDirs places): the model's static libraries with their public headers
+# under include/l6470emu/, exported as l6470emu::core/spi/daisychain/linux (find_package) and
+# described in l6470emu.pc (pkg-config); the preload library in lib/l6470emu/; the l6470emu
+# program, its man page and the docs. The Python module installs itself (python/CMakeLists.txt).
+include(GNUInstallDirs)
+include(CMakePackageConfigHelpers)
+
+set(L6470EMU_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/l6470emu CACHE STRING
+    "Where l6470emuConfig.cmake goes, relative to the prefix")
+set(L6470EMU_INSTALL_PRELOADDIR ${CMAKE_INSTALL_LIBDIR}/l6470emu CACHE STRING
+    "Where libl6470emu-preload.so goes, relative to the prefix")
+
+# Installed headers keep the in-tree spelling: include/l6470emu/core/chip.hpp is reached as
+# <l6470emu/core/chip.hpp>, and include/l6470emu is on the include path too, so the headers'
+# own "core/x.hpp" includes resolve (as they do from the source tree).
+set(layers core spi daisychain linux)
+foreach(layer ${layers})
+  set_target_properties(l6470emu_${layer} PROPERTIES EXPORT_NAME ${layer})
+endforeach()
+target_include_directories(l6470emu_core INTERFACE
+  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/l6470emu>)
+target_compile_features(l6470emu_core PUBLIC cxx_std_20)
+
+# l6470emu::l6470emu: every layer at once.
+add_library(l6470emu_all INTERFACE)
+target_link_libraries(l6470emu_all INTERFACE l6470emu_linux)
+set_target_properties(l6470emu_all PROPERTIES EXPORT_NAME l6470emu)
+
+install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_linux l6470emu_all
+  EXPORT l6470emuTargets
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+list(TRANSFORM layers PREPEND ${PROJECT_SOURCE_DIR}/ OUTPUT_VARIABLE layer_dirs)
+install(DIRECTORY ${layer_dirs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
+  FILES_MATCHING PATTERN "*.hpp"
+  PATTERN "preload" EXCLUDE           # the preload library's own internals
+  PATTERN "*_internal.hpp" EXCLUDE
+  PATTERN "import_support.hpp" EXCLUDE)
+install(EXPORT l6470emuTargets NAMESPACE l6470emu:: DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
+
+configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/l6470emuConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/l6470emuConfig.cmake
+  INSTALL_DESTINATION ${L6470EMU_INSTALL_CMAKEDIR}
+  PATH_VARS L6470EMU_INSTALL_PRELOADDIR CMAKE_INSTALL_BINDIR)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/l6470emuConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)  # 0.x: a minor version may change the API
+install(FILES ${PROJECT_BINARY_DIR}/l6470emuConfig.cmake ${PROJECT_BINARY_DIR}/l6470emuConfigVersion.cmake
+  DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
+
+# pkg-config: relocatable (prefix found from the .pc file's own place).
+file(RELATIVE_PATH L6470EMU_PC_TO_PREFIX /prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig /prefix)
+configure_file(${CMAKE_CURRENT_LIST_DIR}/l6470emu.pc.in ${PROJECT_BINARY_DIR}/l6470emu.pc @ONLY)
+install(FILES ${PROJECT_BINARY_DIR}/l6470emu.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# The preload library (LD_PRELOAD only: no headers, not linked against) and the program.
+install(TARGETS l6470emu-preload LIBRARY DESTINATION ${L6470EMU_INSTALL_PRELOADDIR})
+install(TARGETS l6470emu RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+
+# The man page, made from the program's own --help by help2man (Debian's help2man).
+find_program(L6470EMU_HELP2MAN help2man)
+if(L6470EMU_HELP2MAN)
+  add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/l6470emu.1
+    COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:l6470emu> -DHELP2MAN=${L6470EMU_HELP2MAN}
+            -DINCLUDE=${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m -DOUTPUT=${PROJECT_BINARY_DIR}/l6470emu.1
+            -P ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
+    DEPENDS l6470emu ${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
+    COMMENT "Generating the l6470emu(1) man page")
+  add_custom_target(l6470emu_manpage ALL DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1)
+  install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+else()
+  message(STATUS "l6470emu: help2man not found: no man page (apt-get install help2man)")
+endif()
+
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} FILES_MATCHING PATTERN "*.md")
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples DESTINATION ${CMAKE_INSTALL_DOCDIR}
+  PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)

@@ -1,0 +1,31 @@
+# Makes the l6470emu(1) man page with help2man (cmake -P, run by the build): the program's
+# --help and --version, each subcommand's --help as a SUBCOMMANDS section, and the sections
+# of docs/l6470emu.h2m. Inputs: PROGRAM, HELP2MAN, INCLUDE, OUTPUT.
+foreach(v PROGRAM HELP2MAN INCLUDE OUTPUT)
+  if(NOT DEFINED ${v})
+    message(FATAL_ERROR "manpage.cmake needs -D${v}=...")
+  endif()
+endforeach()
+
+set(subcommands demo tables serve ctl replay decode convert)
+set(section "[SUBCOMMANDS]\n")
+foreach(sub ${subcommands})
+  execute_process(COMMAND ${PROGRAM} ${sub} --help OUTPUT_VARIABLE help RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${PROGRAM} ${sub} --help failed (${rc})")
+  endif()
+  string(REPLACE "\\" "\\e" help "${help}")   # roff escapes
+  string(REGEX REPLACE "\n+$" "" help "${help}")
+  string(APPEND section ".SS ${sub}\n.nf\n${help}\n.fi\n")
+endforeach()
+
+file(READ ${INCLUDE} sections)
+get_filename_component(dir ${OUTPUT} DIRECTORY)
+file(WRITE ${dir}/l6470emu-sections.h2m "${sections}\n${section}")
+execute_process(COMMAND ${HELP2MAN} --no-info --section=1 --source=l6470emu
+                        --name=register-level\ emulator\ of\ the\ ST\ L6470-family\ SPI\ motion\ engines
+                        --include=${dir}/l6470emu-sections.h2m --output=${OUTPUT} ${PROGRAM}
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "help2man failed (${rc})")
+endif()
