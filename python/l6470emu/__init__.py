@@ -1,0 +1,56 @@
+"""l6470emu: a register-level emulator of the ST L6470-family SPI motion engines for Python.
+
+Chain(["L6470", "L6480"]) is a daisy chain of emulated chips in virtual time: byte-level
+frames (Chain.frame), the reference host's commands (get_status, move, ...), pins and faults,
+STATUS decoded (Status), and recording into native traces that replay() and decode() read.
+The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spidev_board
+fixtures; preload_library() finds libl6470emu-preload.so for running unmodified programs.
+"""
+from ._l6470emu import (
+    TICKS_PER_SECOND,
+    Bridge,
+    Chain,
+    DecodeResult,
+    Diagnostic,
+    Divergence,
+    Fault,
+    Reg,
+    RegisterInfo,
+    ReplayResult,
+    Thermal,
+    Trace,
+    TraceError,
+    TraceEvent,
+    __version__,
+    decode,
+    register_table,
+    replay,
+    variants,
+)
+from ._paths import preload_library, program
+from ._status import Status
+
+__all__ = [
+    "TICKS_PER_SECOND",
+    "Bridge",
+    "Chain",
+    "DecodeResult",
+    "Diagnostic",
+    "Divergence",
+    "Fault",
+    "Reg",
+    "RegisterInfo",
+    "ReplayResult",
+    "Status",
+    "Thermal",
+    "Trace",
+    "TraceError",
+    "TraceEvent",
+    "__version__",
+    "decode",
+    "preload_library",
+    "program",
+    "register_table",
+    "replay",
+    "variants",
+]

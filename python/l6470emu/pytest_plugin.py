@@ -1,0 +1,167 @@
+"""pytest plugin for testing host code against emulated L6470-family chips.
+
+Fixtures:
+  l6470_chain    an l6470emu.Chain in virtual time (in-process, no OS involved)
+  spidev_board   runs a program (your unmodified driver) under libl6470emu-preload.so with an
+                 emulated /dev/spidevB.C and /dev/gpiochipN, recording a native trace
+
+The chips come from the l6470_chain marker, chip 0 (the MISO end) first; default one L6470:
+  @pytest.mark.l6470_chain("L6470", "2xL6480")
+
+Installed, the plugin is registered through its pytest11 entry point; from a build tree, put
+`pytest_plugins = ["l6470emu.pytest_plugin"]` in the top conftest.py (with the build's python/
+directory on PYTHONPATH).
+"""
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence, Union
+
+import pytest
+
+_MARKER = "l6470_chain"
+_DEFAULT_CHIPS = ("L6470",)
+
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers",
+        f"{_MARKER}(*chips): the chips of the l6470_chain and spidev_board fixtures, chip 0 "
+        "(the MISO end) first, e.g. \"L6470\", \"2xL6480\" (default: one L6470)")
+
+
+def _chips(request) -> List[str]:
+    marker = request.node.get_closest_marker(_MARKER)
+    if marker is None or not marker.args:
+        return list(_DEFAULT_CHIPS)
+    for chip in marker.args:
+        if not isinstance(chip, str):
+            raise pytest.UsageError(f"@pytest.mark.{_MARKER}: chips are strings (\"L6470\", \"2xL6480\"), not {chip!r}")
+    return list(marker.args)
+
+
+@pytest.fixture
+def l6470_chain(request):
+    """An l6470emu.Chain of the marker's chips (default one L6470), fresh from power-up."""
+    import l6470emu
+
+    chain = l6470emu.Chain(_chips(request))
+    yield chain
+    chain.close()
+
+
+class SpidevBoard:
+    """An emulated board for programs run under the preload library.
+
+    run() starts a program with LD_PRELOAD=libl6470emu-preload.so and L6470EMU_CHAIN set to
+    this board: the chips on /dev/spidev{bus}.{cs} and their BUSY/FLAG/SW/STCK/STBY_RST lines
+    on a gpiochip, in virtual time by default (the program's clocks and sleeps are the
+    board's: fast and deterministic). Each run gets a freshly powered-up board and records
+    its traffic into trace_path, which trace(), decode() and replay() read.
+    """
+
+    def __init__(self, chips: Sequence[str], directory: Path):
+        self.chips: List[str] = list(chips)
+        #: B of /dev/spidevB.C
+        self.bus: int = 0
+        #: C of /dev/spidevB.C
+        self.cs: int = 0
+        #: "virtual" (the program's clocks are the board's) or "wall"
+        self.time: str = "virtual"
+        #: more board description words ("speed=1000000 mode=3"), see docs/linux.md
+        self.options: str = ""
+        #: the native trace each run records into (None: do not record)
+        self.trace_path: Optional[Path] = directory / "spidev_board.trace"
+        #: where the preload library's diagnostics go
+        self.log_path: Path = directory / "spidev_board.log"
+        self._directory = directory
+
+    @property
+    def preload(self) -> str:
+        """The preload library's path (found in the build tree or the installed location)."""
+        import l6470emu
+
+        return l6470emu.preload_library()
+
+    @property
+    def description(self) -> str:
+        """The board description given as L6470EMU_CHAIN."""
+        words = [f"bus={self.bus}", f"cs={self.cs}", "chips=" + ",".join(self.chips), f"time={self.time}"]
+        if self.options:
+            words.append(self.options)
+        return " ".join(words)
+
+    @property
+    def device(self) -> str:
+        """The spidev node the program opens."""
+        return f"/dev/spidev{self.bus}.{self.cs}"
+
+    def env(self, base: Optional[Dict[str, str]] = None) -> Dict[str, str]:
+        """The environment a program runs in: `base` (default os.environ) plus the preload."""
+        env = dict(os.environ if base is None else base)
+        for name in ("L6470EMU_SOCKET", "L6470EMU_CONFIG", "L6470EMU_TRACE"):
+            env.pop(name, None)  # this board, in process, nothing inherited
+        preload = self.preload
+        env["LD_PRELOAD"] = preload + (":" + env["LD_PRELOAD"] if env.get("LD_PRELOAD") else "")
+        env["L6470EMU_CHAIN"] = self.description
+        env["L6470EMU_LOG"] = str(self.log_path)
+        if self.trace_path is not None:
+            env["L6470EMU_TRACE"] = str(self.trace_path)
+        return env
+
+    def run(self, args: Sequence[Union[str, os.PathLike]], *, timeout: float = 60, check: bool = True,
+            input: Optional[str] = None, cwd: Optional[Union[str, os.PathLike]] = None,
+            env: Optional[Dict[str, str]] = None) -> subprocess.CompletedProcess:
+        """Runs args under the board; returns the CompletedProcess (text stdout and stderr).
+
+        A trace left by an earlier run is removed first. With check (the default), a
+        non-zero exit fails the test with the program's output and the board's log."""
+        if self.trace_path is not None and self.trace_path.exists():
+            self.trace_path.unlink()
+        argv = [os.fspath(a) for a in args]
+        result = subprocess.run(argv, env=self.env(env), cwd=cwd, input=input, capture_output=True, text=True,
+                                timeout=timeout)
+        if check and result.returncode != 0:
+            pytest.fail(
+                f"{' '.join(argv)} exited with {result.returncode} on board '{self.description}'\n"
+                f"--- stdout\n{result.stdout}--- stderr\n{result.stderr}--- board log\n{self.log()}",
+                pytrace=False)
+        return result
+
+    def python(self, script: Union[str, os.PathLike], *args: str, **kwargs) -> subprocess.CompletedProcess:
+        """run() of a Python script with this interpreter (sys.executable)."""
+        return self.run([sys.executable, os.fspath(script), *args], **kwargs)
+
+    def log(self) -> str:
+        """What the preload library reported (settings the chip cannot work with, host mistakes)."""
+        return self.log_path.read_text(errors="replace") if self.log_path.exists() else ""
+
+    def _recorded(self) -> Path:
+        if self.trace_path is None or not self.trace_path.exists():
+            raise RuntimeError("no trace recorded: run() a program first (and keep trace_path set)")
+        return self.trace_path
+
+    def trace(self):
+        """The last run's trace, as an l6470emu.Trace."""
+        import l6470emu
+
+        return l6470emu.Trace.load(self._recorded())
+
+    def decode(self, **options) -> str:
+        """The last run's traffic explained, per chip (l6470emu.decode)."""
+        import l6470emu
+
+        return l6470emu.decode(self._recorded(), **options).text
+
+    def replay(self, **options):
+        """The last run's trace replayed against a fresh chain (an l6470emu.ReplayResult)."""
+        import l6470emu
+
+        return l6470emu.replay(self._recorded(), **options)
+
+
+@pytest.fixture
+def spidev_board(request, tmp_path):
+    """A SpidevBoard of the marker's chips (default one L6470) for running programs under the preload."""
+    return SpidevBoard(_chips(request), tmp_path)

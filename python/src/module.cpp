@@ -1,0 +1,14 @@
+// The l6470emu._l6470emu extension module: the emulator for Python (bindings over daisychain/,
+// spi/ traces and the tools' trace input). The package's __init__.py re-exports it.
+#include "bindings.hpp"
+
+PYBIND11_MODULE(_l6470emu, m) {
+  m.doc() =
+      "Register-level emulator of the ST L6470-family SPI motion engines (L6470, L6472, L6480,\n"
+      "L6482, powerSTEP01): daisy chains in virtual time, byte-exact SPI, pins, faults, traces.";
+  m.attr("__version__") = L6470EMU_VERSION;
+  m.attr("TICKS_PER_SECOND") = 4'000'000;
+  l6470emu::python::bind_registers(m);
+  l6470emu::python::bind_chain(m);
+  l6470emu::python::bind_trace(m);
+}

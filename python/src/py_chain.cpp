@@ -1,0 +1,104 @@
+// PyChain: a chain, its host and an optional recorder (see py_chain.hpp).
+#include "py_chain.hpp"
+
+#include "daisychain/chain_spec.hpp"
+#include "linux/trace_recorder.hpp"
+#include "spi/trace_native.hpp"
+
+namespace l6470emu::python {
+
+PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap)
+    : chain_(std::make_unique<Chain>(make_chain(variants))),
+      diagnostics_(std::make_unique<DiagnosticStore>()),
+      frame_gap_(frame_gap) {
+  for (std::size_t k = 0; k < chain_->size(); ++k) {
+    chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), k](const Diagnostic& d) {
+      static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored"};
+      if (store->kept.size() == kMaxDiagnostics) {
+        store->kept.pop_front();
+        ++store->dropped;
+      }
+      store->kept.push_back({d.tick, k, kKinds[static_cast<int>(d.kind)], d.message});
+    });
+  }
+  if (!record.path.empty()) {
+    file_ = std::make_unique<NativeTraceWriter>(record.path);  // throws std::runtime_error with the reason
+    record_path_ = record.path;
+    rec_ = std::make_unique<RecordingChain>(*chain_, *file_);
+  } else if (record.memory) {
+    memory_ = std::make_shared<Trace>();
+    rec_ = std::make_unique<RecordingChain>(*chain_, *memory_);
+  }
+  host_ = std::make_unique<ChainHost>(*chain_, bus(), frame_gap_);
+}
+
+PyChain::~PyChain() = default;
+
+void PyChain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  SpiDevice& b = bus();
+  b.select();
+  b.exchange(tx, rx);
+  b.deselect();
+}
+
+void PyChain::advance_to(Tick tick) {
+  bus().advance_to(tick);
+  if (rec_) rec_->observe_outputs();
+}
+
+void PyChain::set_sw_pin(std::size_t chip, bool level) {
+  if (rec_)
+    rec_->set_sw_pin(chip, level);
+  else
+    chain_->chip(chip).set_sw_pin(level);
+}
+
+void PyChain::set_stck_pin(std::size_t chip, bool level) {
+  if (rec_)
+    rec_->set_stck_pin(chip, level);
+  else
+    chain_->chip(chip).set_stck_pin(level);
+}
+
+void PyChain::set_stby_rst_pin(std::size_t chip, bool level) {
+  if (rec_)
+    rec_->set_stby_rst_pin(chip, level);
+  else
+    chain_->chip(chip).set_stby_rst_pin(level);
+}
+
+void PyChain::set_adc_input(std::size_t chip, std::uint8_t code) { fault(chip, TraceFault::ADCIN, code); }
+
+void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
+  if (!rec_) {
+    apply_fault(chain_->chip(chip), fault, value);
+    return;
+  }
+  switch (fault) {
+    case TraceFault::UVLO: rec_->set_undervoltage(chip, value != 0); break;
+    case TraceFault::UVLO_ADC: rec_->set_adc_undervoltage(chip, value != 0); break;
+    case TraceFault::OCD: rec_->set_overcurrent(chip, value != 0); break;
+    case TraceFault::STALL_A: rec_->set_stall(chip, Bridge::A, value != 0); break;
+    case TraceFault::STALL_B: rec_->set_stall(chip, Bridge::B, value != 0); break;
+    case TraceFault::THERMAL: rec_->set_thermal(chip, static_cast<Thermal>(value & 3)); break;
+    case TraceFault::ADCIN: rec_->set_adc_input(chip, value); break;
+  }
+}
+
+void PyChain::close() {
+  if (!rec_) return;
+  rec_->observe_outputs();
+  host_ = std::make_unique<ChainHost>(*chain_, frame_gap_);
+  rec_.reset();
+  file_.reset();
+}
+
+std::vector<ChainDiagnostic> PyChain::take_diagnostics(std::uint64_t& dropped) {
+  std::vector<ChainDiagnostic> out(diagnostics_->kept.begin(), diagnostics_->kept.end());
+  diagnostics_->kept.clear();
+  dropped = diagnostics_->dropped;
+  diagnostics_->dropped = 0;
+  return out;
+}
+
+}  // namespace l6470emu::python

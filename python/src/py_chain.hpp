@@ -1,0 +1,93 @@
+// The state behind l6470emu.Chain: a daisy chain, the reference host driving it, and, when
+// asked, a RecordingChain in front of it so that every frame, pin and fault goes into a
+// native trace (a file flushed event by event, or a Trace in memory). Diagnostics the chips
+// raise are kept for Python to take. No Python types here; chain_bindings.cpp wraps it.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daisychain/chain.hpp"
+#include "daisychain/host.hpp"
+#include "daisychain/recording_chain.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu::python {
+
+/// A diagnostic of one chip of the chain (WRONG_CMD, NOTPERF_CMD, ignored input).
+struct ChainDiagnostic {
+  Tick tick = 0;
+  std::size_t chip = 0;
+  std::string kind;  ///< "wrong_cmd", "notperf_cmd", "ignored"
+  std::string message;
+};
+
+/// How a Chain records, if at all.
+struct RecordTo {
+  bool memory = false;  ///< into a Trace in memory
+  std::string path;     ///< into a native trace file (when not empty)
+};
+
+/// A chain as the Python module sees it. Not thread-safe: the GIL serialises callers.
+class PyChain {
+ public:
+  /// Diagnostics kept at most (older ones are dropped and counted).
+  static constexpr std::size_t kMaxDiagnostics = 10000;
+
+  PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap);
+  ~PyChain();
+  PyChain(const PyChain&) = delete;
+  PyChain& operator=(const PyChain&) = delete;
+
+  Chain& chain() { return *chain_; }
+  const Chain& chain() const { return *chain_; }
+  /// What frames go through: the recorder when recording, else the chain.
+  SpiDevice& bus() { return rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_; }
+  ChainHost& host() { return *host_; }
+
+  /// One CS frame through the bus.
+  void frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  /// Lets time run to `tick` (recording BUSY/FLAG changes seen at the end).
+  void advance_to(Tick tick);
+
+  // The physical world, recorded when recording.
+  void set_sw_pin(std::size_t chip, bool level);
+  void set_stck_pin(std::size_t chip, bool level);
+  void set_stby_rst_pin(std::size_t chip, bool level);
+  void set_adc_input(std::size_t chip, std::uint8_t code);
+  /// A backdoor event as in a trace: UVLO/UVLO_ADC/OCD/STALL_A/STALL_B 0 or 1, THERMAL 0..3, ADCIN 0..31.
+  void fault(std::size_t chip, TraceFault fault, std::uint8_t value);
+
+  bool recording() const { return rec_ != nullptr; }
+  /// The file being (or last) recorded into; empty for none or memory.
+  const std::string& record_path() const { return record_path_; }
+  /// The trace recorded in memory (also after close()), or nullptr.
+  const Trace* memory_trace() const { return memory_.get(); }
+  /// Stops recording (the file is closed); the chain stays usable.
+  void close();
+
+  /// Takes the diagnostics kept so far; `dropped` gets how many were not kept.
+  std::vector<ChainDiagnostic> take_diagnostics(std::uint64_t& dropped);
+
+ private:
+  struct DiagnosticStore {
+    std::deque<ChainDiagnostic> kept;
+    std::uint64_t dropped = 0;
+  };
+
+  // Destroyed bottom-up: the host and the recorder refer to what is above them.
+  std::unique_ptr<Chain> chain_;
+  std::unique_ptr<DiagnosticStore> diagnostics_;
+  std::shared_ptr<Trace> memory_;
+  std::unique_ptr<TraceSink> file_;
+  std::unique_ptr<RecordingChain> rec_;
+  std::unique_ptr<ChainHost> host_;
+  std::string record_path_;
+  Tick frame_gap_;
+};
+
+}  // namespace l6470emu::python

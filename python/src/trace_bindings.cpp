@@ -1,0 +1,307 @@
+// Traces for Python: l6470emu.Trace (a whole trace in memory: loaded from any format the
+// l6470emu program reads, parsed from text, or recorded by a Chain), its events, and
+// replay() / decode() over a Trace or a file (daisychain/replay.hpp, daisychain/decode.hpp).
+#include <pybind11/stl.h>
+
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "daisychain/chain_spec.hpp"
+#include "daisychain/decode.hpp"
+#include "daisychain/replay.hpp"
+#include "spi/trace_import.hpp"
+#include "spi/trace_native.hpp"
+#include "tools/trace_input.hpp"
+
+namespace l6470emu::python {
+namespace {
+
+/// One trace event with its bytes copied out (a TraceEvent's spans do not outlive the trace).
+struct PyTraceEvent {
+  std::string kind;
+  Tick tick = 0;
+  Tick duration = 0;
+  py::bytes mosi;
+  py::object miso;  // bytes, or None when the trace has no MISO for the frame
+  std::vector<bool> miso_known;
+  std::size_t chip = 0;
+  py::object pin;    // str or None
+  py::object fault;  // str or None
+  unsigned value = 0;
+  std::uint64_t line = 0;
+  py::object source_time;  // float or None
+  std::string text;        // the native line
+};
+
+PyTraceEvent event_of(const TraceEvent& e) {
+  static constexpr const char* kKinds[] = {"frame", "pin", "fault"};
+  PyTraceEvent p;
+  p.kind = kKinds[static_cast<int>(e.kind)];
+  p.tick = e.tick;
+  p.duration = e.duration;
+  p.mosi = py::bytes(reinterpret_cast<const char*>(e.mosi.data()), e.mosi.size());
+  p.miso = e.miso.empty() ? py::object(py::none()) : py::object(py::bytes(reinterpret_cast<const char*>(e.miso.data()), e.miso.size()));
+  for (std::size_t i = 0; i < e.miso.size(); ++i) p.miso_known.push_back(e.miso_byte_known(i));
+  p.chip = e.chip;
+  p.pin = e.kind == TraceEventKind::pin ? py::object(py::str(std::string(to_string(e.pin)))) : py::object(py::none());
+  p.fault = e.kind == TraceEventKind::fault ? py::object(py::str(std::string(to_string(e.fault)))) : py::object(py::none());
+  p.value = e.value;
+  p.line = e.line;
+  p.source_time = e.has_source_time() ? py::object(py::float_(e.source_time)) : py::object(py::none());
+  p.text = NativeTraceWriter::format_event(e);
+  return p;
+}
+
+TraceFormat format_arg(const py::object& format) {
+  if (format.is_none()) return TraceFormat::unknown;
+  const std::string name = py::str(format);
+  const TraceFormat f = trace_format_named(name);
+  if (f == TraceFormat::unknown && name != "auto")
+    throw py::value_error("format: \"" + name + "\" is not native, saleae, umockdev, ftrace, sigrok or vcd");
+  return f;
+}
+
+/// Where replay() and decode() read from, and the chain they run through.
+struct Source {
+  std::shared_ptr<const Trace> trace;   // a Trace object
+  std::unique_ptr<TraceFile> file;      // or a file (native ones are streamed)
+  std::vector<const Variant*> variants;
+  std::string how;
+
+  std::unique_ptr<TraceReader> reader() const { return trace ? trace->reader() : file->read(); }
+};
+
+Source source_of(py::handle trace, py::handle chain, py::handle format) {
+  Source s;
+  std::string spec;
+  if (!chain.is_none()) spec = chain_spec_from(chain);
+  if (py::isinstance<Trace>(trace)) {
+    s.trace = trace.cast<std::shared_ptr<Trace>>();
+    const std::string& own = s.trace->header.chain;
+    if (spec.empty() && own.empty())
+      throw py::value_error("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
+    s.how = spec.empty() ? "from the trace" : "from chain=";
+    try {
+      s.variants = parse_chain_spec(spec.empty() ? own : spec);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string("chain: ") + e.what());
+    }
+    return s;
+  }
+  const std::string path = path_from(trace, "trace");
+  TraceInputOptions options;
+  options.format = format_arg(py::reinterpret_borrow<py::object>(format));
+  {
+    py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
+    s.file = std::make_unique<TraceFile>(path, options);
+    s.variants = chain_for_trace(spec, *s.file, s.how);
+  }
+  if (!spec.empty()) s.how = "from chain=";
+  return s;
+}
+
+/// decode()'s answer: the counts and the log.
+struct DecodeResult {
+  DecodeSummary summary;
+  std::string text;
+};
+
+}  // namespace
+
+void bind_trace(py::module_& m) {
+  // TraceError: a malformed input, with its file and line.
+  static py::exception<TraceError> trace_error(m, "TraceError", PyExc_ValueError);
+  trace_error.doc() = "A malformed trace: .file and .line say where (line 0: the file as a whole).";
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const TraceError& e) {
+      py::object exc = py::handle(trace_error.ptr())(e.what());
+      exc.attr("file") = e.file();
+      exc.attr("line") = e.line();
+      PyErr_SetObject(trace_error.ptr(), exc.ptr());
+    }
+  });
+
+  py::class_<PyTraceEvent>(m, "TraceEvent", "One event of a trace: a CS frame, a pin level or a backdoor fault.")
+      .def_readonly("kind", &PyTraceEvent::kind, "\"frame\", \"pin\" or \"fault\"")
+      .def_readonly("tick", &PyTraceEvent::tick, "frame: CS falling edge; pin/fault: when (250 ns ticks)")
+      .def_readonly("duration", &PyTraceEvent::duration, "frame: ticks from CS falling to rising edge")
+      .def_property_readonly("end", [](const PyTraceEvent& e) { return e.tick + e.duration; }, "frame: the CS rising edge")
+      .def_readonly("mosi", &PyTraceEvent::mosi, "frame: bytes the host sent")
+      .def_readonly("miso", &PyTraceEvent::miso, "frame: bytes received, or None when the trace has none")
+      .def_readonly("miso_known", &PyTraceEvent::miso_known, "frame: for each MISO byte, whether the trace knows it")
+      .def_readonly("chip", &PyTraceEvent::chip, "pin/fault: the chip (0 drives MISO)")
+      .def_readonly("pin", &PyTraceEvent::pin, "pin: SW, STCK, STBY, BUSY or FLAG")
+      .def_readonly("fault", &PyTraceEvent::fault, "fault: UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL or ADCIN")
+      .def_readonly("value", &PyTraceEvent::value, "pin: level 0/1; fault: on/off, Thermal number or ADC code")
+      .def_readonly("line", &PyTraceEvent::line, "line in the source file (0 = none)")
+      .def_readonly("source_time", &PyTraceEvent::source_time, "seconds as in the source file, or None")
+      .def("__str__", [](const PyTraceEvent& e) { return e.text; })
+      .def("__repr__", [](const PyTraceEvent& e) { return "TraceEvent(" + e.text + ")"; });
+
+  py::class_<Trace, std::shared_ptr<Trace>>(m, "Trace", R"(A whole trace in memory: CS frames, pin events and faults in time order.
+
+Trace.load(path) reads any format the l6470emu program reads (native, Saleae CSV, umockdev
+.ioctl, ftrace text, sigrok JSON; VCD and .sr through sigrok-cli); Trace.parse(text) reads
+text; a Chain made with record=True gives one as Chain.trace.)")
+      .def(py::init<>(), "An empty trace.")
+      .def_static(
+          "load",
+          [](py::handle path, py::object format, std::string select) {
+            const std::string p = path_from(path, "path");
+            TraceInputOptions options;
+            options.format = format_arg(format);
+            options.import.select = select;
+            py::gil_scoped_release unlocked;
+            return std::make_shared<Trace>(TraceFile(p, options).load());
+          },
+          py::arg("path"), py::arg("format") = py::none(), py::arg("select") = "",
+          "Reads a trace file; format (\"native\", \"saleae\", \"umockdev\", \"ftrace\", \"sigrok\", \"vcd\") is "
+          "recognised from the content when None; select picks one stream of a file that holds several.")
+      .def_static(
+          "parse",
+          [](const std::string& text, std::string name, py::object format) {
+            TraceFormat f = format_arg(format);
+            if (f == TraceFormat::unknown) f = detect_trace_format(text, name);
+            if (f == TraceFormat::unknown)
+              throw TraceError(name, 0, "unknown trace format (native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON)");
+            if (f == TraceFormat::vcd) throw TraceError(name, 0, "a VCD capture needs sigrok-cli: use Trace.load(path)");
+            return std::make_shared<Trace>(import_trace(text, name, f));
+          },
+          py::arg("text"), py::arg("name") = "<text>", py::arg("format") = py::none(),
+          "Reads a trace from text (any text format; recognised from the content when format is None).")
+      .def("save", [](const Trace& t, py::handle path) {
+             const std::string p = path_from(path, "path");
+             std::ofstream out(p, std::ios::binary | std::ios::trunc);
+             if (!out) throw std::runtime_error("cannot create " + p);
+             out << to_native_text(t);
+             if (!out.flush()) throw std::runtime_error("cannot write " + p);
+           },
+           py::arg("path"), "Writes the trace as a native trace file.")
+      .def("to_native", [](const Trace& t) { return to_native_text(t); }, "The trace as native text.")
+      .def("__len__", &Trace::size, "Number of events.")
+      .def("__getitem__",
+           [](const Trace& t, long long i) {
+             const long long n = static_cast<long long>(t.size());
+             if (i < 0) i += n;
+             if (i < 0 || i >= n) throw py::index_error("trace event index out of range");
+             return event_of(t[static_cast<std::size_t>(i)]);
+           })
+      .def("__iter__",
+           [](const Trace& t) {
+             std::vector<PyTraceEvent> all;
+             all.reserve(t.size());
+             for (std::size_t i = 0; i < t.size(); ++i) all.push_back(event_of(t[i]));
+             return py::iter(py::cast(std::move(all)));
+           })
+      .def_property_readonly("frame_count", &Trace::frame_count, "Number of CS frames.")
+      .def_property_readonly(
+          "chain", [](const Trace& t) -> py::object {
+            if (t.header.chain.empty()) return py::none();
+            return py::str(t.header.chain);
+          },
+          "The chain the trace was taken from (\"3*L6470\"), or None when it does not say.")
+      .def_property_readonly("format", [](const Trace& t) { return t.header.format; }, "The format it was read from.")
+      .def_property_readonly("name", [](const Trace& t) { return t.header.name; }, "The file name used in messages.")
+      .def_property_readonly("notes", [](const Trace& t) { return t.header.notes; }, "Importer remarks.")
+      .def("__repr__", [](const Trace& t) {
+        return "Trace(" + std::to_string(t.size()) + " events, " + std::to_string(t.frame_count()) + " frames, chain " +
+               (t.header.chain.empty() ? std::string("unknown") : t.header.chain) + ")";
+      });
+
+  py::class_<Divergence>(m, "Divergence", "One point where the emulator and a trace disagree.")
+      .def_readonly("frame", &Divergence::frame, "1-based frame number")
+      .def_readonly("line", &Divergence::line, "line of the trace file")
+      .def_readonly("tick", &Divergence::tick, "when, in 250 ns ticks")
+      .def_readonly("source_time", &Divergence::source_time, "seconds shown (the capture's time when it has one)")
+      .def_readonly("summary", &Divergence::summary, "one line")
+      .def_readonly("report", &Divergence::report, "the full report: bytes, where they come from, the chip state")
+      .def("__str__", [](const Divergence& d) { return d.report; })
+      .def("__repr__", [](const Divergence& d) { return "Divergence(" + d.summary + ")"; });
+
+  py::class_<ReplayResult>(m, "ReplayResult", "What a replay did; true when every captured byte and pin matched.")
+      .def_property_readonly("matched", &ReplayResult::matched, "every captured MISO byte and pin level matched")
+      .def("__bool__", &ReplayResult::matched)
+      .def_readonly("frames", &ReplayResult::frames, "frames replayed")
+      .def_readonly("bytes_compared", &ReplayResult::bytes_compared, "captured MISO bytes checked")
+      .def_readonly("bytes_unknown", &ReplayResult::bytes_unknown, "MISO bytes the trace does not know")
+      .def_readonly("pin_checks", &ReplayResult::pin_checks, "BUSY/FLAG observations checked")
+      .def_readonly("divergent_frames", &ReplayResult::divergent_frames, "frames with a differing MISO byte")
+      .def_readonly("pin_mismatches", &ReplayResult::pin_mismatches, "BUSY/FLAG observations that differed")
+      .def_readonly("stopped_early", &ReplayResult::stopped_early, "stopped at the first divergence")
+      .def_readonly("divergences", &ReplayResult::divergences, "the reported divergences")
+      .def("__repr__", [](const ReplayResult& r) {
+        return std::string("ReplayResult(") + (r.matched() ? "matched" : "diverged") + ", " + std::to_string(r.frames) +
+               " frames, " + std::to_string(r.bytes_compared) + " bytes compared)";
+      });
+
+  py::class_<DecodeResult>(m, "DecodeResult", "A trace explained: .text is the per-chip log (str() gives it too).")
+      .def_property_readonly("frames", [](const DecodeResult& d) { return d.summary.frames; }, "frames decoded")
+      .def_property_readonly("commands", [](const DecodeResult& d) { return d.summary.commands; },
+                             "complete commands, NOPs excluded")
+      .def_property_readonly("answers", [](const DecodeResult& d) { return d.summary.answers; },
+                             "GetParam/GetStatus answers")
+      .def_property_readonly("diagnostics", [](const DecodeResult& d) { return d.summary.diagnostics; },
+                             "protocol diagnostics, shown or not")
+      .def_property_readonly("suppressed", [](const DecodeResult& d) { return d.summary.suppressed; },
+                             "diagnostics not shown (max_repeats)")
+      .def_property_readonly("answer_mismatches", [](const DecodeResult& d) { return d.summary.answer_mismatches; },
+                             "captured answers the emulator would give differently")
+      .def_readonly("text", &DecodeResult::text, "the log, one line per command, answer or diagnostic")
+      .def("__str__", [](const DecodeResult& d) { return d.text; })
+      .def("__repr__", [](const DecodeResult& d) {
+        return "DecodeResult(" + std::to_string(d.summary.frames) + " frames, " + std::to_string(d.summary.commands) +
+               " commands, " + std::to_string(d.summary.diagnostics) + " diagnostics)";
+      });
+
+  m.def(
+      "replay",
+      [](py::handle trace, py::handle chain, py::handle format, bool keep_going, std::size_t max_reports,
+         bool compare_pins) {
+        const Source s = source_of(trace, chain, format);
+        ReplayOptions o;
+        o.keep_going = keep_going;
+        o.max_reports = max_reports;
+        o.compare_pins = compare_pins;
+        py::gil_scoped_release unlocked;
+        Chain c = make_chain(s.variants);
+        auto reader = s.reader();
+        return replay_trace(*reader, c, o);
+      },
+      py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
+      py::arg("keep_going") = false, py::arg("max_reports") = 100, py::arg("compare_pins") = true,
+      R"(Drives a trace's MOSI into a fresh emulated chain with the captured timing and compares every
+MISO byte (and BUSY/FLAG observation). trace: a Trace or a file path. chain: the chain
+(default: the trace's own; for a file without one, guessed from its frame lengths).)");
+
+  m.def(
+      "decode",
+      [](py::handle trace, py::handle chain, py::handle format, bool show_nops, std::size_t max_repeats,
+         py::object only_chip) {
+        const Source s = source_of(trace, chain, format);
+        DecodeOptions o;
+        o.show_nops = show_nops;
+        o.max_repeats = max_repeats;
+        if (!only_chip.is_none())
+          o.only_chip = static_cast<int>(int_in_range(only_chip, "only_chip", 0, static_cast<long long>(s.variants.size()) - 1));
+        DecodeResult result;
+        {
+          py::gil_scoped_release unlocked;
+          std::ostringstream text;
+          Chain c = make_chain(s.variants);
+          auto reader = s.reader();
+          result.summary = decode_trace(*reader, c, text, o);
+          result.text = text.str();
+        }
+        return result;
+      },
+      py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
+      py::arg("show_nops") = false, py::arg("max_repeats") = 10, py::arg("only_chip") = py::none(),
+      "Explains a trace: every command and answer per chip, with protocol diagnostics (as `l6470emu decode`).");
+}
+
+}  // namespace l6470emu::python
