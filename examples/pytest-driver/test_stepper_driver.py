@@ -1,0 +1,16 @@
+import sys
+from pathlib import Path
+
+import pytest
+
+DRIVER = Path(__file__).with_name("stepper_driver.py")
+
+
+@pytest.mark.l6470_chain("2xL6470")
+def test_a_move_ends_on_target_and_leaves_the_other_chip_alone(spidev_board):
+    result = spidev_board.run([sys.executable, DRIVER, "--chips", "2", "--chip", "1", "--move", "-3200"])
+    assert result.stdout == "chip 1 at -3200\n"
+    log = spidev_board.decode()          # every command the driver sent, per chip
+    assert "chip 1   Move(REV, 3200 microsteps)" in log
+    assert "chip 0   Move" not in log
+    assert spidev_board.replay().matched  # the recording replays byte-exact

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# Install and package test (ctest `install_and_package`): `cmake --install` into a temporary
+# prefix; the README's CMake consumer (examples/cmake-consumer) built against it with
+# find_package and with pkg-config, and run; every installed header compiles; the installed
+# Python module finds the installed preload library and its pytest plugin loads through the
+# entry point. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
+# into a throwaway root with dpkg -x, and the consumer is built and run against that too.
+# Usage: install_test.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd)
+source=$(cd "$2" && pwd)
+work=$(mktemp -d "${TMPDIR:-/tmp}/l6470emu-install-test.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+python=/usr/bin/python3
+fail() { echo "install_test: FAIL: $*" >&2; exit 1; }
+step() { echo "-- $*"; }
+
+# Builds and runs the CMake consumer and the pkg-config consumer against PREFIX.
+consumers() {
+  local prefix=$1 name=$2
+  step "$name: the CMake consumer (find_package(l6470emu CONFIG REQUIRED))"
+  cmake -S "$source/examples/cmake-consumer" -B "$work/$name-cmake" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: configure"; }
+  cmake --build "$work/$name-cmake" >>"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: build"; }
+  out=$("$work/$name-cmake/stepper_check") || fail "$name: stepper_check exited $?"
+  [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: stepper_check printed '$out'"
+
+  step "$name: the pkg-config consumer"
+  local pc
+  pc=$(dirname "$(find "$prefix" -name l6470emu.pc -print -quit)")
+  [ -n "$pc" ] || fail "$name: no l6470emu.pc"
+  flags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags --libs l6470emu) || fail "$name: pkg-config l6470emu"
+  # shellcheck disable=SC2086
+  c++ -std=c++20 -O1 -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
+  out=$("$work/$name-pc") || fail "$name: pkg-config consumer exited $?"
+  [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: pkg-config consumer printed '$out'"
+}
+
+# The installed Python package under SITE finds the preload library at PRELOAD.
+python_module() {
+  local site=$1 preload=$2 name=$3
+  step "$name: the Python module from $site"
+  [ -f "$site/l6470emu/_build_paths.py" ] && fail "$name: the build tree's _build_paths.py was installed"
+  found=$(cd "$work" && PYTHONPATH="$site" "$python" -c 'import l6470emu, sys; c = l6470emu.Chain(2); c.move(1, True, 3200); c.advance(seconds=0.5); assert c.position(1) == 3200; print(l6470emu.preload_library())') \
+    || fail "$name: import l6470emu"
+  [ "$(realpath "$found")" = "$(realpath "$preload")" ] || fail "$name: preload_library() is $found, not $preload"
+}
+
+step "cmake --install into a temporary prefix"
+prefix=$work/prefix
+cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
+for f in bin/l6470emu include/l6470emu/core/chip.hpp include/l6470emu/daisychain/host.hpp \
+         include/l6470emu/linux/board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md; do
+  [ -f "$prefix/$f" ] || fail "not installed: $f"
+done
+[ -z "$(find "$prefix/include" -path '*preload*' -o -name '*_internal.hpp')" ] || fail "internal headers were installed"
+"$prefix/bin/l6470emu" --version | grep -qx "l6470emu [0-9.]*" || fail "l6470emu --version"
+preload=$(find "$prefix" -name libl6470emu-preload.so -print -quit)
+case "$preload" in "$prefix"/lib*/l6470emu/libl6470emu-preload.so) ;; *) fail "preload library at '$preload'" ;; esac
+
+step "every installed header compiles (one translation unit including them all)"
+(cd "$prefix/include" && find l6470emu -name '*.hpp' | sort | sed 's/.*/#include <&>/') >"$work/all_headers.cpp"
+c++ -std=c++20 -fsyntax-only -I"$prefix/include" -I"$prefix/include/l6470emu" "$work/all_headers.cpp" || fail "installed headers"
+
+step "the CMake package: every target and variable"
+mkdir -p "$work/targets"
+cat >"$work/targets/CMakeLists.txt" <<'CMAKE'
+cmake_minimum_required(VERSION 3.25)
+project(targets LANGUAGES CXX)
+find_package(l6470emu CONFIG REQUIRED)
+foreach(t core spi daisychain linux l6470emu)
+  if(NOT TARGET l6470emu::${t})
+    message(FATAL_ERROR "no target l6470emu::${t}")
+  endif()
+endforeach()
+if(NOT EXISTS "${l6470emu_PRELOAD_LIBRARY}" OR NOT EXISTS "${l6470emu_PROGRAM}")
+  message(FATAL_ERROR "l6470emu_PRELOAD_LIBRARY / l6470emu_PROGRAM")
+endif()
+CMAKE
+cmake -S "$work/targets" -B "$work/targets/build" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >"$work/targets.log" 2>&1 \
+  || { cat "$work/targets.log"; fail "the CMake package's targets"; }
+
+consumers "$prefix" prefix
+site=$(dirname "$(dirname "$(find "$prefix" -name pytest_plugin.py -path '*/l6470emu/*' -print -quit)")")
+case "$site" in "$prefix"/lib/python3.[0-9]*/dist-packages) ;; *) fail "Python package in '$site', not lib/python3.X/dist-packages" ;; esac
+python_module "$site" "$preload" prefix
+
+step "prefix: the pytest plugin loads through its entry point (no conftest)"
+mkdir -p "$work/plugin"
+cat >"$work/plugin/test_entry_point.py" <<'PY'
+import pytest
+
+@pytest.mark.l6470_chain("L6480")
+def test_chain(l6470_chain):
+    assert l6470_chain.variants == ["L6480"]
+
+def test_board(spidev_board):
+    import os
+    assert os.path.realpath(spidev_board.preload) == os.path.realpath(os.environ["EXPECTED_PRELOAD"])
+PY
+(cd "$work/plugin" && env -u PYTEST_DISABLE_PLUGIN_AUTOLOAD PYTHONPATH="$site" PYTHONDONTWRITEBYTECODE=1 EXPECTED_PRELOAD="$preload" \
+  "$python" -m pytest -q -p no:cacheprovider test_entry_point.py) || fail "the pytest plugin's entry point"
+
+step "cpack -G DEB"
+cpack --config "$build/CPackConfig.cmake" -G DEB -B "$work/deb" >"$work/cpack.log" 2>&1 || { cat "$work/cpack.log"; fail "cpack"; }
+deb=$(ls "$work"/deb/l6470emu_*.deb)
+dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./||' >"$work/deb.files"
+for pattern in usr/bin/l6470emu 'usr/lib/.*l6470emu/libl6470emu-preload\.so' 'usr/lib/.*libl6470emu_core\.a' \
+               'usr/lib/.*cmake/l6470emu/l6470emuConfig\.cmake' 'usr/lib/.*pkgconfig/l6470emu\.pc' \
+               usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1 \
+               usr/share/doc/l6470emu/README.md usr/share/doc/l6470emu/examples/cmake-consumer/main.cpp \
+               'usr/lib/python3/dist-packages/l6470emu/_l6470emu\.cpython-.*\.so' \
+               usr/lib/python3/dist-packages/l6470emu/__init__.py usr/lib/python3/dist-packages/l6470emu/_l6470emu.pyi \
+               usr/lib/python3/dist-packages/l6470emu/py.typed usr/lib/python3/dist-packages/l6470emu/pytest_plugin.py \
+               usr/lib/python3/dist-packages/l6470emu/_install_paths.py \
+               'usr/lib/python3/dist-packages/l6470emu-.*\.dist-info/entry_points\.txt'; do
+  grep -qx "$pattern" "$work/deb.files" || fail "the .deb lacks $pattern"
+done
+grep -q '_build_paths' "$work/deb.files" && fail "the .deb holds the build tree's _build_paths.py"
+depends=$(dpkg-deb -f "$deb" Depends)
+for d in libc6 libstdc++6 'python3 (>= 3'; do
+  [[ "$depends" == *"$d"* ]] || fail ".deb Depends '$depends' lacks $d"
+done
+[[ "$depends" == *spidev* || "$depends" == *gpiod* ]] && fail ".deb Depends '$depends' names a user-side package"
+
+step "the .deb unpacked into a throwaway root (dpkg -x)"
+root=$work/root
+dpkg -x "$deb" "$root"
+"$root/usr/bin/l6470emu" --version >/dev/null || fail "the packaged program"
+consumers "$root/usr" deb
+python_module "$root/usr/lib/python3/dist-packages" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
+
+echo "install_test: 1 passed, 0 failed"

@@ -1,0 +1,132 @@
+"""Traces from Python: a Chain records itself (into memory or a native file flushed frame by
+frame), Trace loads every format the l6470emu program reads, and replay() / decode() run the
+library's replay and decoder over a Trace or a file."""
+from pathlib import Path
+
+import pytest
+
+import l6470emu
+from l6470emu import Reg
+
+FIXTURES = Path(__file__).resolve().parents[2] / "fixtures" / "traces"
+
+
+def session(chain):
+    chain.get_status(1)
+    chain.set_param(1, Reg.MAX_SPEED, 0x20)
+    chain.move(1, True, 1600)
+    chain.set_sw_pin(0, False)
+    chain.set_thermal(0, "warning")
+    chain.advance(seconds=0.5)
+    chain.get_param(1, Reg.ABS_POS)
+    chain.frame(b"\xD0\xD0")
+    chain.frame(bytes(2))
+
+
+def test_a_recording_in_memory_replays_without_a_divergence():
+    chain = l6470emu.Chain(["L6470", "L6480"], record=True)
+    assert chain.recording
+    session(chain)
+    trace = chain.trace
+    assert trace.chain == "L6470,L6480" and trace.frame_count == 3 + 3 + 4 + 4 + 2
+    kinds = {e.kind for e in trace}
+    assert kinds == {"frame", "pin", "fault"}
+    result = l6470emu.replay(trace)
+    assert result and result.matched and result.frames == trace.frame_count and result.pin_checks > 0
+    assert not result.divergences
+
+
+def test_a_recording_into_a_file_is_complete_as_it_goes(tmp_path):
+    path = tmp_path / "run.trace"
+    with l6470emu.Chain(["L6470", "L6480"], record=path) as chain:
+        assert chain.record_path == str(path)
+        session(chain)
+        frames_so_far = path.read_text().count(" frame ")
+        assert frames_so_far == 16  # flushed frame by frame, before the chain is closed
+    assert not chain.recording
+    chain.get_status(0)  # still usable, no longer recorded
+    assert l6470emu.Trace.load(path).frame_count == 16
+    assert l6470emu.replay(path).matched
+    assert l6470emu.replay(str(path), chain=["L6470", "L6480"]).matched
+
+
+def test_decode_explains_every_command_per_chip():
+    chain = l6470emu.Chain(2, record=True)
+    chain.get_status(1)
+    chain.move(1, False, 3200)
+    chain.frame(b"\xEB\x00")  # a reserved opcode for chip 0
+    result = l6470emu.decode(chain.trace)
+    assert "chip 1   Move(REV, 3200 microsteps)" in result.text
+    assert "GetStatus" in str(result)
+    assert (result.commands, result.answers, result.diagnostics) == (1, 1, 1)  # Move; GetStatus; 0xEB
+    only = l6470emu.decode(chain.trace, only_chip=0).text
+    assert "Move" not in only
+
+
+def test_a_diverging_replay_reports_where_and_why():
+    chain = l6470emu.Chain(1, record=True)
+    chain.move(0, True, 3200)
+    chain.set_sw_pin(0, False)
+    chain.advance(seconds=0.5)
+    chain.get_param(0, Reg.ABS_POS)
+    lines = chain.trace.to_native().splitlines()  # edit the last frame's last MISO byte
+    last = max(i for i, l in enumerate(lines) if " frame " in l)
+    lines[last] = lines[last][:-2] + ("00" if not lines[last].endswith("00") else "01")
+    trace = l6470emu.Trace.parse("\n".join(lines) + "\n", name="edited.trace")
+    result = l6470emu.replay(trace)
+    assert not result and result.divergent_frames == 1 and result.stopped_early
+    assert result.divergences[0].summary.startswith("edited.trace:")
+    assert "expected" in result.divergences[0].report
+    assert l6470emu.replay(trace, keep_going=True).stopped_early is False
+
+
+@pytest.mark.parametrize("name, chain", [
+    ("three_chips.trace", None), ("single_chip.trace", None), ("saleae_logic2.csv", "L6470"),
+    ("saleae_logic2_decimal_no_duration.csv", "L6470"),
+])
+def test_the_fixture_captures_replay_clean(name, chain):
+    assert l6470emu.replay(FIXTURES / name, chain=chain).matched
+    assert l6470emu.decode(FIXTURES / name, chain=chain).frames > 0
+
+
+def test_loading_any_format_gives_events_with_their_bytes():
+    trace = l6470emu.Trace.load(FIXTURES / "saleae_logic2.csv")
+    assert trace.format == "saleae" and trace.chain is None and len(trace) == trace.frame_count
+    first = trace[0]
+    assert (first.kind, first.mosi, first.miso) == ("frame", b"\xD0", b"\x00")
+    assert first.source_time == pytest.approx(0.4218552, abs=1e-6) and first.line == 2
+    assert trace[-1].kind == "frame"
+    with pytest.raises(IndexError):
+        trace[len(trace)]
+    with pytest.raises(ValueError, match="names no chain"):
+        l6470emu.replay(trace)
+    assert l6470emu.replay(trace, chain="L6470").matched
+    native = l6470emu.Trace.load(FIXTURES / "three_chips.trace")
+    faults = [e for e in native if e.kind == "fault"]
+    assert faults and faults[0].fault == "THERMAL" and faults[0].chip == 2
+    assert any(e.pin == "SW" for e in native)
+
+
+def test_a_trace_saved_and_parsed_back_is_the_same(tmp_path):
+    trace = l6470emu.Trace.load(FIXTURES / "three_chips.trace")
+    trace.save(tmp_path / "copy.trace")
+    again = l6470emu.Trace.load(tmp_path / "copy.trace")
+    assert again.to_native() == trace.to_native()
+    assert l6470emu.Trace.parse(trace.to_native()).frame_count == trace.frame_count
+
+
+def test_malformed_input_is_a_trace_error_with_file_and_line(tmp_path):
+    bad = tmp_path / "bad.trace"
+    bad.write_text("l6470emu-trace 1\nchain 1*L6470\n0.001 frame 1us D0 | ZZ\n")
+    with pytest.raises(l6470emu.TraceError) as caught:
+        l6470emu.replay(bad)
+    assert caught.value.file.endswith("bad.trace") and caught.value.line == 3
+    assert isinstance(caught.value, ValueError) and "bad.trace:3:" in str(caught.value)
+    with pytest.raises(l6470emu.TraceError, match="cannot open"):
+        l6470emu.Trace.load(tmp_path / "missing.trace")
+    with pytest.raises(l6470emu.TraceError, match="unknown trace format"):
+        l6470emu.Trace.parse("hello\n")
+    with pytest.raises(ValueError, match="format"):
+        l6470emu.Trace.load(bad, format="pcap")
+    with pytest.raises(RuntimeError, match="record"):
+        l6470emu.Chain(record=tmp_path / "no" / "such" / "dir.trace")
