@@ -1,3 +1,4 @@
+# Tests an unmodified py-spidev driver (stepper_driver.py) against two emulated L6470s.
 import sys
 from pathlib import Path
 
