@@ -105,6 +105,9 @@ const Variant& powerstep01();
 /// Every family member, in the order above.
 std::span<const Variant* const> all_variants();
 
+/// Whether two datasheet names are the same ignoring ASCII case ("ABS_POS" and "abs_pos").
+bool same_name(std::string_view a, std::string_view b);
+
 /// The variant called `name` (case-insensitive: "L6470", "l6480", "powerSTEP01", "powerstep01"), or nullptr.
 const Variant* find_variant(std::string_view name);
 

@@ -5,7 +5,6 @@
 #include "core/variant.hpp"
 
 namespace l6470emu {
-namespace {
 
 bool same_name(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
@@ -13,8 +12,6 @@ bool same_name(std::string_view a, std::string_view b) {
     if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
   return true;
 }
-
-}  // namespace
 
 std::span<const Variant* const> all_variants() {
   static const std::array<const Variant*, 5> kAll{&l6470(), &l6472(), &l6480(), &l6482(), &powerstep01()};

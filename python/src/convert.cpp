@@ -11,12 +11,6 @@
 namespace l6470emu::python {
 namespace {
 
-bool same_name(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  return true;
-}
 
 // A 1-byte item format: "B", "b", "c", optionally with a byte-order character.
 bool byte_format(const std::string& f) {
