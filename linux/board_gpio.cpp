@@ -14,13 +14,13 @@ namespace {
 template <typename T>
 T load(std::span<const std::uint8_t> arg) {
   T v{};
-  std::memcpy(&v, arg.data(), std::min(sizeof v, arg.size()));
+  if (!arg.empty()) std::memcpy(&v, arg.data(), std::min(sizeof v, arg.size()));  // an empty argument may be null
   return v;
 }
 
 template <typename T>
 void store(std::span<std::uint8_t> arg, const T& v) {
-  std::memcpy(arg.data(), &v, std::min(sizeof v, arg.size()));
+  if (!arg.empty()) std::memcpy(arg.data(), &v, std::min(sizeof v, arg.size()));
 }
 
 void copy_name(char (&dst)[GPIO_MAX_NAME_SIZE], const std::string& s) {
