@@ -238,24 +238,18 @@ __attribute__((visibility("default"))) ssize_t read(int fd, void* buf, size_t co
     }
     return real::read(fd, buf, count);
   }
+  auto body = [&]() __attribute__((noinline)) -> ssize_t {
+    Guard guard;
+    try {
+      return emulated_read(fd, *e, buf, count);
+    } catch (...) {
+      errno = ENOMEM;
+      return -1;
+    }
+  };
   // Virtual time: a read of gpio events may wait, a cancellation point acted on out here.
-  if (installed_virtual_time())
-    return as_cancellation_point([&]() __attribute__((noinline)) -> ssize_t {
-      Guard guard;
-      try {
-        return emulated_read(fd, *e, buf, count);
-      } catch (...) {
-        errno = ENOMEM;
-        return -1;
-      }
-    });
-  Guard guard;
-  try {
-    return emulated_read(fd, *e, buf, count);
-  } catch (...) {
-    errno = ENOMEM;
-    return -1;
-  }
+  if (installed_virtual_time()) return as_cancellation_point(body);
+  return body();
 }
 
 __attribute__((visibility("default"))) ssize_t __read_chk(int fd, void* buf, size_t count, size_t buflen) {
