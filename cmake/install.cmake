@@ -2,13 +2,8 @@
 # under include/l6470emu/, exported as l6470emu::core/spi/daisychain/linux (find_package) and
 # described in l6470emu.pc (pkg-config); the preload library in lib/l6470emu/; the l6470emu
 # program, its man page and the docs. The Python module installs itself (python/CMakeLists.txt).
-include(GNUInstallDirs)
+# The locations themselves are set in cmake/install_dirs.cmake (included first).
 include(CMakePackageConfigHelpers)
-
-set(L6470EMU_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/l6470emu CACHE STRING
-    "Where l6470emuConfig.cmake goes, relative to the prefix")
-set(L6470EMU_INSTALL_PRELOADDIR ${CMAKE_INSTALL_LIBDIR}/l6470emu CACHE STRING
-    "Where libl6470emu-preload.so goes, relative to the prefix")
 
 # Installed headers keep the in-tree spelling: include/l6470emu/core/chip.hpp is reached as
 # <l6470emu/core/chip.hpp>, and include/l6470emu is on the include path too, so the headers'
