@@ -56,13 +56,14 @@ std::uint8_t Chain::exchange(std::uint8_t mosi) {
 }
 
 void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  if (!selected_ || standby_in_frame_) {
+  const std::size_t n = ring_.size();
+  if (!selected_ || (standby_in_frame_ && tx.size() < n)) {
     for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
     return;
   }
+  if (standby_in_frame_ && exchange_through_standby(tx, rx)) return;
   // The common case: a plain shift of the ring buffer, a run of bytes at a time
   // (what leaves the ring goes to MISO, what enters it comes from MOSI).
-  const std::size_t n = ring_.size();
   std::uint8_t* ring = ring_.data();
   std::size_t head = head_;
   if (tx.size() >= n) {
@@ -87,6 +88,31 @@ void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> r
   }
   head_ = head;
   bytes_in_frame_ += tx.size();
+}
+
+bool Chain::exchange_through_standby(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  // At least a whole chain's worth of bytes while chips in standby break the chain. A byte
+  // reaches MISO only if it never sits in a standby chip's register on its way, so only what
+  // the chips in front of the first standby chip held comes out; everything after is 0x00.
+  // Every byte in the ring at the end came from tx (tx.size() >= n); those that passed through
+  // the last standby chip were lost, the ones behind it are tx's last bytes. This equals n or
+  // more single-byte exchanges, in O(tx.size()) memory traffic rather than O(n) per byte.
+  const std::size_t n = ring_.size();
+  std::size_t first = n, last = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!chips_[i].spi_enabled()) {
+      first = std::min(first, i);
+      last = i;
+    }
+  if (first == n) return false;  // STBY rose since the frame began: a plain shift
+  const std::size_t size = tx.size();
+  for (std::size_t i = 0; i < first; ++i) rx[i] = ring_[(head_ + i) % n];
+  std::memset(rx.data() + first, 0, size - first);
+  const std::size_t new_head = (head_ + size) % n;
+  head_ = new_head;
+  for (std::size_t i = 0; i < n; ++i) set_shift_register(i, i > last ? tx[size - n + i] : 0x00);
+  bytes_in_frame_ += size;
+  return true;
 }
 
 void Chain::deselect() {

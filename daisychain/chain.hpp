@@ -67,6 +67,8 @@ class Chain final : public SpiDevice {
  private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
+  /// false (nothing done) when no chip is in standby any more.
+  bool exchange_through_standby(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
   // Chips are advanced lazily: when they decode a byte that needs their state,
   // or when someone looks at them through chip(). Hence mutable.

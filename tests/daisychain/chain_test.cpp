@@ -337,5 +337,50 @@ TEST(ChainShift, ABlockOfBytesShiftsExactlyAsTheSameBytesOneByOne) {
   }
 }
 
+TEST(ChainShift, ABlockThroughChipsInStandbyShiftsExactlyAsTheSameBytesOneByOne) {
+  std::uint32_t seed = 777;
+  auto next = [&] { return static_cast<std::uint8_t>((seed = seed * 1103515245u + 12345u) >> 16); };
+  for (std::size_t chips : {1u, 2u, 3u, 5u}) {
+    for (unsigned standby = 1; standby < (1u << chips); ++standby) {  // every non-empty set
+      for (std::size_t len : {chips, chips + 1, 2 * chips + 3, std::size_t{40}}) {
+        for (std::size_t lead = 0; lead < chips + 1; ++lead) {
+          Chain block(chips), single(chips);
+          for (std::size_t k = 0; k < chips; ++k) {  // registers full of something before STBY falls
+            block.select();
+            single.select();
+            const std::uint8_t b = next();
+            block.exchange(b);
+            single.exchange(b);
+          }
+          for (std::size_t k = 0; k < chips; ++k)
+            if (standby & (1u << k)) {
+              block.chip(k).set_stby_rst_pin(false);
+              single.chip(k).set_stby_rst_pin(false);
+            }
+          block.deselect();
+          single.deselect();
+          block.select();
+          single.select();
+          for (std::size_t i = 0; i < lead; ++i) {
+            const std::uint8_t b = next();
+            block.exchange(b);
+            single.exchange(b);
+          }
+          std::vector<std::uint8_t> tx(len), rx_block(len), rx_single(len);
+          for (auto& b : tx) b = next();
+          block.exchange(tx, rx_block);
+          for (std::size_t i = 0; i < len; ++i) rx_single[i] = single.exchange(tx[i]);
+          const auto what = std::to_string(chips) + " chips, standby set " + std::to_string(standby) + ", " +
+                            std::to_string(len) + " bytes after " + std::to_string(lead);
+          EXPECT_EQ(rx_block, rx_single) << what;
+          for (std::size_t k = 0; k < chips; ++k)
+            EXPECT_EQ(block.shift_register(k), single.shift_register(k)) << what << ", chip " << k;
+          EXPECT_EQ(block.bytes_in_frame(), single.bytes_in_frame()) << what;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace l6470emu
