@@ -53,6 +53,17 @@ void from_wire(const std::uint8_t* wire, std::uint8_t* host, std::size_t len, un
 
 }  // namespace
 
+bool is_spidev_settings_ioctl(unsigned long cmd) {
+  switch (cmd) {
+    case SPI_IOC_RD_MODE: case SPI_IOC_WR_MODE: case SPI_IOC_RD_MODE32: case SPI_IOC_WR_MODE32:
+    case SPI_IOC_RD_LSB_FIRST: case SPI_IOC_WR_LSB_FIRST: case SPI_IOC_RD_BITS_PER_WORD:
+    case SPI_IOC_WR_BITS_PER_WORD: case SPI_IOC_RD_MAX_SPEED_HZ: case SPI_IOC_WR_MAX_SPEED_HZ:
+      return true;
+    default:
+      return false;
+  }
+}
+
 IoctlResult spidev_settings_ioctl(SpidevSettings& s, unsigned long cmd, std::uint32_t& value) {
   switch (cmd) {
     case SPI_IOC_RD_MODE:
@@ -112,7 +123,7 @@ bool is_spi_message_ioctl(unsigned long cmd, std::size_t& n) {
   return true;
 }
 
-IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers) {
+IoctlResult spidev_message_sizes(std::uint32_t bufsiz, std::span<const spi_ioc_transfer> xfers) {
   std::uint64_t total = 0, tx_total = 0, rx_total = 0;
   for (const auto& x : xfers) {
     const std::uint64_t aligned = (std::uint64_t{x.len} + kKmallocMinAlign - 1) / kKmallocMinAlign * kKmallocMinAlign;
@@ -120,13 +131,19 @@ IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi
     if (total > INT_MAX || x.len > INT_MAX) return -EMSGSIZE;
     if (x.rx_buf) {
       rx_total += aligned;
-      if (rx_total > s.bufsiz) return -EMSGSIZE;
+      if (rx_total > bufsiz) return -EMSGSIZE;
     }
     if (x.tx_buf) {
       tx_total += aligned;
-      if (tx_total > s.bufsiz) return -EMSGSIZE;
+      if (tx_total > bufsiz) return -EMSGSIZE;
     }
   }
+  return static_cast<IoctlResult>(total);
+}
+
+IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers) {
+  const IoctlResult total = spidev_message_sizes(s.bufsiz, xfers);
+  if (total < 0) return total;
   // __spi_validate
   if (xfers.empty()) return -EINVAL;
   for (const auto& x : xfers) {
@@ -136,7 +153,7 @@ IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi
     if (x.tx_buf && x.tx_nbits != 0 && x.tx_nbits != 1) return -EINVAL;  // dual/quad need SPI_TX_DUAL/QUAD
     if (x.rx_buf && x.rx_nbits != 0 && x.rx_nbits != 1) return -EINVAL;
   }
-  return static_cast<IoctlResult>(total);
+  return total;
 }
 
 std::size_t spidev_tx_bytes(std::span<const spi_ioc_transfer> xfers) {

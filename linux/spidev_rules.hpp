@@ -48,6 +48,11 @@ using IoctlResult = long;
 /// Whether `bits` is a word size the emulated controller supports (8, 16, 32).
 constexpr bool controller_supports_bits(unsigned bits) { return bits == 8 || bits == 16 || bits == 32; }
 
+/// Whether `cmd` is one of spidev's settings ioctls (exactly: the size and direction too).
+/// spidev answers any other command but SPI_IOC_MESSAGE(n) with -ENOTTY before it touches the
+/// caller's memory.
+bool is_spidev_settings_ioctl(unsigned long cmd);
+
 /// SPI_IOC_RD_* / SPI_IOC_WR_* except SPI_IOC_MESSAGE: reads or changes `s` as spidev does.
 /// `value` is the (already copied) argument; reads store into it. Returns 0 or -errno
 /// (-ENOTTY for a command that is not a spidev settings ioctl).
@@ -55,6 +60,11 @@ IoctlResult spidev_settings_ioctl(SpidevSettings& s, unsigned long cmd, std::uin
 
 /// Whether `cmd` is SPI_IOC_MESSAGE(n) for some n (n may be 0); sets n.
 bool is_spi_message_ioctl(unsigned long cmd, std::size_t& n);
+
+/// spidev_message's first loop, before any user memory is copied: -EMSGSIZE when the tx or
+/// rx data (each transfer rounded up to 8 bytes) exceeds `bufsiz`, or the total exceeds INT_MAX.
+/// Returns the total length in bytes or -EMSGSIZE. Every transport checks this before it copies.
+IoctlResult spidev_message_sizes(std::uint32_t bufsiz, std::span<const spi_ioc_transfer> xfers);
 
 /// spidev_message's and __spi_validate's checks on a message, before anything is clocked:
 /// -EMSGSIZE past bufsiz (or past INT_MAX in total), -EINVAL for word sizes, lengths and

@@ -40,16 +40,9 @@ long spi_message(FdEntry& e, std::size_t n, void* argp) {
   t_xfers.resize(n);
   if (!copy_from_user(t_xfers.data(), argp, n * sizeof(spi_ioc_transfer))) return fail(-EFAULT);
   const std::uint32_t bufsiz = nodes()[e.node].bufsiz;
-  // spidev_message's first loop: sizes against the bounce buffers, tx data copied in, in order.
-  std::uint64_t total = 0, tx_total = 0, rx_total = 0, tx_bytes = 0;
-  for (const auto& x : t_xfers) {
-    const std::uint64_t aligned = (std::uint64_t{x.len} + 7) / 8 * 8;
-    total += x.len;
-    if (total > 0x7FFFFFFF || x.len > 0x7FFFFFFF) return fail(-EMSGSIZE);
-    if (x.rx_buf && (rx_total += aligned) > bufsiz) return fail(-EMSGSIZE);
-    if (x.tx_buf && (tx_total += aligned) > bufsiz) return fail(-EMSGSIZE);
-    if (x.tx_buf) tx_bytes += x.len;
-  }
+  // spidev_message's first loop: sizes against the bounce buffers, before anything is copied.
+  if (const long sizes = spidev_message_sizes(bufsiz, t_xfers); sizes < 0) return fail(sizes);
+  const std::size_t tx_bytes = spidev_tx_bytes(t_xfers);
   t_tx.resize(tx_bytes);
   std::size_t off = 0, rx_bytes = 0;
   for (const auto& x : t_xfers) {
@@ -84,7 +77,7 @@ long new_fd_offset(unsigned long cmd) {
 long generic_ioctl(FdEntry& e, unsigned long cmd, void* argp) {
   const std::size_t size = _IOC_SIZE(cmd);
   const unsigned dir = _IOC_DIR(cmd);
-  if (e.kind == HandleKind::spidev && _IOC_TYPE(cmd) != SPI_IOC_MAGIC) return fail(-ENOTTY);
+  if (e.kind == HandleKind::spidev && !is_spidev_settings_ioctl(cmd)) return fail(-ENOTTY);
   std::uint8_t buf[1024] = {};
   if (size > sizeof buf) return fail(e.kind == HandleKind::spidev ? -ENOTTY : -EINVAL);
   if ((dir & _IOC_WRITE) && !copy_from_user(buf, argp, size)) return fail(-EFAULT);
