@@ -477,6 +477,14 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
   wake_pump();
 }
 
+std::size_t Board::spidev_node(std::size_t chain) const {
+  for (std::size_t i = 0; i < nodes_.size(); ++i)
+    if (nodes_[i].type == DeviceNode::Type::spidev && node_target_[i] == static_cast<int>(chain)) return i;
+  return nodes_.size();
+}
+
+std::size_t Board::chip_count(std::size_t chain) const { return chains_.at(chain)->chain.size(); }
+
 bool Board::drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level) {
   std::lock_guard lock(m_);
   if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;

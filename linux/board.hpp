@@ -102,6 +102,10 @@ class Board {
   // ---- the physical world (ctl, tests) ----------------------------------------
 
   std::size_t chain_count() const { return chains_.size(); }
+  /// Index in nodes() of chain `chain`'s spidev node.
+  std::size_t spidev_node(std::size_t chain) const;
+  /// Number of chips of chain `chain`.
+  std::size_t chip_count(std::size_t chain) const;
   /// "spidev0.0 (3 x L6470, gpiochip0)".
   std::string chain_summary(std::size_t chain) const;
   /// Index of the chain on node path or name ("spidev0.0", "/dev/spidev0.0", "0.0"), or -1.

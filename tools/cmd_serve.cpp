@@ -7,6 +7,7 @@
 #include "linux/config.hpp"
 #include "linux/serve/control.hpp"
 #include "linux/serve/daemon.hpp"
+#include "tools/kernel_nodes.hpp"
 
 namespace l6470emu {
 
@@ -26,6 +27,16 @@ ServeCommands::ServeCommands(CLI::App& app) {
   serve_->add_option("--record", record_,
                      "record every chain into this native trace, flushed frame by frame "
                      "(several chains: the chain's name goes before the extension)");
+
+  serve_->add_flag("--cuse", cuse_,
+                   "also serve each chain as a real character device /dev/spidevB.C through CUSE "
+                   "(root; modprobe cuse), for every program, static or not");
+  serve_->add_flag("--uhid", uhid_,
+                   "also put each chip's BUSY, FLAG, SW, STCK, STBY_RST on a real gpiochip: one emulated "
+                   "CP2112 USB bridge per chip through /dev/uhid (root; modprobe uhid hid-cp2112)");
+  serve_->add_option("--node-owner", node_owner_, "owner of the kernel nodes (user name or id; default root)");
+  serve_->add_option("--node-group", node_group_, "group of the kernel nodes (default root; `spi`, `gpio` as on a Raspberry Pi)");
+  serve_->add_option("--node-mode", node_mode_, "mode of the kernel nodes, octal (default 0660)");
 
   ctl_ = app.add_subcommand("ctl", "control a running daemon: " + std::string("status, get, dump, sw, pin, fault, adc, "
                                                                                "time, advance, chains, trace (ctl help)"));
@@ -61,7 +72,16 @@ std::optional<int> ServeCommands::run() {
     if (!log_.empty()) config.log = log_;
     if (!record_.empty()) config.trace = record_;
     const std::string socket = !socket_.empty() ? socket_ : !config.socket.empty() ? config.socket : default_socket_path();
-    return run_daemon(config, socket, std::cout, std::cerr);
+    FrontEnds front_ends;
+    if (cuse_ || uhid_) {
+      NodeAccess access;
+      if (const std::string error = parse_node_access(node_owner_, node_group_, node_mode_, access); !error.empty()) {
+        std::cerr << "l6470emu serve: " << error << "\n";
+        return 2;
+      }
+      front_ends = kernel_front_ends(cuse_, uhid_, access);
+    }
+    return run_daemon(config, socket, std::cout, std::cerr, front_ends);
   }
   if (ctl_ && *ctl_) {
     std::vector<std::string> all = {command_word_};

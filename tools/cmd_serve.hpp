@@ -27,6 +27,11 @@ class ServeCommands {
   bool virtual_time_ = false;
   std::string log_;
   std::string record_;
+  bool cuse_ = false;
+  bool uhid_ = false;
+  std::string node_owner_ = "root";
+  std::string node_group_ = "root";
+  std::string node_mode_ = "0660";
   std::string command_word_;  // the ctl command; its arguments come from remaining()
 };
 

@@ -116,7 +116,8 @@ std::string default_socket_path() {
   return "/tmp/l6470emu-" + std::to_string(getuid()) + ".sock";
 }
 
-int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err) {
+int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err,
+               const FrontEnds& front_ends) {
   sockaddr_un addr;
   if (!fill_address(socket_path, addr)) {
     err << "l6470emu serve: socket path too long or empty: " << socket_path << "\n";
@@ -176,6 +177,19 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     }
   }
   board.start_pump();
+  std::shared_ptr<void> kept;
+  if (front_ends) {
+    std::string error;
+    kept = front_ends(board, out, error);
+    if (!error.empty()) {
+      err << "l6470emu serve: " << error << "\n";
+      kept.reset();
+      close(listener);
+      unlink(socket_path.c_str());
+      if (sfd >= 0) close(sfd);
+      return 1;
+    }
+  }
   std::mutex control_mutex;  // ctl commands one at a time
   const ControlHandler control = [&](const std::string& command, std::string& text) {
     std::lock_guard lock(control_mutex);
@@ -266,6 +280,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     pthread_join(c.thread, nullptr);
     close(c.fd);
   }
+  kept.reset();  // the kernel nodes go away before the recordings end
   for (std::size_t i = 0; i < board.chain_count(); ++i) {
     std::string summary;
     if (board.stop_recording(i, &summary)) out << "l6470emu serve: recorded " << summary << "\n";

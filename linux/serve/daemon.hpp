@@ -2,6 +2,8 @@
 // and `ctl` over one Unix SOCK_SEQPACKET socket, a thread per connection.
 #pragma once
 
+#include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -13,9 +15,17 @@ namespace l6470emu {
 /// else /tmp/l6470emu-<uid>.sock.
 std::string default_socket_path();
 
+class Board;
+
+/// More ways in, started once the board exists (the kernel nodes of `serve --cuse --uhid`):
+/// returns what must stay alive while the daemon serves, or sets `error` to one line. Whatever
+/// it prints to `out` goes before the daemon's "run programs with" line.
+using FrontEnds = std::function<std::shared_ptr<void>(Board& board, std::ostream& out, std::string& error)>;
+
 /// Serves `config` on `socket_path` until SIGINT or SIGTERM. Prints one line when ready.
-/// Returns the exit status (non-zero when the socket cannot be set up).
-int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err);
+/// Returns the exit status (non-zero when the socket or a front end cannot be set up).
+int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err,
+               const FrontEnds& front_ends = {});
 
 /// Sends one control command to the daemon at `socket_path`; prints its answer.
 int run_ctl(const std::string& socket_path, const std::string& command, std::ostream& out, std::ostream& err);
