@@ -135,6 +135,7 @@ class Decoder {
     std::string where = e.chip == ProtocolEvent::kNoChip ? "frame " + std::to_string(e.frame + 1) + " " : chip_column(e.chip);
     std::string l = stamp(t) + where + "! " + text + "  [" + name_;
     if (e.line) l += ":" + std::to_string(e.line);
+    if (e.repetition) l += " repetition " + std::to_string(e.repetition);
     l += ']';
     if (options_.max_repeats != 0 && count == options_.max_repeats) l += "  (further ones of this kind not shown)";
     put(t, std::move(l));
