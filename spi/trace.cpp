@@ -107,7 +107,7 @@ class TraceCursor final : public TraceReader {
     e = trace_[i_++];
     return true;
   }
-  ReadProgress progress() const override { return {i_, trace_.size()}; }
+  ReadProgress progress() const override { return {i_, trace_.size(), false}; }
 
  private:
   const Trace& trace_;

@@ -104,6 +104,7 @@ class TraceError : public std::runtime_error {
 struct ReadProgress {
   std::uint64_t done = 0;   ///< bytes of the file (or events) behind the reader
   std::uint64_t total = 0;  ///< all of them; 0 = not known
+  bool bytes = true;        ///< done and total count bytes (else events)
 };
 
 /// A source of trace events, read once from the start (a file being parsed, a Trace in memory).

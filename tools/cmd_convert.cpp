@@ -13,6 +13,7 @@
 #include "spi/export_vcd.hpp"
 #include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
+#include "tools/progress.hpp"
 #include "tools/trace_commands.hpp"
 
 namespace l6470emu {
@@ -78,8 +79,11 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
       TraceHeader h = reader->header();
       if (!args.trace.chain.empty()) h.chain = chain_spec_of(parse_chain_spec(args.trace.chain));
       w.write_header(h);
+      ProgressBar bar = ProgressBar::on_stderr("converting " + file.path());
+      ProgressTraceReader watched(*reader, bar);
       TraceEvent e;
-      while (reader->next(e)) w.write(e);
+      while (watched.next(e)) w.write(e);
+      bar.finish();
       w.finish();
     } else if (to == "ioctl") {
       std::unique_ptr<TraceReader> reader = file.read();

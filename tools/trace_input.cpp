@@ -24,6 +24,7 @@
 #include "daisychain/chain_spec.hpp"
 #include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
+#include "tools/progress.hpp"
 
 namespace l6470emu {
 namespace {
@@ -171,7 +172,21 @@ TraceFile::TraceFile(std::string path, const TraceInputOptions& options)
     trace_ = import_sigrok_json(run_sigrok_spi_decoder(path_, options), path_, options.import);
     trace_.header.format = "sigrok-cli on a logic capture";
   } else {
-    trace_ = import_trace(read_trace_file(path_), path_, format_, options.import);
+    {
+      // Reading a large capture takes a while: a bar on a terminal (the parse that follows
+      // is faster than the disk).
+      std::string text;
+      {
+        TraceFileReader in(path_);
+        ProgressBar bar = ProgressBar::on_stderr("reading " + path_);
+        std::vector<char> buf(1 << 20);
+        while (const std::size_t got = in.read(buf.data(), buf.size())) {
+          text.append(buf.data(), got);
+          bar.update(in.disk_offset(), in.size_on_disk());
+        }
+      }
+      trace_ = import_trace(text, path_, format_, options.import);
+    }
   }
   header_ = trace_.header;
 }
