@@ -1,7 +1,11 @@
 // Trace benchmarks: replaying a native trace of 10 million frames from disk (parse, drive
-// the emulated chain, compare every MISO byte; goal >= 2 M frames/s) and importing a Saleae
-// Logic 2 CSV export (goal >= 50 MB/s). The inputs are generated here, in /tmp, not committed.
+// the emulated chain, compare every MISO byte; goal >= 2 M frames/s), importing a Saleae
+// Logic 2 CSV export (goal >= 50 MB/s), and recording a host that polls STATUS for a minute
+// as plain or gzip, one line per frame or with `repeat` lines (file sizes as counters).
+// The inputs are generated here, in /tmp, not committed.
 #include <benchmark/benchmark.h>
+
+#include <sys/stat.h>
 
 #include <cstdio>
 #include <random>
@@ -25,7 +29,7 @@ constexpr std::size_t kChips = 3;
 /// must match everywhere.
 void record_trace(const std::string& path, std::uint64_t frames) {
   Chain chain(kChips);
-  NativeTraceWriter writer(path, /*flush_each_event=*/false);
+  NativeTraceWriter writer(path, NativeWriteOptions{/*flush_each_event=*/false, /*compact=*/false});
   RecordingChain rec(chain, writer, RecordOptions{false});
   std::mt19937 rng(6470);
   std::vector<std::uint8_t> tx(kChips), rx(kChips);
@@ -113,6 +117,91 @@ void BM_ImportSaleaeCsv(benchmark::State& state) {
   state.counters["frames"] = static_cast<double>(frames);
 }
 BENCHMARK(BM_ImportSaleaeCsv)->Arg(100)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// A one-chip host as vendor examples write it, recorded as a running board records: every
+/// event flushed. For a minute of virtual time it polls GetStatus every millisecond (a frame
+/// per byte) and, every 10 s, starts a 200-step Move and polls until it ends.
+/// Returns the frames recorded.
+std::uint64_t record_polling_host(const std::string& path, NativeWriteOptions options) {
+  Chain chain(1);
+  NativeTraceWriter writer(path, options);
+  RecordingChain rec(chain, writer);
+  std::vector<std::uint8_t> rx(1);
+  auto frame = [&](std::uint8_t b) {
+    rec.advance_to(rec.now() + 8);
+    rec.select();
+    const std::uint8_t tx[1] = {b};
+    rec.advance_to(rec.now() + 7);
+    rec.exchange(tx, rx);
+    rec.deselect();
+  };
+  const Tick start = rec.now();
+  for (std::uint64_t ms = 0; ms < 60'000; ++ms) {
+    rec.advance_to(start + ticks_from_ms(ms));
+    rec.observe_outputs();
+    if (ms % 10'000 == 5'000) {  // Move(FWD, 25600 microsteps)
+      for (std::uint8_t b : {std::uint8_t{0x41}, std::uint8_t{0x00}, std::uint8_t{0x64}, std::uint8_t{0x00}}) frame(b);
+    }
+    frame(0xD0);
+    frame(0x00);
+    frame(0x00);
+  }
+  writer.finish();
+  return rec.frames_recorded();
+}
+
+std::uint64_t file_size(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? static_cast<std::uint64_t>(st.st_size) : 0;
+}
+
+/// Arg: 0 = plain, one line per frame (as before compaction); 1 = plain with `repeat` lines;
+/// 2 = gzip, one line per frame; 3 = gzip with `repeat` lines.
+void BM_RecordPollingHost(benchmark::State& state) {
+  const bool compact = state.range(0) % 2 == 1, gzip = state.range(0) >= 2;
+  const std::string path = temp_path(gzip ? "poll.trace.gz" : "poll.trace");
+  std::uint64_t frames = 0;
+  for (auto _ : state) frames = record_polling_host(path, NativeWriteOptions{true, compact});
+  const std::uint64_t bytes = file_size(path);
+  // The file reads back to every frame.
+  std::uint64_t read = 0;
+  {
+    NativeTraceReader reader(path);
+    TraceEvent e;
+    while (reader.next(e)) read += e.kind == TraceEventKind::frame;
+  }
+  std::remove(path.c_str());
+  if (read != frames) {
+    state.SkipWithError("the recording does not read back to every frame");
+    return;
+  }
+  state.SetLabel(std::string(gzip ? "gzip" : "plain") + (compact ? ", repeat lines" : ", a line per frame"));
+  state.SetItemsProcessed(static_cast<std::int64_t>(frames) * state.iterations());
+  state.counters["frames"] = static_cast<double>(frames);
+  state.counters["file_bytes"] = static_cast<double>(bytes);
+  state.counters["bytes_per_frame"] = static_cast<double>(bytes) / static_cast<double>(frames);
+}
+BENCHMARK(BM_RecordPollingHost)->DenseRange(0, 3)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// Replaying the minute of polling from its compacted file: the repetitions are expanded as read.
+void BM_ReplayCompactPollingTrace(benchmark::State& state) {
+  const std::string path = temp_path("poll-replay.trace");
+  record_polling_host(path, NativeWriteOptions{false, true});
+  ReplayResult r;
+  for (auto _ : state) {
+    NativeTraceReader reader(path);
+    Chain chain(1);
+    r = replay_trace(reader, chain);
+  }
+  std::remove(path.c_str());
+  if (!r.matched()) {
+    state.SkipWithError("the replay diverged from its own recording");
+    return;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(r.frames) * state.iterations());
+  state.counters["frames"] = static_cast<double>(r.frames);
+}
+BENCHMARK(BM_ReplayCompactPollingTrace)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <set>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -88,7 +89,8 @@ class Decoder {
     return options_.only_chip < 0 || chip == ProtocolEvent::kNoChip || chip == static_cast<std::size_t>(options_.only_chip);
   }
 
-  void pin(const TraceEvent& e, double t) {
+  /// A pin or fault line at `t`; `previous_seconds` is when the event before it ended.
+  void pin(const TraceEvent& e, double t, double previous_seconds) {
     if (!shown(e.chip)) return;
     std::string what;
     const bool level = e.value != 0;
@@ -102,6 +104,17 @@ class Decoder {
       }
       // STCK edges are as frequent as the steps: show them only with --nops.
       if (e.pin == TracePin::STCK && !options_.show_nops) return;
+      // An output level in a trace is an observation: when it was looked at, not when it changed.
+      if (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG) {
+        const bool first = seen_outputs_.insert({e.chip, static_cast<int>(e.pin)}).second;
+        if (first) {
+          what += ", seen at (its level when watching began)";
+        } else {
+          char buf[64];
+          std::snprintf(buf, sizeof buf, "%.6f", previous_seconds);
+          what += std::string(", seen at (the edge was not watched: it came after t=") + buf + " s)";
+        }
+      }
     } else {
       what = "fault " + std::string(to_string(e.fault)) + " ";
       if (e.fault == TraceFault::THERMAL) what += thermal_name(e.value);
@@ -135,6 +148,7 @@ class Decoder {
     std::string where = e.chip == ProtocolEvent::kNoChip ? "frame " + std::to_string(e.frame + 1) + " " : chip_column(e.chip);
     std::string l = stamp(t) + where + "! " + text + "  [" + name_;
     if (e.line) l += ":" + std::to_string(e.line);
+    if (e.repetition) l += " repetition " + std::to_string(e.repetition);
     l += ']';
     if (options_.max_repeats != 0 && count == options_.max_repeats) l += "  (further ones of this kind not shown)";
     put(t, std::move(l));
@@ -153,6 +167,7 @@ class Decoder {
   std::string line_;
   std::deque<std::pair<double, std::string>> pending_;
   std::map<std::pair<std::size_t, int>, std::size_t> seen_;
+  std::set<std::pair<std::size_t, int>> seen_outputs_;  // (chip, BUSY/FLAG) looked at before
 };
 
 }  // namespace
@@ -163,8 +178,12 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
   ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); });
   TraceEvent e;
   std::vector<std::uint8_t> rx;
+  double previous = 0;  // display time of the end of the event before (a frame's CS rising edge)
   while (in.next(e)) {
     if (e.kind == TraceEventKind::frame) {
+      previous = display_seconds(e.end(), e.source_time == e.source_time
+                                              ? e.source_time + static_cast<double>(e.duration) / kTicksPerSecond
+                                              : e.source_time);
       ++decoder.summary.frames;
       rx.resize(e.mosi.size());
       tracker.begin_frame(e, rx);
@@ -176,7 +195,10 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       throw TraceError(name, e.line, "event for chip " + std::to_string(e.chip) + ", but the chain has " +
                                          std::to_string(chain.size()) + " chips (see --chain)");
     tracker.apply(e);
-    decoder.pin(e, display_seconds(e.tick, e.source_time));
+    const double t = display_seconds(e.tick, e.source_time);
+    decoder.pin(e, t, previous);
+    // Outputs looked at together share one bound; an input or fault is an event of its own.
+    if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) previous = t;
     decoder.flush(tracker.pending_answer_seconds());
   }
   tracker.finish();

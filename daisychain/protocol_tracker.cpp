@@ -46,6 +46,7 @@ ProtocolEvent ProtocolTracker::event_here(ProtocolEvent::Kind kind, std::size_t 
   e.tick = frame_.tick;
   e.source_time = frame_.source_time;
   e.line = frame_.line;
+  e.repetition = frame_.repetition;
   return e;
 }
 
@@ -92,6 +93,7 @@ void ProtocolTracker::finish_answer(std::size_t k, AnswerEnd why) {
   e.tick = a.tick;
   e.source_time = a.source_time;
   e.line = a.line;
+  e.repetition = a.repetition;
   e.opcode = a.opcode;
   e.op = a.table->opcodes[a.opcode];
   e.reg = a.reg;
@@ -235,6 +237,7 @@ void ProtocolTracker::end_frame() {
         a.tick = frame_.tick;
         a.source_time = frame_.source_time;
         a.line = frame_.line;
+        a.repetition = frame_.repetition;
       } else if (reset) {
         if (a.active) finish_answer(k, AnswerEnd::replaced);
       } else if (a.active && ++a.loaded == a.len) {

@@ -45,6 +45,7 @@ struct ProtocolEvent {
   Tick tick = 0;                ///< CS falling edge of that frame (when it began)
   double source_time = std::numeric_limits<double>::quiet_NaN();  ///< that frame's capture time
   std::uint64_t line = 0;       ///< that frame's line in the trace file
+  std::uint64_t repetition = 0; ///< that frame's repetition of a native `repeat` line (0 = none)
 
   // command and answer
   std::uint8_t opcode = 0;
@@ -119,6 +120,7 @@ class ProtocolTracker {
     Tick tick = 0;
     double source_time = 0;
     std::uint64_t line = 0;
+    std::uint64_t repetition = 0;
   };
   struct Collect {
     bool active = false;

@@ -20,8 +20,10 @@ std::string time_text(Tick tick, double source_time) {
   return buf;
 }
 
-std::string where(const std::string& name, std::uint64_t line) {
-  return line ? name + ":" + std::to_string(line) : name;
+std::string where(const std::string& name, const TraceEvent& e) {
+  std::string w = e.line ? name + ":" + std::to_string(e.line) : name;
+  if (e.repetition) w += " (repetition " + std::to_string(e.repetition) + ")";
+  return w;
 }
 
 std::string indent(const std::string& text, const char* prefix) {
@@ -121,7 +123,7 @@ class Replayer {
     for (std::size_t i = 0; i < len; ++i)
       if (e.miso_byte_known(i) && e.miso[i] != rx_[i]) bad.push_back(i);
 
-    d.summary = where(name_, e.line) + ": frame " + std::to_string(d.frame) + " at " + time_text(e.tick, e.source_time) +
+    d.summary = where(name_, e) + ": frame " + std::to_string(d.frame) + " at " + time_text(e.tick, e.source_time) +
                 ": MISO byte " + std::to_string(bad[0]) + " expected " + hex_value(e.miso[bad[0]], 8) + ", emulated " +
                 hex_value(rx_[bad[0]], 8);
     if (bad.size() > 1) d.summary += " (and " + std::to_string(bad.size() - 1) + " more bytes differ)";
@@ -167,7 +169,7 @@ class Replayer {
     auto level = [busy](bool l) {
       return std::string(l ? "high" : "low") + (busy ? (l ? " (released)" : " (busy)") : (l ? " (no alarm)" : " (alarm)"));
     };
-    d.summary = where(name_, e.line) + ": " + time_text(e.tick, e.source_time) + " (after frame " +
+    d.summary = where(name_, e) + ": " + time_text(e.tick, e.source_time) + " (after frame " +
                 std::to_string(d.frame) + "): chip " + std::to_string(e.chip) + " " + std::string(to_string(e.pin)) +
                 " expected " + level(e.value != 0) + ", emulated " + level(emulated);
     d.report = d.summary + "\n  chip " + std::to_string(e.chip) + " state (emulated):\n" +

@@ -3,6 +3,7 @@
 
 #include <exception>
 
+#include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu {
@@ -92,11 +93,14 @@ void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value) {
 
 std::string trace_path_for_chain(const std::string& path, const std::string& name, std::size_t chains) {
   if (chains <= 1) return path;
-  const std::size_t slash = path.rfind('/');
-  const std::size_t dot = path.rfind('.');
+  // A ".gz" stays last: "run.trace.gz" -> "run.spidev0.1.trace.gz".
+  const std::string gz = gzip_file_name(path) ? ".gz" : "";
+  const std::string base = path.substr(0, path.size() - gz.size());
+  const std::size_t slash = base.rfind('/');
+  const std::size_t dot = base.rfind('.');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash) || dot == (slash == std::string::npos ? 0 : slash + 1))
-    return path + "." + name;
-  return path.substr(0, dot) + "." + name + path.substr(dot);
+    return base + "." + name + gz;
+  return base.substr(0, dot) + "." + name + base.substr(dot) + gz;
 }
 
 }  // namespace l6470emu

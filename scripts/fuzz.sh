@@ -46,6 +46,7 @@ for h in "${harnesses[@]}"; do
   case $h in
     spi_chain) extra=(-max_len=2048) ;;  # long command sequences
     ftrace) extra=(-max_len=4096) ;;     # the seeds are 20 KB; mutants that size are slow
+    native) extra=(-dict=tests/fuzz/native.dict) ;;  # the format's words, `repeat` lines and the gzip magic
   esac
   rm -rf "${scratch:?}/$h"
   mkdir -p "$scratch/$h" "tests/fuzz/regressions/$h"

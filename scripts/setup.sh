@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
-  gcc python3 python3-spidev python3-libgpiod gpiod libgpiod-dev umockdev
+  zlib1g-dev gcc python3 python3-spidev python3-libgpiod gpiod libgpiod-dev umockdev
   sigrok-cli clang libclang-rt-14-dev
   python3-dev pybind11-dev python3-pybind11 python3-pytest python3-numpy help2man dpkg-dev
   libfuse3-dev qemu-system-x86 busybox-static cpio kmod

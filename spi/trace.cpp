@@ -38,7 +38,8 @@ std::string_view thermal_name(std::uint8_t value) {
 TraceError::TraceError(std::string file, std::uint64_t line, const std::string& message)
     : std::runtime_error((line ? file + ":" + std::to_string(line) : file) + ": " + message),
       file_(std::move(file)),
-      line_(line) {}
+      line_(line),
+      reason_(message) {}
 
 // ---------------------------------------------------------------- Trace
 
@@ -48,6 +49,7 @@ void Trace::write(const TraceEvent& e) {
   s.duration = e.duration;
   s.source_time = e.source_time;
   s.line = e.line;
+  s.repetition = e.repetition;
   s.chip = e.chip;
   s.kind = e.kind;
   s.value = e.value;
@@ -80,6 +82,7 @@ TraceEvent Trace::operator[](std::size_t i) const {
   e.duration = s.duration;
   e.source_time = s.source_time;
   e.line = s.line;
+  e.repetition = s.repetition;
   e.chip = s.chip;
   e.value = s.value;
   if (s.kind == TraceEventKind::pin) e.pin = static_cast<TracePin>(s.what);
@@ -104,6 +107,7 @@ class TraceCursor final : public TraceReader {
     e = trace_[i_++];
     return true;
   }
+  ReadProgress progress() const override { return {i_, trace_.size(), false}; }
 
  private:
   const Trace& trace_;

@@ -62,6 +62,7 @@ struct TraceEvent {
   TraceFault fault = TraceFault::UVLO;       ///< fault events
   std::uint8_t value = 0;                    ///< pin: level 0/1; fault: see TraceFault
   std::uint64_t line = 0;                    ///< line in the source file (0 = none)
+  std::uint64_t repetition = 0;              ///< native `repeat` lines: which repetition (1..), else 0
   double source_time = std::numeric_limits<double>::quiet_NaN();  ///< seconds as in the source file
 
   /// Tick of the CS rising edge of a frame.
@@ -90,10 +91,20 @@ class TraceError : public std::runtime_error {
   TraceError(std::string file, std::uint64_t line, const std::string& message);
   const std::string& file() const { return file_; }
   std::uint64_t line() const { return line_; }
+  /// What is wrong, without the file and line.
+  const std::string& reason() const { return reason_; }
 
  private:
   std::string file_;
   std::uint64_t line_;
+  std::string reason_;
+};
+
+/// How far a reader has come through its input, for a progress bar.
+struct ReadProgress {
+  std::uint64_t done = 0;   ///< bytes of the file (or events) behind the reader
+  std::uint64_t total = 0;  ///< all of them; 0 = not known
+  bool bytes = true;        ///< done and total count bytes (else events)
 };
 
 /// A source of trace events, read once from the start (a file being parsed, a Trace in memory).
@@ -104,6 +115,8 @@ class TraceReader {
   virtual const TraceHeader& header() const = 0;
   /// Reads the next event into `e`; false at the end. Throws TraceError on malformed input.
   virtual bool next(TraceEvent& e) = 0;
+  /// How far reading has come (bytes of a file, or events of a trace in memory).
+  virtual ReadProgress progress() const { return {}; }
 };
 
 /// Where recorded events go (a native trace file, a Trace in memory).
@@ -142,6 +155,7 @@ class Trace final : public TraceSink {
     Tick duration;
     double source_time;
     std::uint64_t line;
+    std::uint64_t repetition;
     std::uint64_t offset;  // mosi at offset, miso at offset + length, mask after that
     std::uint32_t length;
     std::uint16_t chip;

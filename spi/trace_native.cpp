@@ -1,10 +1,10 @@
-// Native trace format, version 1: parsing line by line with exact times, and writing
-// with one flush per event. The grammar is in docs/trace-format.md.
+// Native trace format, version 1: parsing line by line with exact times and expanding
+// `repeat` lines, and writing with one flush per event and runs of repeated frames
+// collapsed. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
 
 #include "spi/import_support.hpp"
-
-#include <sys/stat.h>
+#include "spi/trace_file.hpp"
 
 #include <algorithm>
 #include <cerrno>
@@ -69,20 +69,12 @@ bool parse_uint(std::string_view s, unsigned long max, unsigned long& out) {
 NativeTraceReader::NativeTraceReader(const std::string& path) {
   header_.name = path;
   header_.format = "native";
-  file_ = std::fopen(path.c_str(), "rb");
-  if (file_ == nullptr) throw TraceError(path, 0, std::string("cannot open: ") + std::strerror(errno));
+  file_ = std::make_unique<TraceFileReader>(path);
   // A small file gets a small buffer (it grows for a line longer than the buffer).
-  struct stat st {};
-  const bool sized = fstat(fileno(file_), &st) == 0 && S_ISREG(st.st_mode) && st.st_size >= 0;
-  buffer_.resize(sized ? std::clamp<std::size_t>(static_cast<std::size_t>(st.st_size) + 1, 4096, kChunk) : kChunk);
-  try {
-    read_header();
-  } catch (...) {
-    // No destructor runs for a constructor that throws: close the file here.
-    std::fclose(file_);
-    file_ = nullptr;
-    throw;
-  }
+  const std::uint64_t size = file_->size_on_disk();
+  buffer_.resize(size > 0 && !file_->gzip() ? std::clamp<std::size_t>(static_cast<std::size_t>(size) + 1, 4096, kChunk)
+                                            : kChunk);
+  read_header();  // a throw here closes the file (file_ is a member already constructed)
 }
 
 NativeTraceReader::NativeTraceReader(std::string_view text, std::string name) : text_(text) {
@@ -92,8 +84,11 @@ NativeTraceReader::NativeTraceReader(std::string_view text, std::string name) : 
   read_header();
 }
 
-NativeTraceReader::~NativeTraceReader() {
-  if (file_ != nullptr) std::fclose(file_);
+NativeTraceReader::~NativeTraceReader() = default;
+
+ReadProgress NativeTraceReader::progress() const {
+  if (!file_) return {};
+  return {file_->disk_offset(), file_->size_on_disk()};
 }
 
 void NativeTraceReader::fail(const std::string& message) const {
@@ -125,11 +120,14 @@ bool NativeTraceReader::next_line(std::string_view& line) {
     const std::size_t keep = text_.size();
     if (keep > 0 && text_.data() != buffer_.data()) std::memmove(buffer_.data(), text_.data(), keep);
     if (keep == buffer_.size()) buffer_.resize(buffer_.size() * 2);
-    const std::size_t got = std::fread(buffer_.data() + keep, 1, buffer_.size() - keep, file_);
-    if (got == 0) {
-      if (std::ferror(file_)) throw TraceError(header_.name, line_no_ + 1, "read error");
-      eof_ = true;
+    std::size_t got = 0;
+    try {
+      got = file_->read(buffer_.data() + keep, buffer_.size() - keep);
+    } catch (const TraceError& e) {
+      // Every complete line before the damage has been read: say where it stopped.
+      throw TraceError(header_.name, line_no_ + 1, e.reason());
     }
+    if (got == 0) eof_ = true;
     text_ = std::string_view(buffer_.data(), keep + got);
   }
 }
@@ -173,10 +171,102 @@ bool NativeTraceReader::next(TraceEvent& e) {
     return true;
   }
   std::string_view line;
-  while (next_line(line)) {
+  for (;;) {
+    if (repeat_done_ < repeat_count_) {
+      next_repetition(e);
+      return true;
+    }
+    if (!next_line(line)) return false;
     if (parse_line(line, e)) return true;
   }
-  return false;
+}
+
+void NativeTraceReader::keep_frame(const TraceEvent& e) {
+  if (kept_.size() < kMaxRepeatGroup) kept_.resize(kMaxRepeatGroup);
+  Kept& k = kept_[kept_next_];
+  k.tick = e.tick;
+  k.duration = e.duration;
+  k.mosi.assign(e.mosi.begin(), e.mosi.end());
+  k.miso.assign(e.miso.begin(), e.miso.end());
+  k.known.assign(e.miso_known.begin(), e.miso_known.end());
+  kept_next_ = (kept_next_ + 1) % kMaxRepeatGroup;
+  kept_count_ = std::min(kept_count_ + 1, kMaxRepeatGroup);
+}
+
+/// The next frame a `repeat` line stands for. The ring holds the group as the last
+/// repetition left it: each frame moves on by one period as it is handed out again.
+void NativeTraceReader::next_repetition(TraceEvent& e) {
+  const std::size_t slot = (kept_next_ + kMaxRepeatGroup - group_ + group_index_) % kMaxRepeatGroup;
+  Kept& k = kept_[slot];
+  k.tick += repeat_period_;
+  e = TraceEvent{};
+  e.kind = TraceEventKind::frame;
+  e.tick = k.tick;
+  e.duration = k.duration;
+  e.mosi = k.mosi;
+  e.miso = k.miso;
+  e.miso_known = k.known;
+  e.line = repeat_line_;
+  e.repetition = repeat_done_ + 1;
+  if (++group_index_ == group_) {
+    group_index_ = 0;
+    ++repeat_done_;
+  }
+}
+
+/// `TIME repeat K frames N times every PERIODus`: checks it and sets up the repetitions.
+void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view time_tok, Tick tick) {
+  const std::string_view group_tok = next_token(rest), frames_tok = next_token(rest);
+  const std::string_view count_tok = next_token(rest), times_tok = next_token(rest);
+  const std::string_view every_tok = next_token(rest), period_tok = next_token(rest);
+  const std::string form = " (expected 'TIME repeat K frames N times every PERIODus')";
+  unsigned long group = 0;
+  if (!parse_uint(group_tok, 1000000000, group) || group == 0 || group > kMaxRepeatGroup)
+    fail("repeat: group size " + quoted(group_tok) + " is not a number of frames from 1 to " +
+         std::to_string(kMaxRepeatGroup) + form);
+  if (frames_tok != "frames" && frames_tok != "frame") fail("repeat: " + quoted(frames_tok) + " where 'frames' belongs" + form);
+  std::uint64_t count = 0;
+  bool count_ok = !count_tok.empty() && count_tok.size() <= 13;
+  for (char c : count_tok) {
+    if (c < '0' || c > '9') count_ok = false;
+    if (count_ok) count = count * 10 + static_cast<std::uint64_t>(c - '0');
+  }
+  if (!count_ok || count == 0 || count > kMaxRepeatCount)
+    fail("repeat: count " + quoted(count_tok) + " is not a number of repetitions from 1 to 10^12" + form);
+  if (times_tok != "times" && times_tok != "time") fail("repeat: " + quoted(times_tok) + " where 'times' belongs" + form);
+  if (every_tok != "every") fail("repeat: " + quoted(every_tok) + " where 'every' belongs" + form);
+  SourceTime p;
+  Tick period = 0;
+  if (period_tok.size() <= 2 || period_tok.substr(period_tok.size() - 2) != "us" ||
+      !parse_source_time(period_tok.substr(0, period_tok.size() - 2), -6, p) || p.seconds < 0 ||
+      !ticks_between({}, p, period))
+    fail("repeat: period " + quoted(period_tok) + " is not a number of microseconds (e.g. 1000.00us)" + form);
+  if (!next_token(rest).empty()) fail("too many fields in the repeat line" + form);
+  if (kept_count_ < group)
+    fail("repeat: there " + std::string(kept_count_ == 1 ? "is " : "are ") + std::to_string(kept_count_) +
+         " frame line" + (kept_count_ == 1 ? "" : "s") + " to repeat since the last pin or fault event, not " +
+         std::to_string(group));
+  const Kept& first = kept_[(kept_next_ + kMaxRepeatGroup - group) % kMaxRepeatGroup];
+  const Kept& last = kept_[(kept_next_ + kMaxRepeatGroup - 1) % kMaxRepeatGroup];
+  if (period == 0) fail("repeat: period " + quoted(period_tok) + " is 0: repetitions take time" + form);
+  if (period < last.tick + last.duration - first.tick)
+    fail("repeat: period " + quoted(period_tok) + " is shorter than the " + std::to_string(group) +
+         " frames it repeats (" + format_microseconds(last.tick + last.duration - first.tick) + " us from the first CS "
+         "falling edge to the last CS rising edge): repetitions would overlap");
+  // The time written is the last repeated frame's: the group's last frame, count periods on.
+  const Tick limit = 1'000'000'000'000ull * kTicksPerSecond;
+  if (period > limit / count || last.tick > limit - period * count || last.tick + period * count != tick)
+    fail("repeat: the line's time " + as_written(time_tok, tick) + " s is not when the last repetition's last frame starts (" +
+         (period <= limit / count && last.tick <= limit - period * count ? format_seconds(last.tick + period * count) + " s"
+                                                                         : std::string("beyond 10^12 s")) +
+         ": its last frame at " + format_seconds(last.tick) + " s plus " + std::to_string(count) + " periods)");
+  group_ = group;
+  group_index_ = 0;
+  repeat_count_ = count;
+  repeat_done_ = 0;
+  repeat_period_ = period;
+  repeat_line_ = line_no_;
+  last_frame_end_ = tick + last.duration;
 }
 
 /// Parses one line into `e`; false for comments and blank lines.
@@ -187,7 +277,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (time_tok[0] < '0' || time_tok[0] > '9') {
     if (time_tok == "chain") fail("'chain' must come before the first event");
     if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
-    fail("unknown line " + quoted(line) + " (expected '<time> frame|pin|fault ...')");
+    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault ...')");
   }
 
   // Time: seconds, decimal (the writer uses 8 decimals: exact ticks).
@@ -227,10 +317,15 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     fail("time " + as_written(time_tok, tick) + " s goes backwards (the previous event was at " + format_seconds(last_tick_) +
          " s)");
 
+  const std::string_view kind = next_token(rest);
+  if (kind == "repeat") {
+    parse_repeat(rest, time_tok, tick);
+    last_tick_ = tick;
+    return false;  // next() hands out the repetitions
+  }
   e = TraceEvent{};
   e.tick = tick;
   e.line = line_no_;
-  const std::string_view kind = next_token(rest);
   if (kind == "frame") {
     e.kind = TraceEventKind::frame;
     if (tick < last_frame_end_)
@@ -288,7 +383,9 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     if (in_miso) e.miso = miso_;
     if (any_unknown) e.miso_known = known_;
     last_frame_end_ = e.end();
+    keep_frame(e);
   } else if (kind == "pin" || kind == "fault") {
+    kept_count_ = 0;  // a repeat line repeats frames only, with nothing between them
     const std::string_view chip_tok = next_token(rest);
     const std::string_view name = next_token(rest);
     const std::string_view value = next_token(rest);
@@ -337,7 +434,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   } else if (kind.empty()) {
     fail("time without an event");
   } else {
-    fail("unknown event " + quoted(kind) + " (frame, pin or fault)");
+    fail("unknown event " + quoted(kind) + " (frame, repeat, pin or fault)");
   }
   any_event_ = true;
   last_tick_ = tick;
@@ -346,28 +443,90 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
 
 // ---------------------------------------------------------------- writer
 
-NativeTraceWriter::NativeTraceWriter(const std::string& path, bool flush_each_event)
-    : path_(path), flush_(flush_each_event) {
-  file_ = std::fopen(path.c_str(), "wb");
-  if (file_ == nullptr) throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
-  // Big enough that a line of a long frame leaves in one write.
-  std::setvbuf(file_, nullptr, _IOFBF, 1 << 16);
+namespace {
+
+constexpr std::uint64_t kCheckpointRepetitions = 1024;  // gzip/stream: a run in progress is written this often...
+constexpr Tick kCheckpointTicks = kTicksPerSecond;      // ...or after this much trace time
+
+}  // namespace
+
+void NativeTraceWriter::Held::assign(const TraceEvent& e) {
+  tick = e.tick;
+  duration = e.duration;
+  has_miso = !e.miso.empty();
+  mosi.assign(e.mosi.begin(), e.mosi.end());
+  miso.assign(e.miso.begin(), e.miso.end());
+  known.assign(e.miso_known.begin(), e.miso_known.end());
 }
 
-NativeTraceWriter::NativeTraceWriter(std::ostream& out, bool flush_each_event) : out_(&out), flush_(flush_each_event) {}
+bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
+  // "??" bytes are written whatever their value: compare what the line shows.
+  if (duration != o.duration || has_miso != o.has_miso || mosi != o.mosi || known != o.known) return false;
+  if (miso.size() != o.miso.size()) return false;
+  for (std::size_t i = 0; i < miso.size(); ++i)
+    if ((known.empty() || known[i]) && miso[i] != o.miso[i]) return false;
+  return true;
+}
+
+TraceEvent NativeTraceWriter::Held::event() const {
+  TraceEvent e;
+  e.kind = TraceEventKind::frame;
+  e.tick = tick;
+  e.duration = duration;
+  e.mosi = mosi;
+  if (has_miso) e.miso = miso;
+  e.miso_known = known;
+  return e;
+}
+
+NativeTraceWriter::NativeTraceWriter(const std::string& path, bool flush_each_event)
+    : NativeTraceWriter(path, NativeWriteOptions{flush_each_event, true}) {}
+
+NativeTraceWriter::NativeTraceWriter(const std::string& path, NativeWriteOptions options)
+    : file_(std::make_unique<TraceFileWriter>(path)), options_(options) {}
+
+NativeTraceWriter::NativeTraceWriter(std::ostream& out, bool flush_each_event)
+    : NativeTraceWriter(out, NativeWriteOptions{flush_each_event, true}) {}
+
+NativeTraceWriter::NativeTraceWriter(std::ostream& out, NativeWriteOptions options) : out_(&out), options_(options) {}
 
 NativeTraceWriter::~NativeTraceWriter() {
-  if (file_ != nullptr) std::fclose(file_);
-  else if (out_ != nullptr) out_->flush();
+  try {
+    finish();
+  } catch (...) {
+  }
 }
 
+void NativeTraceWriter::finish() {
+  if (finished_) return;
+  finished_ = true;
+  if (in_run_) end_run();
+  if (file_) {
+    file_->close();
+  } else if (out_ != nullptr) {
+    out_->flush();
+    if (!*out_) throw std::runtime_error("trace write failed");
+  }
+}
+
+bool NativeTraceWriter::rewritable() const { return file_ && !file_->gzip() && options_.flush_each_event; }
+
 void NativeTraceWriter::put(const std::string& text) {
-  if (file_ != nullptr) {
-    if (std::fwrite(text.data(), 1, text.size(), file_) != text.size() || (flush_ && std::fflush(file_) != 0))
-      throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
+  if (file_) {
+    file_->write(text);
   } else {
     out_->write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (flush_) out_->flush();
+    if (!*out_) throw std::runtime_error("trace write failed");
+  }
+}
+
+/// The end of one event: handed to the OS when asked to.
+void NativeTraceWriter::end_event() {
+  if (!options_.flush_each_event) return;
+  if (file_) {
+    file_->flush();
+  } else {
+    out_->flush();
     if (!*out_) throw std::runtime_error("trace write failed");
   }
 }
@@ -381,6 +540,129 @@ void NativeTraceWriter::write_header(const TraceHeader& header) {
     text += "# converted from " + header.name + (header.format.empty() ? "" : " (" + header.format + ")") + "\n";
   for (const std::string& note : header.notes) text += "# note: " + note + "\n";
   put(text);
+  end_event();
+}
+
+void NativeTraceWriter::write_line(const TraceEvent& e) {
+  line_ = format_event(e);
+  line_ += '\n';
+  put(line_);
+}
+
+void NativeTraceWriter::write(const TraceEvent& e) {
+  if (finished_) throw std::logic_error("NativeTraceWriter::write after finish()");
+  if (!header_written_) write_header({});
+  if (e.kind == TraceEventKind::frame && options_.compact) {
+    frame(e);
+  } else {
+    if (in_run_) end_run();
+    recent_.clear();
+    write_line(e);
+  }
+  end_event();
+}
+
+std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period) {
+  return format_seconds(last_frame + period * count) + " repeat " + std::to_string(group) +
+         (group == 1 ? " frame " : " frames ") + std::to_string(count) + (count == 1 ? " time" : " times") +
+         " every " + format_microseconds(period) + "us";
+}
+
+/// A frame with compaction: either the next one of the run under way, or a line of its own
+/// (after which it may start a run).
+void NativeTraceWriter::frame(const TraceEvent& e) {
+  if (in_run_) {
+    const Held& model = run_[partial_.size()];
+    Held h;
+    h.assign(e);
+    if (e.tick == model.tick + run_period_ && h.same_bytes(model)) {
+      if (rewritable()) write_line(e);  // a killed process leaves it; rewritten into the count below
+      partial_.push_back(std::move(h));
+      if (partial_.size() < run_group_) return;
+      // A whole repetition more.
+      run_.swap(partial_);
+      partial_.clear();
+      ++line_count_;
+      if (rewritable()) {
+        // The repeat line, rewritten in one write(2) over itself and the frame lines after it;
+        // what is left of them becomes a comment, so a kill before the cut leaves a valid file.
+        const std::string line = format_repeat(line_base_, run_group_, line_count_, run_period_);
+        const std::uint64_t old_tail = file_->end_offset() - run_offset_;
+        std::string text = line;
+        if (old_tail == line.size() + 2) text += ' ';  // one byte to cover: trailing space (allowed)
+        text += '\n';
+        const std::size_t keep = text.size();
+        if (old_tail >= text.size() + 2) {
+          text += '#';
+          text.append(static_cast<std::size_t>(old_tail - text.size() - 1), ' ');
+          text += '\n';
+        }
+        file_->overwrite_tail(run_offset_, text, keep);
+      } else if (options_.flush_each_event &&
+                 (line_count_ >= kCheckpointRepetitions || run_.back().tick - checkpoint_tick_ >= kCheckpointTicks)) {
+        write_repeat_line();
+      }
+      return;
+    }
+    end_run();
+  }
+  write_line(e);
+  Held h;
+  h.assign(e);
+  recent_.push_back(std::move(h));
+  if (recent_.size() > 2 * kMaxRepeatGroup) recent_.erase(recent_.begin());
+  look_for_run();
+}
+
+/// Whether the last frames are a group that came twice with a constant period: then the
+/// next ones may be its repetitions.
+void NativeTraceWriter::look_for_run() {
+  const std::size_t n = recent_.size();
+  for (std::size_t k = 1; k <= kMaxRepeatGroup && 2 * k <= n; ++k) {
+    const Held* a = &recent_[n - 2 * k];
+    const Held* b = &recent_[n - k];
+    const Tick period = b[0].tick - a[0].tick;
+    if (period == 0) continue;
+    bool same = true;
+    for (std::size_t j = 0; j < k && same; ++j) same = b[j].tick - a[j].tick == period && b[j].same_bytes(a[j]);
+    if (!same) continue;
+    in_run_ = true;
+    run_group_ = k;
+    run_period_ = period;
+    run_.assign(recent_.end() - static_cast<std::ptrdiff_t>(k), recent_.end());
+    partial_.clear();
+    line_count_ = 0;
+    line_base_ = run_.back().tick;
+    checkpoint_tick_ = run_.back().tick;
+    if (file_) run_offset_ = file_->end_offset();
+    return;
+  }
+}
+
+void NativeTraceWriter::write_repeat_line() {
+  if (line_count_ == 0) return;
+  line_ = format_repeat(line_base_, run_group_, line_count_, run_period_);
+  line_ += '\n';
+  put(line_);
+  line_count_ = 0;
+  line_base_ = run_.back().tick;
+  checkpoint_tick_ = run_.back().tick;
+}
+
+/// The run is over: its repeat line and the frames of an unfinished repetition go to the file
+/// (a rewritten plain file has them already), and they are the recent frames from now on.
+void NativeTraceWriter::end_run() {
+  in_run_ = false;
+  if (!rewritable()) {
+    write_repeat_line();
+    for (const Held& h : partial_) write_line(h.event());
+  }
+  recent_ = std::move(run_);
+  for (Held& h : partial_) recent_.push_back(std::move(h));
+  run_.clear();
+  partial_.clear();
+  // A new run may start right away among these frames (but not one that includes the old run's
+  // group twice: that would have continued the run).
 }
 
 std::string NativeTraceWriter::format_event(const TraceEvent& e) {
@@ -418,20 +700,12 @@ std::string NativeTraceWriter::format_event(const TraceEvent& e) {
   return s;
 }
 
-void NativeTraceWriter::write(const TraceEvent& e) {
-  if (!header_written_) write_header({});
-  line_ = format_event(e);
-  line_ += '\n';
-  put(line_);
-}
-
-std::string to_native_text(const Trace& trace) {
+std::string to_native_text(const Trace& trace, bool compact) {
   std::ostringstream out;
-  {
-    NativeTraceWriter w(out, false);
-    w.write_header(trace.header);
-    for (std::size_t i = 0; i < trace.size(); ++i) w.write(trace[i]);
-  }
+  NativeTraceWriter w(out, NativeWriteOptions{false, compact});
+  w.write_header(trace.header);
+  for (std::size_t i = 0; i < trace.size(); ++i) w.write(trace[i]);
+  w.finish();
   return out.str();
 }
 

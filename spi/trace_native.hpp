@@ -1,11 +1,12 @@
 // The native trace format (docs/trace-format.md): line-based text, one CS frame per
-// line, version 1. Reader (streaming, for traces of any length) and writer (flushed
-// event by event, so a killed process leaves a complete file). No other formats here.
+// line, version 1, plain or gzip. Reader (streaming, for traces of any length, expanding
+// `repeat` lines as it goes) and writer (flushed event by event, so a killed process leaves
+// a complete file; collapsing runs of repeated frames into `repeat` lines). No other formats here.
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,11 +19,19 @@ namespace l6470emu {
 inline constexpr std::string_view kNativeTraceMagic = "l6470emu-trace";
 /// The format version this code writes and reads.
 inline constexpr int kNativeTraceVersion = 1;
+/// The most frames a `repeat` line can repeat as one group.
+inline constexpr std::size_t kMaxRepeatGroup = 16;
+/// The most repetitions one `repeat` line can stand for.
+inline constexpr std::uint64_t kMaxRepeatCount = 1'000'000'000'000ull;
+
+class TraceFileReader;
+class TraceFileWriter;
 
 /// Reads a native trace event by event; memory use does not grow with its length.
 class NativeTraceReader final : public TraceReader {
  public:
-  /// Opens `path`. Throws TraceError when it cannot be read or is not a version-1 native trace.
+  /// Opens `path` (gzip-compressed or not: recognised by its first bytes). Throws TraceError
+  /// when it cannot be read or is not a version-1 native trace.
   explicit NativeTraceReader(const std::string& path);
   /// Reads `text` (kept by reference: it must outlive the reader), called `name` in messages.
   NativeTraceReader(std::string_view text, std::string name);
@@ -32,15 +41,24 @@ class NativeTraceReader final : public TraceReader {
 
   const TraceHeader& header() const override { return header_; }
   bool next(TraceEvent& e) override;
+  ReadProgress progress() const override;
 
  private:
+  /// A frame kept for `repeat` lines (the last kMaxRepeatGroup frames).
+  struct Kept {
+    Tick tick = 0, duration = 0;
+    std::vector<std::uint8_t> mosi, miso, known;
+  };
   bool next_line(std::string_view& line);
   bool parse_line(std::string_view line, TraceEvent& e);
+  void parse_repeat(std::string_view rest, std::string_view time_tok, Tick tick);
+  void keep_frame(const TraceEvent& e);
+  void next_repetition(TraceEvent& e);
   void read_header();
   [[noreturn]] void fail(const std::string& message) const;
 
   TraceHeader header_;
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<TraceFileReader> file_;
   std::vector<char> buffer_;
   std::string_view text_;     // unread text (whole input in string mode, buffered part in file mode)
   bool eof_ = false;
@@ -52,39 +70,100 @@ class NativeTraceReader final : public TraceReader {
   Tick last_tick_ = 0;
   Tick last_frame_end_ = 0;
   std::vector<std::uint8_t> mosi_, miso_, known_;
+  // `repeat` lines: the last frames (a ring), and the repetition being handed out.
+  std::vector<Kept> kept_;
+  std::size_t kept_next_ = 0;   // ring slot the next frame goes to
+  std::size_t kept_count_ = 0;  // frames in the ring since the last pin/fault event
+  std::size_t group_ = 0;       // frames in the group being repeated (0 = none)
+  std::size_t group_index_ = 0; // next frame of the current repetition
+  std::uint64_t repeat_count_ = 0, repeat_done_ = 0;
+  Tick repeat_period_ = 0;
+  std::uint64_t repeat_line_ = 0;
 };
 
-/// Writes a native trace. Every event is one line, handed to the OS (fflush) before
-/// write() returns unless `flush_each_event` is false.
+/// Choices for a NativeTraceWriter.
+struct NativeWriteOptions {
+  /// Hand every event to the OS (for gzip: a sync flush) before write() returns, so a process
+  /// that is killed leaves a trace that ends with the last event written.
+  bool flush_each_event = true;
+  /// Collapse a group of up to kMaxRepeatGroup frames that repeats with a constant period
+  /// (same bytes, same durations) into one `repeat` line. Lossless: reading gives every frame.
+  bool compact = true;
+};
+
+/// Writes a native trace: one line per event, or per run of repeated frames (see
+/// NativeWriteOptions). A file whose name ends in ".gz" is gzip-compressed.
+///
+/// What a killed process leaves (flush_each_event): in a plain file, every event written,
+/// including the repetitions of a run in progress (the run's `repeat` line is rewritten in
+/// place as it grows, the frames of an unfinished repetition follow it as frame lines); in a
+/// gzip file, every event up to the last flush point, where a run in progress is written at
+/// most every 1024 repetitions or every second of trace time (the repetitions since are lost).
 class NativeTraceWriter final : public TraceSink {
  public:
   /// Creates or truncates `path`. Throws std::runtime_error when it cannot.
   explicit NativeTraceWriter(const std::string& path, bool flush_each_event = true);
+  NativeTraceWriter(const std::string& path, NativeWriteOptions options);
   /// Writes to `out` (flushed after every event when `flush_each_event`).
   explicit NativeTraceWriter(std::ostream& out, bool flush_each_event = true);
+  NativeTraceWriter(std::ostream& out, NativeWriteOptions options);
+  /// Writes what is pending (a run in progress) and closes; errors here are lost: call finish().
   ~NativeTraceWriter() override;
   NativeTraceWriter(const NativeTraceWriter&) = delete;
   NativeTraceWriter& operator=(const NativeTraceWriter&) = delete;
 
   void write_header(const TraceHeader& header) override;
   void write(const TraceEvent& e) override;
+  /// Writes what is pending and closes the file (the gzip trailer). Throws on a write error.
+  void finish();
 
   /// One event as its native line, without the newline.
   static std::string format_event(const TraceEvent& e);
+  /// The `repeat` line, without the newline, saying that the last `group` frames (the last
+  /// of them at `last_frame`) repeat `count` times, each repetition `period` after the one before.
+  static std::string format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period);
 
  private:
+  struct Held {
+    Tick tick = 0, duration = 0;
+    bool has_miso = false;
+    std::vector<std::uint8_t> mosi, miso, known;
+    void assign(const TraceEvent& e);
+    bool same_bytes(const Held& o) const;
+    TraceEvent event() const;
+  };
   void put(const std::string& text);
+  void end_event();
+  void write_line(const TraceEvent& e);
+  void frame(const TraceEvent& e);
+  void look_for_run();
+  void end_run();
+  void write_repeat_line();
+  bool rewritable() const;
 
-  std::FILE* file_ = nullptr;
+  std::unique_ptr<TraceFileWriter> file_;
   std::ostream* out_ = nullptr;
-  std::string path_;
-  bool flush_;
+  NativeWriteOptions options_;
   bool header_written_ = false;
+  bool finished_ = false;
   std::string line_;
+  // Compaction: the frames written since the last pin/fault event (at most 2 groups' worth)...
+  std::vector<Held> recent_;
+  // ...and the run being collapsed: the group (its last complete repetition), the period,
+  // the repetitions not yet in the file and the frames of the repetition under way.
+  bool in_run_ = false;
+  std::size_t run_group_ = 0;
+  Tick run_period_ = 0;
+  std::vector<Held> run_;
+  std::vector<Held> partial_;
+  std::uint64_t line_count_ = 0;  // repetitions the run's repeat line stands for
+  Tick line_base_ = 0;            // tick of the group's last frame as the file has it before that line
+  std::uint64_t run_offset_ = 0;  // plain file being rewritten: where the repeat line starts
+  Tick checkpoint_tick_ = 0;
 };
 
-/// A native trace as text (header and every event).
-std::string to_native_text(const Trace& trace);
+/// A native trace as text (header and every event; runs collapsed when `compact`).
+std::string to_native_text(const Trace& trace, bool compact = false);
 
 /// Reads a whole native trace into memory.
 Trace read_native_trace(std::string_view text, const std::string& name);

@@ -1,10 +1,13 @@
 // `l6470emu decode TRACE`: the explained log on standard output, a summary on standard error.
+#include <unistd.h>
+
 #include <exception>
 #include <stdexcept>
 #include <ostream>
 
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/decode.hpp"
+#include "tools/progress.hpp"
 #include "tools/trace_commands.hpp"
 
 namespace l6470emu {
@@ -26,7 +29,11 @@ int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
       throw std::invalid_argument("--chip " + std::to_string(args.chip) + ": the chain has " +
                                   std::to_string(chain.size()) + " chips");
     std::unique_ptr<TraceReader> reader = file.read();
-    const DecodeSummary s = decode_trace(*reader, chain, out, options);
+    // The log goes to standard output: a bar on the terminal only when that is elsewhere.
+    ProgressBar bar = isatty(STDOUT_FILENO) == 1 ? ProgressBar(err, false, "") : ProgressBar::on_stderr("decoding " + file.path());
+    ProgressTraceReader watched(*reader, bar);
+    const DecodeSummary s = decode_trace(watched, chain, out, options);
+    bar.finish();
     out << "# " << s.frames << " frames, " << s.commands << " commands, " << s.answers << " answers, " << s.diagnostics
         << " diagnostics";
     if (s.suppressed) out << " (" << s.suppressed << " not shown: --max-repeats 0 shows all)";

@@ -5,6 +5,7 @@
 
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/replay.hpp"
+#include "tools/progress.hpp"
 #include "tools/trace_commands.hpp"
 
 namespace l6470emu {
@@ -23,9 +24,13 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
     options.max_reports = args.max_reports;
     options.compare_pins = !args.no_pins;
     std::unique_ptr<TraceReader> reader = file.read();
-    const ReplayResult r = replay_trace(*reader, chain, options, [&](const Divergence& d) {
+    ProgressBar bar = ProgressBar::on_stderr("replaying " + file.path());
+    ProgressTraceReader watched(*reader, bar);
+    const ReplayResult r = replay_trace(watched, chain, options, [&](const Divergence& d) {
+      bar.clear();
       out << (args.quiet ? d.summary : d.report) << "\n";
     });
+    bar.finish();
 
     out << file.path() << ": " << r.frames << " frames, " << r.bytes_compared << " MISO bytes compared";
     if (r.bytes_unknown) out << " (" << r.bytes_unknown << " not captured)";

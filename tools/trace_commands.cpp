@@ -81,8 +81,9 @@ void add_trace_commands(CLI::App& app) {
   CLI::App* c = app.add_subcommand(
       "convert", "write a trace as native text, VCD (SPI wires in mode 3, BUSY/FLAG/SW/STCK/STBY, ABS_POS) or umockdev .ioctl");
   add_trace_options(c, convert->trace);
-  c->add_option("-o,--output", convert->output, "file to write (- = standard output)")->required();
-  c->add_option("--to", convert->to, "output format (default: from the extension: .vcd, .ioctl, else native)")
+  c->add_option("-o,--output", convert->output, "file to write (- = standard output; a name ending in .gz is gzip-compressed)")
+      ->required();
+  c->add_option("--to", convert->to, "output format (default: from the extension before any .gz: .vcd, .ioctl, else native)")
       ->check(CLI::IsMember({"auto", "native", "vcd", "ioctl"}));
   c->add_option("--device", convert->device, "umockdev: the spidev node the recording is for");
   c->add_option("--timescale-ns", convert->timescale_ns, "VCD time unit in ns (1, 10 or 100)")
@@ -90,6 +91,8 @@ void add_trace_commands(CLI::App& app) {
   c->add_option("--sample-us", convert->sample_us, "VCD: how often moving chips are looked at, in µs")
       ->check(CLI::Range(0.25, 1e6));
   c->add_flag("--no-emulation", convert->no_emulation, "VCD: only the trace's own signals, no emulated BUSY/FLAG/ABS_POS");
+  c->add_flag("--expand", convert->expand,
+              "native: one line per frame (by default frames repeated at a constant period become 'repeat' lines)");
   c->callback([convert] { finish(run_convert(*convert, std::cout, std::cerr)); });
 }
 

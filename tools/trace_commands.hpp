@@ -63,6 +63,7 @@ struct ConvertArgs {
   unsigned timescale_ns = 10;   ///< VCD time unit
   double sample_us = 10;        ///< VCD: how often moving chips are looked at
   bool no_emulation = false;    ///< VCD: only what the trace holds (no BUSY/FLAG/ABS_POS from the emulator)
+  bool expand = false;          ///< native: one line per frame, no `repeat` lines
 };
 /// `l6470emu convert`: 0, or 2 on bad input.
 int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err);

@@ -22,28 +22,12 @@
 #include <stdexcept>
 
 #include "daisychain/chain_spec.hpp"
+#include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
+#include "tools/progress.hpp"
 
 namespace l6470emu {
 namespace {
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TraceError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-  std::ostringstream s;
-  s << in.rdbuf();
-  if (in.bad()) throw TraceError(path, 0, "read error");
-  return s.str();
-}
-
-std::string read_head(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TraceError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-  std::string head(64 * 1024, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  return head;
-}
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -51,7 +35,8 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 
 TraceFormat format_of(const std::string& path, const TraceInputOptions& options) {
   if (options.format != TraceFormat::unknown) return options.format;
-  const TraceFormat f = detect_trace_format(read_head(path), path);
+  const std::string head = read_trace_file_head(path, 64 * 1024);
+  const TraceFormat f = detect_trace_format(head, without_gz(path));
   if (f == TraceFormat::unknown)
     throw TraceError(path, 0,
                      "unknown trace format (native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON trace, VCD "
@@ -182,10 +167,26 @@ TraceFile::TraceFile(std::string path, const TraceInputOptions& options)
     return;
   }
   if (format_ == TraceFormat::vcd) {
+    if (TraceFileReader(path_).gzip())
+      throw TraceError(path_, 0, "a gzip-compressed logic capture: sigrok-cli reads it uncompressed (gunzip it first)");
     trace_ = import_sigrok_json(run_sigrok_spi_decoder(path_, options), path_, options.import);
     trace_.header.format = "sigrok-cli on a logic capture";
   } else {
-    trace_ = import_trace(read_file(path_), path_, format_, options.import);
+    {
+      // Reading a large capture takes a while: a bar on a terminal (the parse that follows
+      // is faster than the disk).
+      std::string text;
+      {
+        TraceFileReader in(path_);
+        ProgressBar bar = ProgressBar::on_stderr("reading " + path_);
+        std::vector<char> buf(1 << 20);
+        while (const std::size_t got = in.read(buf.data(), buf.size())) {
+          text.append(buf.data(), got);
+          bar.update(in.disk_offset(), in.size_on_disk());
+        }
+      }
+      trace_ = import_trace(text, path_, format_, options.import);
+    }
   }
   header_ = trace_.header;
 }

@@ -184,3 +184,32 @@ TEST(Decode, ReadsTheRecordedFixtureWithoutSurprises) {
 
 }  // namespace
 }  // namespace l6470emu
+
+namespace l6470emu {
+namespace {
+
+TEST(DecodeOutputs, MarksBusyAndFlagLevelsAsSeenAtNotAsExactEdges) {
+  const std::string text =
+      "l6470emu-trace 1\n"
+      "0.00000000 pin 0 BUSY 1\n"
+      "0.00000000 pin 0 FLAG 0\n"
+      "0.00000200 frame 1.75us D0 | 00\n"
+      "0.00000550 pin 0 FLAG 1\n"
+      "0.00010000 pin 0 SW 0\n"
+      "0.00020000 pin 0 BUSY 0\n";
+  const std::string log = decode_text(text, "1").log;
+  EXPECT_NE(log.find("t=0.000000 s  chip 0   BUSY output high (released), seen at (its level when watching began)"),
+            std::string::npos)
+      << log;
+  // The FLAG edge came after the frame's CS rising edge (3.75 µs), the BUSY edge after the SW event.
+  EXPECT_NE(log.find("t=0.000005 s  chip 0   FLAG output high (no alarm), seen at (the edge was not watched: it came "
+                     "after t=0.000004 s)"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("BUSY output low (busy), seen at (the edge was not watched: it came after t=0.000100 s)"),
+            std::string::npos)
+      << log;
+}
+
+}  // namespace
+}  // namespace l6470emu

@@ -102,5 +102,42 @@ TEST(ConvertCommand, WritesNativeVcdAndUmockdevFiles) {
   EXPECT_NE(r.out.find("TW d0\n R 00\n"), std::string::npos) << r.out;
 }
 
+TEST(ConvertCommand, WritesAndReadsGzipTracesOfAnyFormat) {
+  test::TempDir dir;
+  // A capture converted to gzip-compressed native text replays as the original.
+  RunResult r = l6470emu("convert " + fixture_path("polling_host.trace") + " -o " + dir.file("p.trace.gz"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(test::read_text(dir.file("p.trace.gz")).substr(0, 2), "\x1f\x8b");
+  r = l6470emu("replay " + dir.file("p.trace.gz"));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("3607 frames"), std::string::npos) << r.out;
+  // Other formats too: a gzip-compressed Saleae export is recognised by its content.
+  r = l6470emu("convert " + fixture_path("saleae_logic2.csv") + " --to vcd --no-emulation -o " + dir.file("s.vcd.gz"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  ASSERT_EQ(std::system(("gzip -c " + fixture_path("saleae_logic2.csv") + " > " + dir.file("s.csv.gz")).c_str()), 0);
+  r = l6470emu("replay --chain 1 " + dir.file("s.csv.gz"));
+  EXPECT_EQ(r.status, 0) << r.out;
+}
+
+TEST(ConvertCommand, ExpandsRepeatLinesOnRequest) {
+  const RunResult compact = l6470emu("convert " + fixture_path("polling_host.trace") + " -o -");
+  const RunResult expanded = l6470emu("convert --expand " + fixture_path("polling_host.trace") + " -o -");
+  ASSERT_EQ(expanded.status, 0) << expanded.out;
+  EXPECT_NE(compact.out.find(" repeat 3 frames 568 times every 1000.00us"), std::string::npos) << compact.out;
+  EXPECT_EQ(expanded.out.find(" repeat "), std::string::npos);
+  EXPECT_GT(expanded.out.size(), 50 * compact.out.size());
+}
+
+TEST(ReplayCommand, NamesTheFileLineAndByteWhereAGzipTraceIsCutShort) {
+  test::TempDir dir;
+  ASSERT_EQ(l6470emu("convert --expand " + fixture_path("polling_host.trace") + " -o " + dir.file("p.trace.gz")).status, 0);
+  const std::string whole = test::read_text(dir.file("p.trace.gz"));
+  const std::string cut = dir.write("cut.trace.gz", whole.substr(0, whole.size() / 2));
+  const RunResult r = l6470emu("replay " + cut);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("l6470emu replay: " + cut + ":"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": the gzip data ends early, after "), std::string::npos) << r.out;
+}
+
 }  // namespace
 }  // namespace l6470emu
