@@ -94,6 +94,7 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
     colours = [f"C{i % 10}" for i in range(len(motion.chips))]
     total_commands = sum(len(c.commands) for c in motion.chips)
     labels: List[str] = []
+    notes: List[tuple] = []  # command labels: (x, y, text, colour)
     for n, (c, colour) in enumerate(zip(motion.chips, colours)):
         t = np.asarray(c.ticks, dtype=np.float64) * SECONDS_PER_TICK * scale
         pos = np.asarray(c.abs_pos, dtype=np.float64) / per_unit
@@ -106,15 +107,7 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
             cp = np.interp(ct, t, pos)
             pos_ax.plot(ct, cp, linestyle="none", marker="v", markersize=7, color=colour,
                         markeredgecolor="black", markeredgewidth=0.6, zorder=3)
-            if total_commands <= MAX_LABELLED_COMMANDS:
-                # Labels of commands close together in time are stacked instead of overprinted.
-                close = (motion.end - motion.start) * SECONDS_PER_TICK * scale / 50
-                stack, last_x = 0, None
-                for x, y, m in zip(ct, cp, c.commands):
-                    stack = stack + 1 if last_x is not None and x - last_x < close else 0
-                    last_x = x
-                    pos_ax.annotate(m.name, (x, y), xytext=(4, 6 + 9 * stack), textcoords="offset points",
-                                    fontsize=7, color=colour)
+            notes.extend((x, y, m.name, colour) for x, y, m in zip(ct, cp, c.commands))
         # The pins as logic traces, one lane per pin (high = the upper edge of the lane, shaded).
         for k, (pin, levels) in enumerate((("BUSY", c.busy), ("FLAG", c.flag), ("SW", c.sw))):
             lane = 3.0 * (len(motion.chips) - 1 - n) + (2 - k)
@@ -122,6 +115,15 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
             pin_ax.plot(t, y, drawstyle="steps-post", color=colour, linewidth=1.2)
             pin_ax.fill_between(t, lane + 0.1, y, step="post", color=colour, alpha=0.2, linewidth=0)
             labels.append((lane + 0.45, f"{pin}{c.chip}"))
+    if total_commands <= MAX_LABELLED_COMMANDS:
+        # Labels of commands close together in time (any chip) are stacked, not overprinted.
+        close = (motion.end - motion.start) * SECONDS_PER_TICK * scale / 40
+        stack, last_x = 0, None
+        for x, y, text, colour in sorted(notes, key=lambda n: n[0]):
+            stack = stack + 1 if last_x is not None and x - last_x < close else 0
+            last_x = x if stack == 0 else last_x
+            pos_ax.annotate(text, (x, y), xytext=(4, 6 + 9 * stack), textcoords="offset points", fontsize=7,
+                            color=colour)
     pos_ax.set_ylabel(f"ABS_POS ({pos_unit})")
     pos_ax.legend(loc="best", fontsize=8)
     pos_ax.grid(True, alpha=0.3)
