@@ -48,17 +48,17 @@ std::vector<MotionSample> thin(const std::vector<MotionSample>& in, Tick from, T
   const Tick span = std::max<Tick>(1, to - from);
   std::vector<MotionSample> out;
   out.reserve(max_points);
+  auto slice_of = [&](Tick t) {
+    const Tick into = t > from ? t - from : 0;
+    return std::min<std::size_t>(slices - 1,
+                                 static_cast<std::size_t>(static_cast<unsigned __int128>(into) * slices / span));
+  };
   std::size_t i = 0;
   std::vector<std::size_t> keep;
   while (i < in.size()) {
-    const std::size_t slice = std::min<std::size_t>(
-        slices - 1, static_cast<std::size_t>(static_cast<unsigned __int128>(in[i].tick - from) * slices / span));
+    const std::size_t slice = slice_of(in[i].tick);
     std::size_t j = i;
-    while (j < in.size() &&
-           std::min<std::size_t>(slices - 1, static_cast<std::size_t>(
-                                                 static_cast<unsigned __int128>(in[j].tick - from) * slices / span)) ==
-               slice)
-      ++j;
+    while (j < in.size() && slice_of(in[j].tick) == slice) ++j;
     // [i, j) is one slice.
     keep.assign({i, j - 1});
     std::size_t lo_pos = i, hi_pos = i, lo_speed = i, hi_speed = i;
@@ -150,7 +150,8 @@ class Sampler {
         active[i] = motion_active(c.motion());
         if (!active[i]) continue;
         moving = true;
-        if (boundaries >= kBoundariesPerGridStep) continue;
+        // Before the window nothing is sampled: no need to stop at the rule changes there.
+        if (now < from_ || boundaries >= kBoundariesPerGridStep) continue;
         const Tick u = uniform_ticks(c.motion(), c.profile(), until - now);
         if (u < until - now) next = std::min(next, now + u + 1);
       }
@@ -182,12 +183,13 @@ class Sampler {
     return false;
   }
 
-  std::vector<ChipMotion> finish() {
+  /// The series, thinned over the window as it ended up (`to`).
+  std::vector<ChipMotion> finish(Tick to) {
     for (ChipMotion& m : series_) {
       const Chip& c = chain_.chip(m.chip);
       const unsigned sel = std::min<unsigned>(c.peek(Reg::STEP_MODE) & 7u, c.variant().max_step_sel);
       m.microsteps_per_step = 1u << sel;
-      m.samples = thin(m.samples, from_, to_, max_points_);
+      m.samples = thin(m.samples, from_, to, max_points_);
     }
     return std::move(series_);
   }
@@ -291,7 +293,7 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
   out.trace_end = trace_end;
   // The last samples close the window (the sampler only looks at moving chips).
   sampler.sample_all(std::min(chain.now(), to));
-  out.chips = sampler.finish();
+  out.chips = sampler.finish(to);
   return out;
 }
 
