@@ -102,7 +102,7 @@ void add_plot_command(CLI::App& app) {
   p->add_option("TRACE", a->trace, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr");
   p->add_option("-o,--output", a->output, "picture to write: .png or .svg");
   p->add_option("--chips", a->chips, "chips to draw: 0,2 or 1-3 (default all; 0 drives MISO)");
-  p->add_option("--from", a->from, "window start, seconds of the trace's time");
+  p->add_option("--from", a->from, "window start, seconds from the trace's start (a capture's own clock counts from 0 here)");
   p->add_option("--to", a->to, "window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)");
   p->add_option("--chain", a->chain, "the emulated chain (3, 2*L6470,L6480); default: the trace's own");
   p->add_option("--format", a->format, "input format: native, saleae, umockdev, ftrace, sigrok, vcd (default: recognised)");

@@ -167,7 +167,8 @@ def _arguments(argv):
     p.add_argument("trace", help="trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
     p.add_argument("-o", "--output", required=True, help="picture to write: .png or .svg")
     p.add_argument("--chips", help="chips to draw: 0,2 or 1-3 (default all; 0 drives MISO)")
-    p.add_argument("--from", dest="start", type=float, help="window start, seconds of the trace's time")
+    p.add_argument("--from", dest="start", type=float,
+                   help="window start, seconds from the trace's start (a capture's own clock counts from 0 here)")
     p.add_argument("--to", dest="end", type=float,
                    help="window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)")
     p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480); default: the trace's own")

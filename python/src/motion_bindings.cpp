@@ -189,7 +189,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
 trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
 program reads. chain: the chain (default: the trace's own; for a file without one, guessed
 from its frame lengths). chips: chip numbers to sample (default all). start, end: the window
-in seconds of the trace's time (end None: the trace's end, plus up to 1 s while a move is
+in seconds from the trace's start (end None: the trace's end, plus up to 1 s while a move is
 still going). Samples are the chips' exact states at their ticks: at the window's edges,
 after every event that touches a chip, at every change of the motion rule (the ends of
 acceleration, constant speed and deceleration: MOT_STATUS and BUSY edges to the tick) and
