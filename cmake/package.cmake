@@ -22,7 +22,7 @@ find_program(CPACK_STRIP_PROGRAM strip)
 set(CPACK_PRE_BUILD_SCRIPTS ${CMAKE_CURRENT_LIST_DIR}/strip_static_libraries.cmake)  # debug info only
 set(CPACK_DEBIAN_PACKAGE_SECTION devel)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-pytest, python3-spidev, python3-libgpiod, python3-numpy, sigrok-cli, umockdev")
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "python3-pytest, python3-spidev, python3-libgpiod, python3-numpy, python3-matplotlib, sigrok-cli, umockdev")
 if(L6470EMU_PYTHON_VERSION)
   # The module is built for one CPython (its file name carries the ABI tag).
   string(REPLACE "." ";" pv "${L6470EMU_PYTHON_VERSION}")

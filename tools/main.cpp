@@ -4,6 +4,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "tools/cmd_plot.hpp"
 #include "tools/cmd_serve.hpp"
 #include "tools/demo.hpp"
 #include "tools/tables.hpp"
@@ -54,6 +55,7 @@ int main(int argc, char** argv) {
 
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::add_trace_commands(app);             // replay, decode, convert
+  l6470emu::add_plot_command(app);               // plot (python3 -m l6470emu.plot)
 
   CLI11_PARSE(app, argc, argv);
   if (auto status = serve_commands.run()) return *status;

@@ -2,7 +2,8 @@
 
 Chain(["L6470", "L6480"]) is a daisy chain of emulated chips in virtual time: byte-level
 frames (Chain.frame), the reference host's commands (get_status, move, ...), pins and faults,
-STATUS decoded (Status), and recording into native traces that replay() and decode() read.
+STATUS decoded (Status), and recording into native traces that replay() and decode() read;
+motion() samples what each chip did over a trace, and l6470emu.plot draws it (matplotlib).
 The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spidev_board
 fixtures; preload_library() finds libl6470emu-preload.so for running unmodified programs.
 """
@@ -10,10 +11,13 @@ from ._l6470emu import (
     TICKS_PER_SECOND,
     Bridge,
     Chain,
+    ChipMotion,
+    CommandMark,
     DecodeResult,
     Diagnostic,
     Divergence,
     Fault,
+    Motion,
     Reg,
     RegisterInfo,
     ReplayResult,
@@ -23,6 +27,7 @@ from ._l6470emu import (
     TraceEvent,
     __version__,
     decode,
+    motion,
     register_table,
     replay,
     variants,
@@ -34,11 +39,14 @@ __all__ = [
     "TICKS_PER_SECOND",
     "Bridge",
     "Chain",
+    "ChipMotion",
+    "CommandMark",
     "DecodeResult",
     "Diagnostic",
     "Divergence",
     "Fault",
     "Reg",
+    "Motion",
     "RegisterInfo",
     "ReplayResult",
     "Status",
@@ -48,6 +56,7 @@ __all__ = [
     "TraceEvent",
     "__version__",
     "decode",
+    "motion",
     "preload_library",
     "program",
     "register_table",

@@ -14,5 +14,7 @@ void bind_registers(py::module_& m);
 void bind_chain(py::module_& m);
 /// Trace, TraceEvent, TraceError, replay() and decode().
 void bind_trace(py::module_& m);
+/// motion() and its Motion, ChipMotion and CommandMark: what the chips of a trace did, as series.
+void bind_motion(py::module_& m);
 
 }  // namespace l6470emu::python

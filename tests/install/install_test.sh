@@ -3,7 +3,7 @@
 # prefix; the README's CMake consumer (examples/cmake-consumer) built against it with
 # find_package and with pkg-config, and run; every installed header compiles; the installed
 # Python module finds the installed preload library and its pytest plugin loads through the
-# entry point. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
+# entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
 # into a throwaway root with dpkg -x, and the consumer is built and run against that too.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
@@ -46,6 +46,19 @@ python_module() {
   [ "$(realpath "$found")" = "$(realpath "$preload")" ] || fail "$name: preload_library() is $found, not $preload"
 }
 
+# The installed program PROGRAM draws a picture with the installed package (no PYTHONPATH).
+plot_command() {
+  local program=$1 name=$2
+  if ! "$python" -c 'import matplotlib' 2>/dev/null; then
+    step "$name: l6470emu plot not checked: $python has no matplotlib"
+    return
+  fi
+  step "$name: l6470emu plot finds the installed package"
+  (cd "$work" && env -u PYTHONPATH "$program" plot "$source/fixtures/traces/single_chip.trace" -o "$work/$name.png") \
+    || fail "$name: l6470emu plot"
+  [ "$(stat -c %s "$work/$name.png")" -gt 10000 ] || fail "$name: l6470emu plot drew an empty picture"
+}
+
 step "cmake --install into a temporary prefix"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
@@ -84,6 +97,7 @@ consumers "$prefix" prefix
 site=$(dirname "$(dirname "$(find "$prefix" -name pytest_plugin.py -path '*/l6470emu/*' -print -quit)")")
 case "$site" in "$prefix"/lib/python3.[0-9]*/dist-packages) ;; *) fail "Python package in '$site', not lib/python3.X/dist-packages" ;; esac
 python_module "$site" "$preload" prefix
+plot_command "$prefix/bin/l6470emu" prefix
 
 step "prefix: the pytest plugin loads through its entry point (no conftest)"
 mkdir -p "$work/plugin"
@@ -112,6 +126,7 @@ for pattern in usr/bin/l6470emu 'usr/lib/.*l6470emu/libl6470emu-preload\.so' 'us
                'usr/lib/python3/dist-packages/l6470emu/_l6470emu\.cpython-.*\.so' \
                usr/lib/python3/dist-packages/l6470emu/__init__.py usr/lib/python3/dist-packages/l6470emu/_l6470emu.pyi \
                usr/lib/python3/dist-packages/l6470emu/py.typed usr/lib/python3/dist-packages/l6470emu/pytest_plugin.py \
+               usr/lib/python3/dist-packages/l6470emu/plot.py \
                usr/lib/python3/dist-packages/l6470emu/_install_paths.py \
                'usr/lib/python3/dist-packages/l6470emu-.*\.dist-info/entry_points\.txt'; do
   grep -qx "$pattern" "$work/deb.files" || fail "the .deb lacks $pattern"
@@ -129,5 +144,6 @@ dpkg -x "$deb" "$root"
 "$root/usr/bin/l6470emu" --version >/dev/null || fail "the packaged program"
 consumers "$root/usr" deb
 python_module "$root/usr/lib/python3/dist-packages" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
+plot_command "$root/usr/bin/l6470emu" deb
 
 echo "install_test: 1 passed, 0 failed"

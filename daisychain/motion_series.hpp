@@ -1,0 +1,83 @@
+// What the motors did over a trace, as time series for plotting: a trace replayed through
+// an emulated chain, each chosen chip's ABS_POS, SPEED, MOT_STATUS, BUSY, FLAG, SW and HiZ
+// sampled at the ticks where they matter, and the commands each chip decoded. Integers in
+// the datasheet's units only; conversions to step/s and seconds are the reader's business.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/tick.hpp"
+#include "core/variant.hpp"
+#include "daisychain/chain.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// One chip's state at one tick, exactly as the emulated chip has it then.
+struct MotionSample {
+  Tick tick = 0;
+  std::int32_t abs_pos = 0;    ///< ABS_POS, microsteps of the STEP_SEL in force
+  std::int32_t speed = 0;      ///< SPEED register (2^-28 full step/tick), negative while turning in reverse
+  std::uint8_t mot_status = 0; ///< MOT_STATUS: 0 stopped, 1 accelerating, 2 decelerating, 3 constant speed
+  bool busy = true;            ///< BUSY pin level (false = pulled low: a command is running)
+  bool flag = true;            ///< FLAG pin level (false = pulled low: an enabled alarm)
+  bool sw = true;              ///< SW pin level (false = switch closed)
+  bool hiz = true;             ///< bridges in high impedance
+};
+
+/// A command a chip decoded (NOP, GetParam and GetStatus left out): when its frame ended
+/// (CS rising edge, when it acts), its name and its argument in words.
+struct CommandMark {
+  Tick tick = 0;
+  std::uint8_t opcode = 0;
+  std::string name;  ///< "Move(FWD)", "SetParam(ACC)", "SoftStop"
+  std::string text;  ///< "Move(FWD, 3200 microsteps)"
+};
+
+/// One chip's series.
+struct ChipMotion {
+  std::size_t chip = 0;
+  std::string variant;                ///< "L6470"
+  unsigned microsteps_per_step = 128; ///< of the STEP_SEL in force at the window's end
+  std::vector<MotionSample> samples;  ///< in time order, at most MotionOptions::max_points
+  std::vector<CommandMark> commands;  ///< in time order, inside the window
+  std::uint64_t commands_dropped = 0; ///< commands in the window beyond max_commands
+};
+
+/// Choices for sample_motion.
+struct MotionOptions {
+  std::vector<std::size_t> chips;  ///< chips to sample (empty = all)
+  Tick from = 0;                   ///< the window: samples and commands from this tick ...
+  Tick to = kNever;                ///< ... up to this one (kNever = the trace's end plus `tail`)
+  /// Past the trace's last event, motion still going is followed for at most this long.
+  Tick tail = kTicksPerSecond;
+  /// Most samples per chip: a long run is sampled on a coarser grid and then thinned (each
+  /// time slice keeps its first and last sample and those with the extremes of ABS_POS and
+  /// SPEED and the first change of each pin), so the picture keeps its shape. At least 64.
+  std::size_t max_points = 4000;
+  std::size_t max_commands = 2000;  ///< most command marks per chip
+};
+
+/// The series of a trace's window.
+struct MotionSeries {
+  Tick from = 0, to = 0;          ///< the window actually sampled
+  Tick trace_end = 0;             ///< the last event's tick (frame: its CS rising edge)
+  std::vector<ChipMotion> chips;  ///< in the order asked for
+};
+
+/// The last tick of a trace: the latest event's tick (a frame's CS rising edge).
+Tick trace_end_tick(TraceReader& in);
+
+/// Replays `in` through `chain` (fresh, as the capture began) and samples the chosen chips.
+/// Samples are taken at the window's edges, after every trace event inside the window that
+/// touches the chip, at every tick where the motion engine's rule changes (the ends of
+/// acceleration, constant speed and deceleration: MOT_STATUS and BUSY edges to the tick),
+/// and on a regular grid of about max_points / 4 ticks across the window while a chip moves.
+/// `trace_end` is trace_end_tick() of the same trace (needed for an open window).
+/// Throws TraceError for malformed input and events naming chips outside the chain, and
+/// std::invalid_argument for a chip outside the chain or an empty window.
+MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const MotionOptions& options = {});
+
+}  // namespace l6470emu

@@ -1,0 +1,217 @@
+"""Pictures of what the motors did: each chip's position, speed, BUSY/FLAG/SW pins and the
+commands it received, against time, from a trace or a live recording (matplotlib, no display).
+
+    l6470emu.plot.plot("run.trace", "run.png", chips=[0, 2], start=0.1, end=0.9)
+    chain = l6470emu.Chain(["L6470"], record=True); ...; l6470emu.plot.plot(chain, "run.svg")
+    python3 -m l6470emu.plot run.trace -o run.png --chips 0,2 --from 0.1 --to 0.9
+
+The numbers come from l6470emu.motion() (the emulator's exact states, in the datasheet's
+integer units); only here are they converted: ticks to seconds, SPEED to full steps per second.
+ABS_POS is drawn in microsteps, as the register holds it.
+"""
+import argparse
+import sys
+from pathlib import Path
+from typing import List, Optional, Sequence, Tuple, Union
+
+from . import _l6470emu
+
+SECONDS_PER_TICK = 1.0 / _l6470emu.TICKS_PER_SECOND
+#: SPEED register units (2^-28 full step per 250 ns tick) in full steps per second.
+STEPS_PER_S_PER_SPEED_UNIT = _l6470emu.TICKS_PER_SECOND / 2.0**28
+#: Command labels are written next to their markers when a picture has at most this many.
+MAX_LABELLED_COMMANDS = 40
+#: The file types plot() writes.
+FORMATS = (".png", ".svg")
+
+EXIT_BAD_INPUT = 2
+
+
+class PlotError(ValueError):
+    """A request plot() cannot draw: an unknown output type, a bad chip list."""
+
+
+def parse_chips(text: str) -> List[int]:
+    """A chip list as the command line gives it: "0,2", "1-3", "0,2-4" (0 drives MISO)."""
+    chips: List[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        first, dash, last = part.partition("-")
+        try:
+            lo = int(first, 10)
+            hi = int(last, 10) if dash else lo
+        except ValueError:
+            raise PlotError(f"--chips {text!r}: chip numbers separated by commas, ranges as 1-3 (e.g. 0,2-4)") from None
+        if lo < 0 or hi < lo or hi > 255:
+            raise PlotError(f"--chips {text!r}: {part!r} is not a chip number or range from 0 to 255")
+        chips.extend(range(lo, hi + 1))
+    return sorted(set(chips))
+
+
+def _motion_of(source, chain, chips, start, end, format, select, max_points):
+    """l6470emu.motion() of a Motion (as is), a Chain recording into memory, a Trace or a path."""
+    if isinstance(source, _l6470emu.Motion):
+        return source
+    if isinstance(source, _l6470emu.Chain):
+        if source.trace is None and source.record_path is None:
+            raise PlotError("the Chain records nothing: make it with record=True (or record=PATH)")
+        if end is None and source.now_seconds > (start or 0.0):
+            end = source.now_seconds  # a live chain: up to its present
+        source = source.trace if source.trace is not None else source.record_path
+    return _l6470emu.motion(source, chain, format=format, select=select, chips=chips, start=start, end=end,
+                            max_points=max_points)
+
+
+def _time_scale(motion) -> tuple:
+    span = (motion.end - motion.start) * SECONDS_PER_TICK
+    if span < 0.01:
+        return 1e6, "µs"
+    if span < 2:
+        return 1e3, "ms"
+    return 1.0, "s"
+
+
+def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
+           end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
+           title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None):
+    """The picture as a matplotlib Figure (not shown, not saved; pyplot is not used).
+
+    source: a trace file (any format the l6470emu program reads), a Trace, a Chain made with
+    record=True, or a Motion from l6470emu.motion(). The other arguments are motion()'s, and
+    position_unit = (name, microsteps per unit), e.g. ("rev", 25600), to draw positions in
+    another unit than ABS_POS's microsteps.
+    """
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    motion = _motion_of(source, chain, chips, start, end, format, select, max_points)
+    scale, unit = _time_scale(motion)
+    pos_unit, per_unit = position_unit if position_unit is not None else ("microsteps", 1.0)
+    if not per_unit > 0:
+        raise PlotError(f"position_unit {position_unit!r}: microsteps per unit must be positive")
+    fig = Figure(figsize=size, layout="constrained")
+    pos_ax, speed_ax, pin_ax = fig.subplots(3, 1, sharex=True, height_ratios=[3, 2, 2])
+    colours = [f"C{i % 10}" for i in range(len(motion.chips))]
+    total_commands = sum(len(c.commands) for c in motion.chips)
+    labels: List[str] = []
+    notes: List[tuple] = []  # command labels: (x, y, text, colour)
+    for n, (c, colour) in enumerate(zip(motion.chips, colours)):
+        t = np.asarray(c.ticks, dtype=np.float64) * SECONDS_PER_TICK * scale
+        pos = np.asarray(c.abs_pos, dtype=np.float64) / per_unit
+        speed = np.asarray(c.speed, dtype=np.float64) * STEPS_PER_S_PER_SPEED_UNIT
+        name = f"chip {c.chip} {c.variant} (1/{c.microsteps_per_step})"
+        pos_ax.plot(t, pos, color=colour, linewidth=1.6, label=name)
+        speed_ax.plot(t, speed, color=colour, linewidth=1.4)
+        if c.commands and len(t):
+            ct = np.asarray([m.tick for m in c.commands], dtype=np.float64) * SECONDS_PER_TICK * scale
+            cp = np.interp(ct, t, pos)
+            pos_ax.plot(ct, cp, linestyle="none", marker="v", markersize=7, color=colour,
+                        markeredgecolor="black", markeredgewidth=0.6, zorder=3)
+            notes.extend((x, y, m.name, colour) for x, y, m in zip(ct, cp, c.commands))
+        # The pins as logic traces, one lane per pin (high = the upper edge of the lane, shaded).
+        for k, (pin, levels) in enumerate((("BUSY", c.busy), ("FLAG", c.flag), ("SW", c.sw))):
+            lane = 3.0 * (len(motion.chips) - 1 - n) + (2 - k)
+            y = lane + 0.1 + 0.7 * np.asarray(levels, dtype=np.float64)
+            pin_ax.plot(t, y, drawstyle="steps-post", color=colour, linewidth=1.2)
+            pin_ax.fill_between(t, lane + 0.1, y, step="post", color=colour, alpha=0.2, linewidth=0)
+            labels.append((lane + 0.45, f"{pin}{c.chip}"))
+    if total_commands <= MAX_LABELLED_COMMANDS:
+        # Labels of commands close together in time (any chip) are stacked, not overprinted.
+        close = (motion.end - motion.start) * SECONDS_PER_TICK * scale / 40
+        stack, last_x = 0, None
+        for x, y, text, colour in sorted(notes, key=lambda n: n[0]):
+            stack = stack + 1 if last_x is not None and x - last_x < close else 0
+            last_x = x if stack == 0 else last_x
+            pos_ax.annotate(text, (x, y), xytext=(4, 6 + 9 * stack), textcoords="offset points", fontsize=7,
+                            color=colour)
+    pos_ax.set_ylabel(f"ABS_POS ({pos_unit})")
+    pos_ax.legend(loc="best", fontsize=8)
+    pos_ax.grid(True, alpha=0.3)
+    speed_ax.set_ylabel("speed (full step/s,\nnegative = reverse)")
+    speed_ax.axhline(0, color="0.6", linewidth=0.6)
+    speed_ax.grid(True, alpha=0.3)
+    pin_ax.set_yticks([y for y, _ in labels], [name for _, name in labels], fontsize=7)
+    pin_ax.set_ylabel("pins (high / low)")
+    pin_ax.grid(True, axis="x", alpha=0.3)
+    pin_ax.set_xlabel(f"time ({unit})")
+    pin_ax.set_xlim(motion.start * SECONDS_PER_TICK * scale, motion.end * SECONDS_PER_TICK * scale)
+    if title is None:
+        name = source if isinstance(source, (str, Path)) else getattr(source, "name", None)
+        title = f"{Path(name).name if isinstance(name, (str, Path)) else 'recording'}: chain {motion.chain}"
+        if total_commands > MAX_LABELLED_COMMANDS:
+            title += f" ({total_commands} commands: markers only)"
+    fig.suptitle(title, fontsize=11)
+    return fig
+
+
+def plot(source, output: Union[str, Path], **options) -> Path:
+    """Draws the picture of `source` (see figure()) into `output`, a .png or .svg file."""
+    output = Path(output)
+    if output.suffix.lower() not in FORMATS:
+        raise PlotError(f"{output}: the picture is written as .png or .svg (the file name says which)")
+    dpi = options.pop("dpi", 100)
+    fig = figure(source, **options)
+    fig.savefig(output, dpi=dpi)
+    return output
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line and exit status 2, not the usage text
+        raise PlotError(message)
+
+
+def _arguments(argv):
+    p = _Parser(
+        prog="l6470emu plot",
+        description="Draw each chip's position, speed, BUSY/FLAG/SW and commands against time, from a trace.")
+    p.add_argument("trace", help="trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
+    p.add_argument("-o", "--output", required=True, help="picture to write: .png or .svg")
+    p.add_argument("--chips", help="chips to draw: 0,2 or 1-3 (default all; 0 drives MISO)")
+    p.add_argument("--from", dest="start", type=float,
+                   help="window start, seconds from the trace's start (a capture's own clock counts from 0 here)")
+    p.add_argument("--to", dest="end", type=float,
+                   help="window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)")
+    p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480); default: the trace's own")
+    p.add_argument("--format", default=None, help="input format (default: recognised from the content)")
+    p.add_argument("--select", default="", help="the stream to take when the file has several")
+    p.add_argument("--max-points", type=int, default=4000, help="most samples per chip (default 4000)")
+    p.add_argument("--title", help="the picture's title (default: the file and the chain)")
+    p.add_argument("--size", default="10x7.5", help="width x height in inches (default 10x7.5)")
+    p.add_argument("--dpi", type=int, default=100, help="PNG resolution (default 100)")
+    return p.parse_args(argv)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """`l6470emu plot` / `python3 -m l6470emu.plot`: 0, or 2 with one line on standard error."""
+    try:
+        args = _arguments(argv)
+        try:
+            width, height = (float(x) for x in args.size.lower().split("x"))
+            if not (0 < width <= 100 and 0 < height <= 100):
+                raise ValueError
+        except ValueError:
+            raise PlotError(f"--size {args.size!r}: WIDTHxHEIGHT in inches, e.g. 10x7.5") from None
+        if args.max_points < 64:
+            raise PlotError(f"--max-points {args.max_points}: at least 64")
+        if args.dpi < 10 or args.dpi > 1200:
+            raise PlotError(f"--dpi {args.dpi}: from 10 to 1200")
+        chips = parse_chips(args.chips) if args.chips is not None else None
+        if not Path(args.trace).exists():
+            raise PlotError(f"{args.trace}: no such file")
+        try:
+            import matplotlib
+        except ImportError:
+            raise PlotError("drawing needs matplotlib (Debian: apt install python3-matplotlib)") from None
+        matplotlib.use("Agg")
+        out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
+                   format=args.format, select=args.select, max_points=args.max_points, title=args.title,
+                   size=(width, height), dpi=args.dpi)
+    except (ValueError, TypeError, OSError, RuntimeError) as e:  # TraceError is a ValueError
+        print(f"l6470emu plot: {e}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"l6470emu plot: wrote {out}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

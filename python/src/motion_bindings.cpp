@@ -1,0 +1,201 @@
+// What the motors did, for Python: l6470emu.motion() replays a trace (a Trace or any file the
+// l6470emu program reads) through a fresh emulated chain and returns each chip's ABS_POS,
+// SPEED, MOT_STATUS, BUSY/FLAG/SW/HiZ series and command marks (daisychain/motion_series.hpp).
+// Values stay in the datasheet's integer units; l6470emu.plot converts and draws them.
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <memory>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "daisychain/chain_spec.hpp"
+#include "daisychain/motion_series.hpp"
+#include "spi/trace_import.hpp"
+#include "tools/trace_input.hpp"
+
+namespace l6470emu::python {
+namespace {
+
+/// One chip's series as Python lists (the plot module makes arrays of them).
+struct PyChipMotion {
+  std::size_t chip = 0;
+  std::string variant;
+  unsigned microsteps_per_step = 0;
+  std::vector<Tick> ticks;
+  std::vector<std::int32_t> abs_pos, speed;
+  std::vector<int> mot_status;
+  std::vector<bool> busy, flag, sw, hiz;
+  std::vector<CommandMark> commands;
+  std::uint64_t commands_dropped = 0;
+};
+
+struct PyMotion {
+  Tick start = 0, end = 0, trace_end = 0;
+  std::string chain, how;
+  std::vector<PyChipMotion> chips;
+};
+
+PyChipMotion chip_of(ChipMotion&& m) {
+  PyChipMotion p;
+  p.chip = m.chip;
+  p.variant = std::move(m.variant);
+  p.microsteps_per_step = m.microsteps_per_step;
+  const std::size_t n = m.samples.size();
+  p.ticks.reserve(n);
+  for (const MotionSample& s : m.samples) {
+    p.ticks.push_back(s.tick);
+    p.abs_pos.push_back(s.abs_pos);
+    p.speed.push_back(s.speed);
+    p.mot_status.push_back(s.mot_status);
+    p.busy.push_back(s.busy);
+    p.flag.push_back(s.flag);
+    p.sw.push_back(s.sw);
+    p.hiz.push_back(s.hiz);
+  }
+  p.commands = std::move(m.commands);
+  p.commands_dropped = m.commands_dropped;
+  return p;
+}
+
+/// Seconds (a float or int >= 0) as the nearest tick; None = `none`.
+Tick tick_from_seconds(py::handle seconds, const char* what, Tick none) {
+  if (seconds.is_none()) return none;
+  if (!py::isinstance<py::float_>(seconds) && !(PyLong_Check(seconds.ptr()) && !PyBool_Check(seconds.ptr())))
+    throw py::type_error(std::string(what) + ": seconds (a float) are needed");
+  const double s = seconds.cast<double>();
+  if (!std::isfinite(s) || s < 0 || s > 1e9)
+    throw py::value_error(std::string(what) + " = " + std::string(py::str(seconds)) + " is not a time in seconds from 0 to 1e9");
+  return static_cast<Tick>(std::llround(s * static_cast<double>(kTicksPerSecond)));
+}
+
+}  // namespace
+
+void bind_motion(py::module_& m) {
+  py::class_<CommandMark>(m, "CommandMark", "A command a chip decoded: when it acted (its frame's CS rising edge).")
+      .def_readonly("tick", &CommandMark::tick, "the frame's CS rising edge, 250 ns ticks")
+      .def_property_readonly("seconds", [](const CommandMark& c) { return static_cast<double>(c.tick) / kTicksPerSecond; },
+                             "the same in seconds")
+      .def_readonly("opcode", &CommandMark::opcode, "the opcode byte")
+      .def_readonly("name", &CommandMark::name, "the command as the datasheet names it: \"Move(FWD)\", \"SoftStop\"")
+      .def_readonly("text", &CommandMark::text, "with its argument: \"Move(FWD, 3200 microsteps)\"")
+      .def("__repr__", [](const CommandMark& c) { return "CommandMark(" + std::to_string(c.tick) + ", " + c.text + ")"; });
+
+  py::class_<PyChipMotion>(m, "ChipMotion", R"(One chip's series, sampled where they change: lists of equal length,
+in the datasheet's units (ABS_POS in microsteps of the STEP_SEL in force, SPEED in 2^-28 full
+step per tick, negative in reverse; pins as levels, False = pulled low).)")
+      .def_readonly("chip", &PyChipMotion::chip, "the chip (0 drives MISO)")
+      .def_readonly("variant", &PyChipMotion::variant, "\"L6470\", ...")
+      .def_readonly("microsteps_per_step", &PyChipMotion::microsteps_per_step, "of the STEP_SEL in force at the end")
+      .def_readonly("ticks", &PyChipMotion::ticks, "sample times, 250 ns ticks")
+      .def_readonly("abs_pos", &PyChipMotion::abs_pos, "ABS_POS, microsteps")
+      .def_readonly("speed", &PyChipMotion::speed, "SPEED register, signed by the direction (2^-28 step/tick)")
+      .def_readonly("mot_status", &PyChipMotion::mot_status, "0 stopped, 1 accelerating, 2 decelerating, 3 constant speed")
+      .def_readonly("busy", &PyChipMotion::busy, "BUSY pin level (False = busy)")
+      .def_readonly("flag", &PyChipMotion::flag, "FLAG pin level (False = an enabled alarm)")
+      .def_readonly("sw", &PyChipMotion::sw, "SW pin level (False = switch closed)")
+      .def_readonly("hiz", &PyChipMotion::hiz, "bridges in high impedance")
+      .def_readonly("commands", &PyChipMotion::commands, "the commands decoded in the window (NOP, GetParam, GetStatus left out)")
+      .def_readonly("commands_dropped", &PyChipMotion::commands_dropped, "commands beyond max_commands, not listed")
+      .def("__len__", [](const PyChipMotion& c) { return c.ticks.size(); })
+      .def("__repr__", [](const PyChipMotion& c) {
+        return "ChipMotion(chip " + std::to_string(c.chip) + " " + c.variant + ", " + std::to_string(c.ticks.size()) +
+               " samples, " + std::to_string(c.commands.size()) + " commands)";
+      });
+
+  py::class_<PyMotion>(m, "Motion", "What the chips of a trace did over a window: .chips holds a ChipMotion per chip asked for.")
+      .def_readonly("start", &PyMotion::start, "the window's first tick")
+      .def_readonly("end", &PyMotion::end, "the window's last tick (open windows: where the motion ended)")
+      .def_readonly("trace_end", &PyMotion::trace_end, "the trace's last event")
+      .def_readonly("chain", &PyMotion::chain, "the emulated chain, chip 0 first (\"3*L6470\")")
+      .def_readonly("how", &PyMotion::how, "where the chain came from, in words")
+      .def_readonly("chips", &PyMotion::chips, "one ChipMotion per chip asked for")
+      .def("__repr__", [](const PyMotion& p) {
+        return "Motion(chain " + p.chain + ", " + std::to_string(p.chips.size()) + " chips, ticks " +
+               std::to_string(p.start) + ".." + std::to_string(p.end) + ")";
+      });
+
+  m.def(
+      "motion",
+      [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
+         py::handle end, std::size_t max_points, std::size_t max_commands) {
+        std::string spec;
+        if (!chain.is_none()) spec = chain_spec_from(chain);
+        MotionOptions o;
+        o.from = tick_from_seconds(start, "start", 0);
+        o.to = tick_from_seconds(end, "end", kNever);
+        o.max_points = max_points;
+        o.max_commands = max_commands;
+        if (!chips.is_none()) {
+          if (!py::isinstance<py::sequence>(chips) || py::isinstance<py::str>(chips))
+            throw py::type_error("chips: a list of chip numbers (0 drives MISO) is needed");
+          for (py::handle c : chips) o.chips.push_back(static_cast<std::size_t>(int_in_range(c, "chips", 0, 255)));
+          if (o.chips.empty()) throw py::value_error("chips: the list is empty (None = every chip)");
+        }
+        PyMotion result;
+        std::shared_ptr<const Trace> held;
+        std::unique_ptr<TraceFile> file;
+        std::vector<const Variant*> variants;
+        if (py::isinstance<Trace>(trace)) {
+          held = trace.cast<std::shared_ptr<Trace>>();
+          const std::string& own = held->header.chain;
+          if (spec.empty() && own.empty())
+            throw py::value_error("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
+          result.how = spec.empty() ? "from the trace" : "from chain=";
+          try {
+            variants = parse_chain_spec(spec.empty() ? own : spec);
+          } catch (const std::invalid_argument& e) {
+            throw py::value_error(std::string("chain: ") + e.what());
+          }
+        } else {
+          const std::string path = path_from(trace, "trace");
+          TraceInputOptions options;
+          if (!format.is_none()) {
+            const std::string name = py::str(format);
+            options.format = trace_format_named(name);
+            if (options.format == TraceFormat::unknown && name != "auto")
+              throw py::value_error("format: \"" + name + "\" is not native, saleae, umockdev, ftrace, sigrok or vcd");
+          }
+          options.import.select = select;
+          py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
+          file = std::make_unique<TraceFile>(path, options);
+          variants = chain_for_trace(spec, *file, result.how);
+          if (!spec.empty()) result.how = "from chain=";
+        }
+        {
+          py::gil_scoped_release unlocked;
+          auto reader = [&] { return held ? held->reader() : file->read(); };
+          Chain c = make_chain(variants);
+          result.chain = chain_spec_of(c);
+          Tick trace_end = 0;
+          {
+            auto pass = reader();
+            trace_end = trace_end_tick(*pass);
+          }
+          auto pass = reader();
+          MotionSeries s = sample_motion(*pass, c, trace_end, o);
+          result.start = s.from;
+          result.end = s.to;
+          result.trace_end = s.trace_end;
+          for (ChipMotion& cm : s.chips) result.chips.push_back(chip_of(std::move(cm)));
+        }
+        return result;
+      },
+      py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
+      py::arg("select") = "", py::arg("chips") = py::none(), py::arg("start") = py::none(), py::arg("end") = py::none(),
+      py::arg("max_points") = 4000, py::arg("max_commands") = 2000,
+      R"(Replays a trace through a fresh emulated chain and samples what each chip did.
+
+trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
+program reads. chain: the chain (default: the trace's own; for a file without one, guessed
+from its frame lengths). chips: chip numbers to sample (default all). start, end: the window
+in seconds from the trace's start (end None: the trace's end, plus up to 1 s while a move is
+still going). Samples are the chips' exact states at their ticks: at the window's edges,
+after every event that touches a chip, at every change of the motion rule (the ends of
+acceleration, constant speed and deceleration: MOT_STATUS and BUSY edges to the tick) and
+on a grid of about max_points / 4 steps; long runs are thinned to at most max_points per
+chip. Raises ValueError for chips outside the chain or an empty window, TraceError for
+malformed traces.)");
+}
+
+}  // namespace l6470emu::python

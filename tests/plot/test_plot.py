@@ -1,0 +1,121 @@
+"""`l6470emu plot` and l6470emu.plot: every trace format the program reads becomes a picture
+with something in it (read back as pixels), PNG and SVG, chosen chips and windows, live
+recordings, and every bad input is one line on standard error with exit status 2.
+Run by ctest's `plot` test, which is skipped (with the reason) when matplotlib is missing."""
+import os
+import subprocess
+from pathlib import Path
+
+import matplotlib
+import matplotlib.image
+import numpy as np
+import pytest
+
+import l6470emu
+import l6470emu.plot
+
+matplotlib.use("Agg")
+
+FIXTURES = Path(os.environ.get("L6470EMU_SOURCE_DIR", Path(__file__).resolve().parents[2])) / "fixtures" / "traces"
+
+
+def run_plot(*args):
+    return subprocess.run([l6470emu.program(), "plot", *map(str, args)], capture_output=True, text=True, timeout=120)
+
+
+def distinct_colours_inside(png: Path) -> int:
+    """Distinct colours in the middle of the picture (inside the axes, away from the labels)."""
+    pixels = matplotlib.image.imread(str(png))
+    h, w = pixels.shape[:2]
+    inside = pixels[h // 10: h * 9 // 10, w // 5: w * 9 // 10, :3]
+    quantised = np.round(inside.reshape(-1, 3) * 31).astype(np.int32)
+    return len({tuple(c) for c in quantised})
+
+
+@pytest.mark.parametrize("fixture", [
+    "three_chips.trace", "single_chip.trace", "saleae_logic2.csv", "saleae_logic2_decimal_no_duration.csv",
+    "umockdev_spidev.ioctl", "ftrace_spi_set_cs.txt", "ftrace_trace_cmd_report.txt", "sigrok_spi.json",
+])
+def test_every_trace_format_becomes_a_picture_with_lines_in_several_colours(tmp_path, fixture):
+    out = tmp_path / "plot.png"
+    r = run_plot(FIXTURES / fixture, "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert out.stat().st_size > 20_000
+    assert distinct_colours_inside(out) >= 6
+
+
+def test_the_three_chip_picture_shows_three_chips_positions_and_pins(tmp_path):
+    fig = l6470emu.plot.figure(FIXTURES / "three_chips.trace")
+    pos_ax, speed_ax, pin_ax = fig.axes
+    assert [t.get_text() for t in pos_ax.get_legend().get_texts()] == [
+        "chip 0 L6470 (1/128)", "chip 1 L6470 (1/128)", "chip 2 L6470 (1/128)"]
+    assert [t.get_text() for t in pin_ax.get_yticklabels()][:3] == ["BUSY0", "FLAG0", "SW0"]
+    assert len(pin_ax.get_lines()) == 9  # BUSY, FLAG, SW per chip
+    assert any(text.get_text().startswith("GoUntil") for text in pos_ax.texts)  # command labels
+
+
+def test_an_svg_is_written_when_the_name_says_svg(tmp_path):
+    out = tmp_path / "plot.svg"
+    r = run_plot(FIXTURES / "single_chip.trace", "-o", out)
+    assert r.returncode == 0, r.stderr
+    text = out.read_text()
+    assert "<svg" in text and "ABS_POS" in text
+
+
+def test_chosen_chips_and_window_are_the_only_ones_drawn(tmp_path):
+    fig = l6470emu.plot.figure(FIXTURES / "three_chips.trace", chips=[2], start=0.01, end=0.03)
+    pos_ax = fig.axes[0]
+    assert [t.get_text() for t in pos_ax.get_legend().get_texts()] == ["chip 2 L6470 (1/128)"]
+    assert pos_ax.get_xlim() == pytest.approx((10.0, 30.0))  # milliseconds
+    out = tmp_path / "window.png"
+    r = run_plot(FIXTURES / "three_chips.trace", "-o", out, "--chips", "0,2", "--from", "0.01", "--to", "0.03")
+    assert r.returncode == 0, r.stderr
+    assert distinct_colours_inside(out) >= 4
+
+
+def test_a_live_recording_is_drawn_from_the_chain(tmp_path):
+    chain = l6470emu.Chain(["L6470", "L6480"], record=True)
+    chain.move(1, forward=True, n_step=3200)
+    chain.advance(seconds=0.5)
+    out = l6470emu.plot.plot(chain, tmp_path / "live.png")
+    assert out.stat().st_size > 20_000
+    assert distinct_colours_inside(out) >= 4
+
+
+def test_a_long_run_is_bounded_and_keeps_its_extremes():
+    chain = l6470emu.Chain("L6470", record=True)
+    for i in range(300):
+        chain.move(0, forward=i % 2 == 0, n_step=3200)
+        chain.advance(seconds=0.4)
+    m = l6470emu.motion(chain.trace, max_points=400)
+    c = m.chips[0]
+    assert len(c) <= 400
+    assert max(c.abs_pos) == 3200 and min(c.abs_pos) == 0
+    assert len(c.commands) == 300
+
+
+@pytest.mark.parametrize("args, says", [
+    (["missing.trace", "-o", "x.png"], "missing.trace: no such file"),
+    (["{three}", "-o", "x.png", "--chips", "x"], "--chips 'x'"),
+    (["{three}", "-o", "x.png", "--chips", "7"], "chip 7: the chain has 3 chips"),
+    (["{three}", "-o", "x.png", "--chips", "3-1"], "--chips '3-1'"),
+    (["{three}", "-o", "x.png", "--from", "0.5", "--to", "0.2"], "the window is empty"),
+    (["{three}", "-o", "x.png", "--from", "1000"], "the window is empty"),
+    (["{three}", "-o", "x.png", "--from", "soon"], "--from"),
+    (["{three}", "-o", "x.jpg"], "x.jpg: the picture is written as .png or .svg"),
+    (["{three}"], "--output"),
+    ([], "required"),
+    (["{three}", "-o", "/nonexistent-dir/x.png"], "No such file or directory"),
+    (["{garbage}", "-o", "x.png"], "unknown trace format"),
+])
+def test_bad_input_is_one_line_and_exit_status_2(tmp_path, args, says):
+    garbage = tmp_path / "garbage.bin"
+    garbage.write_bytes(b"\x00\x01 not a trace\n")
+    args = [a.format(three=FIXTURES / "three_chips.trace", garbage=garbage) for a in args]
+    args = [str(tmp_path / a) if a.endswith((".png", ".jpg")) and not a.startswith("/") else a for a in args]
+    r = run_plot(*args)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1, r.stderr
+    assert lines[0].startswith("l6470emu plot: ") and says in lines[0], lines[0]
