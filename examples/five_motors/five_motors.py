@@ -52,15 +52,6 @@ def positions(chain):
     return out
 
 
-def plotting_possible() -> bool:
-    try:
-        import matplotlib  # noqa: F401
-        return True
-    except ImportError:
-        print("plot skipped: matplotlib is not installed (Debian: apt install python3-matplotlib)")
-        return False
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--plot", help="draw the run into this .png or .svg (needs python3-matplotlib)")
@@ -111,11 +102,14 @@ def main() -> int:
         print(f"  {'ok  ' if good else 'FAIL'} {what}")
         ok = ok and good
 
-    if args.plot and plotting_possible():
-        from l6470emu.plot import plot
-        out = plot(chain, args.plot, position_unit=("half-steps", 1),
-                                 title="five motors: 10 000 half-steps each; SoftStop of 3 at 4 s, HardHiZ at 7 s")
-        print(f"plot: {out}")
+    if args.plot:
+        from l6470emu import plot as pictures
+        if pictures.available():
+            out = pictures.plot(chain, args.plot, position_unit=("half-steps", 1),
+                                title="five motors: 10 000 half-steps each; SoftStop of 3 at 4 s, HardHiZ at 7 s")
+            print(f"plot: {out}")
+        else:
+            print(f"plot skipped: {pictures.MATPLOTLIB_MISSING}")
     return 0 if ok else 1
 
 

@@ -66,15 +66,6 @@ class Carriage:
                 raise AssertionError(f"the motor is still busy after {limit_s} s")
 
 
-def plotting_possible() -> bool:
-    try:
-        import matplotlib  # noqa: F401
-        return True
-    except ImportError:
-        print("plot skipped: matplotlib is not installed (Debian: apt install python3-matplotlib)")
-        return False
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--plot", help="draw the run into this .png or .svg (needs python3-matplotlib)")
@@ -116,10 +107,13 @@ def main() -> int:
         print(f"  {'ok  ' if good else 'FAIL'} {what}")
         ok = ok and bool(good)
 
-    if args.plot and plotting_possible():
-        from l6470emu.plot import plot
-        out = plot(chain, args.plot, title="homing: GoUntil, ReleaseSW, ResetPos, GoTo(10000)")
-        print(f"plot: {out}")
+    if args.plot:
+        from l6470emu import plot as pictures
+        if pictures.available():
+            out = pictures.plot(chain, args.plot, title="homing: GoUntil, ReleaseSW, ResetPos, GoTo(10000)")
+            print(f"plot: {out}")
+        else:
+            print(f"plot skipped: {pictures.MATPLOTLIB_MISSING}")
     return 0 if ok else 1
 
 

@@ -42,15 +42,6 @@ def wait_until(chain, condition, what: str, limit_s: float = 30.0, step_s: float
             raise AssertionError(f"{what}: still not after {limit_s} s")
 
 
-def plotting_possible() -> bool:
-    try:
-        import matplotlib  # noqa: F401
-        return True
-    except ImportError:
-        print("plot skipped: matplotlib is not installed (Debian: apt install python3-matplotlib)")
-        return False
-
-
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--plot", help="draw the run into this .png or .svg (needs python3-matplotlib)")
@@ -103,11 +94,14 @@ def main() -> int:
         print(f"  {'ok  ' if good else 'FAIL'} {what}")
         ok = ok and good
 
-    if args.plot and plotting_possible():
-        from l6470emu.plot import plot
-        out = plot(chain, args.plot, position_unit=("rev", MICROSTEPS_PER_REV),
-                                 title="retarget: 10 → 50 rev, told at 30 to go back to 10")
-        print(f"plot: {out}")
+    if args.plot:
+        from l6470emu import plot as pictures
+        if pictures.available():
+            out = pictures.plot(chain, args.plot, position_unit=("rev", MICROSTEPS_PER_REV),
+                                title="retarget: 10 → 50 rev, told at 30 to go back to 10")
+            print(f"plot: {out}")
+        else:
+            print(f"plot skipped: {pictures.MATPLOTLIB_MISSING}")
     return 0 if ok else 1
 
 

@@ -37,7 +37,9 @@ CuseIoctlStep message(Board& board, std::uint64_t handle, std::uint32_t bufsiz, 
   // spidev_message's first loop checks the sizes before it copies any tx data.
   if (const long sizes = spidev_message_sizes(bufsiz, xfers); sizes < 0) return done(sizes);
   const std::size_t tx_bytes = spidev_tx_bytes(xfers), rx_bytes = spidev_rx_bytes(xfers);
-  if (in.size() == array + tx_bytes && out_size == rx_bytes && (tx_bytes > 0 || rx_bytes > 0 || in.size() == array)) {
+  // Everything is in once the array and the tx data came and the rx buffers are named (a
+  // message without data is complete with the array alone).
+  if (in.size() == array + tx_bytes && out_size == rx_bytes) {
     std::vector<std::uint8_t> rx(rx_bytes);
     const long r = board.spi_message(handle, xfers, in.subspan(array, tx_bytes), rx);
     if (r < 0) return done(r);

@@ -25,6 +25,8 @@ MAX_LABELLED_COMMANDS = 40
 FORMATS = (".png", ".svg")
 
 EXIT_BAD_INPUT = 2
+#: What to say when matplotlib is missing.
+MATPLOTLIB_MISSING = "matplotlib is not installed (Debian: apt install python3-matplotlib)"
 
 
 class PlotError(ValueError):
@@ -181,6 +183,15 @@ def _arguments(argv):
     return p.parse_args(argv)
 
 
+def available() -> bool:
+    """Whether pictures can be drawn here (matplotlib can be imported)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """`l6470emu plot` / `python3 -m l6470emu.plot`: 0, or 2 with one line on standard error."""
     try:
@@ -198,10 +209,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         chips = parse_chips(args.chips) if args.chips is not None else None
         if not Path(args.trace).exists():
             raise PlotError(f"{args.trace}: no such file")
-        try:
-            import matplotlib
-        except ImportError:
-            raise PlotError("drawing needs matplotlib (Debian: apt install python3-matplotlib)") from None
+        if not available():
+            raise PlotError(f"drawing needs matplotlib: {MATPLOTLIB_MISSING}")
+        import matplotlib
         matplotlib.use("Agg")
         out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
                    format=args.format, select=args.select, max_points=args.max_points, title=args.title,

@@ -9,6 +9,7 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "trace_source.hpp"
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/motion_series.hpp"
 #include "spi/trace_import.hpp"
@@ -119,8 +120,6 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       "motion",
       [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
          py::handle end, std::size_t max_points, std::size_t max_commands) {
-        std::string spec;
-        if (!chain.is_none()) spec = chain_spec_from(chain);
         MotionOptions o;
         o.from = tick_from_seconds(start, "start", 0);
         o.to = tick_from_seconds(end, "end", kNever);
@@ -133,46 +132,18 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
           if (o.chips.empty()) throw py::value_error("chips: the list is empty (None = every chip)");
         }
         PyMotion result;
-        std::shared_ptr<const Trace> held;
-        std::unique_ptr<TraceFile> file;
-        std::vector<const Variant*> variants;
-        if (py::isinstance<Trace>(trace)) {
-          held = trace.cast<std::shared_ptr<Trace>>();
-          const std::string& own = held->header.chain;
-          if (spec.empty() && own.empty())
-            throw py::value_error("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
-          result.how = spec.empty() ? "from the trace" : "from chain=";
-          try {
-            variants = parse_chain_spec(spec.empty() ? own : spec);
-          } catch (const std::invalid_argument& e) {
-            throw py::value_error(std::string("chain: ") + e.what());
-          }
-        } else {
-          const std::string path = path_from(trace, "trace");
-          TraceInputOptions options;
-          if (!format.is_none()) {
-            const std::string name = py::str(format);
-            options.format = trace_format_named(name);
-            if (options.format == TraceFormat::unknown && name != "auto")
-              throw py::value_error("format: \"" + name + "\" is not native, saleae, umockdev, ftrace, sigrok or vcd");
-          }
-          options.import.select = select;
-          py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
-          file = std::make_unique<TraceFile>(path, options);
-          variants = chain_for_trace(spec, *file, result.how);
-          if (!spec.empty()) result.how = "from chain=";
-        }
+        const Source source = source_of(trace, chain, format, select);
+        result.how = source.how;
         {
           py::gil_scoped_release unlocked;
-          auto reader = [&] { return held ? held->reader() : file->read(); };
-          Chain c = make_chain(variants);
+          Chain c = make_chain(source.variants);
           result.chain = chain_spec_of(c);
           Tick trace_end = 0;
           {
-            auto pass = reader();
+            auto pass = source.reader();
             trace_end = trace_end_tick(*pass);
           }
-          auto pass = reader();
+          auto pass = source.reader();
           MotionSeries s = sample_motion(*pass, c, trace_end, o);
           result.start = s.from;
           result.end = s.to;

@@ -9,6 +9,7 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "trace_source.hpp"
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/decode.hpp"
 #include "daisychain/replay.hpp"
@@ -53,54 +54,6 @@ PyTraceEvent event_of(const TraceEvent& e) {
   p.source_time = e.has_source_time() ? py::object(py::float_(e.source_time)) : py::object(py::none());
   p.text = NativeTraceWriter::format_event(e);
   return p;
-}
-
-TraceFormat format_arg(const py::object& format) {
-  if (format.is_none()) return TraceFormat::unknown;
-  const std::string name = py::str(format);
-  const TraceFormat f = trace_format_named(name);
-  if (f == TraceFormat::unknown && name != "auto")
-    throw py::value_error("format: \"" + name + "\" is not native, saleae, umockdev, ftrace, sigrok or vcd");
-  return f;
-}
-
-/// Where replay() and decode() read from, and the chain they run through.
-struct Source {
-  std::shared_ptr<const Trace> trace;   // a Trace object
-  std::unique_ptr<TraceFile> file;      // or a file (native ones are streamed)
-  std::vector<const Variant*> variants;
-  std::string how;
-
-  std::unique_ptr<TraceReader> reader() const { return trace ? trace->reader() : file->read(); }
-};
-
-Source source_of(py::handle trace, py::handle chain, py::handle format) {
-  Source s;
-  std::string spec;
-  if (!chain.is_none()) spec = chain_spec_from(chain);
-  if (py::isinstance<Trace>(trace)) {
-    s.trace = trace.cast<std::shared_ptr<Trace>>();
-    const std::string& own = s.trace->header.chain;
-    if (spec.empty() && own.empty())
-      throw py::value_error("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
-    s.how = spec.empty() ? "from the trace" : "from chain=";
-    try {
-      s.variants = parse_chain_spec(spec.empty() ? own : spec);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(std::string("chain: ") + e.what());
-    }
-    return s;
-  }
-  const std::string path = path_from(trace, "trace");
-  TraceInputOptions options;
-  options.format = format_arg(py::reinterpret_borrow<py::object>(format));
-  {
-    py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
-    s.file = std::make_unique<TraceFile>(path, options);
-    s.variants = chain_for_trace(spec, *s.file, s.how);
-  }
-  if (!spec.empty()) s.how = "from chain=";
-  return s;
 }
 
 /// decode()'s answer: the counts and the log.

@@ -15,18 +15,9 @@
 namespace l6470emu {
 namespace {
 
+using test::frame_at;
 using test::TempDir;
 using Bytes = std::vector<std::uint8_t>;
-
-TraceEvent frame_at(Tick t, Tick d, const Bytes& mosi, const Bytes& miso) {
-  TraceEvent e;
-  e.kind = TraceEventKind::frame;
-  e.tick = t;
-  e.duration = d;
-  e.mosi = mosi;
-  e.miso = miso;
-  return e;
-}
 
 /// A host polling GetStatus on one chip, one frame per byte, `polls` times every `period` ticks.
 Trace polling(int polls, Tick period, Tick start = 400) {

@@ -15,18 +15,9 @@
 namespace l6470emu {
 namespace {
 
+using test::frame_at;
 using test::TempDir;
 using Bytes = std::vector<std::uint8_t>;
-
-TraceEvent frame_at(Tick t, Tick d, const Bytes& mosi, const Bytes& miso) {
-  TraceEvent e;
-  e.kind = TraceEventKind::frame;
-  e.tick = t;
-  e.duration = d;
-  e.mosi = mosi;
-  e.miso = miso;
-  return e;
-}
 
 std::string error_of(const std::string& text, const std::string& name = "t.trace") {
   try {

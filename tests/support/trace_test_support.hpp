@@ -19,6 +19,17 @@
 
 namespace l6470emu::test {
 
+/// A CS frame event at tick `t` lasting `d` ticks.
+inline TraceEvent frame_at(Tick t, Tick d, const std::vector<std::uint8_t>& mosi, const std::vector<std::uint8_t>& miso) {
+  TraceEvent e;
+  e.kind = TraceEventKind::frame;
+  e.tick = t;
+  e.duration = d;
+  e.mosi = mosi;
+  e.miso = miso;
+  return e;
+}
+
 /// Path of a file under fixtures/traces.
 inline std::string fixture_path(const std::string& name) {
   return std::string(L6470EMU_SOURCE_DIR) + "/fixtures/traces/" + name;
