@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -24,11 +25,6 @@ std::string stamp(double seconds) {
   return buf;
 }
 
-std::string chip_column(std::size_t chip) {
-  char buf[24];
-  std::snprintf(buf, sizeof buf, "chip %-3zu ", chip);
-  return buf;
-}
 
 const char* issue_name(ProtocolEvent::Issue i) {
   switch (i) {
@@ -44,8 +40,8 @@ const char* issue_name(ProtocolEvent::Issue i) {
 
 class Decoder {
  public:
-  Decoder(std::ostream& out, const DecodeOptions& options, const std::string& name)
-      : out_(out), options_(options), name_(name) {}
+  Decoder(std::ostream& out, const DecodeOptions& options, const std::string& name, ChipNumbering numbering)
+      : out_(out), options_(options), name_(name), numbering_(numbering) {}
 
   void on_event(const ProtocolEvent& e) {
     if (!shown(e.chip)) return;
@@ -86,7 +82,8 @@ class Decoder {
   }
 
   bool shown(std::size_t chip) const {
-    return options_.only_chip < 0 || chip == ProtocolEvent::kNoChip || chip == static_cast<std::size_t>(options_.only_chip);
+    return options_.only_chip < 0 || chip == ProtocolEvent::kNoChip ||
+           numbering_.number_of(chip) == static_cast<std::size_t>(options_.only_chip);
   }
 
   /// A pin or fault line at `t`; `previous_seconds` is when the event before it ended.
@@ -136,6 +133,13 @@ class Decoder {
   DecodeSummary summary;
 
  private:
+  /// "chip 2   ": the chip's number as the user counts, in a column.
+  std::string chip_column(std::size_t chip) const {
+    char buf[24];
+    std::snprintf(buf, sizeof buf, "chip %-3zu ", numbering_.number_of(chip));
+    return buf;
+  }
+
   void diagnostic(const ProtocolEvent& e, double t, const std::string& text) {
     ++summary.diagnostics;
     const auto key = std::make_pair(e.chip, static_cast<int>(e.issue));
@@ -164,6 +168,7 @@ class Decoder {
   std::ostream& out_;
   const DecodeOptions& options_;
   const std::string& name_;
+  ChipNumbering numbering_;
   std::string line_;
   std::deque<std::pair<double, std::string>> pending_;
   std::map<std::pair<std::size_t, int>, std::size_t> seen_;
@@ -174,8 +179,11 @@ class Decoder {
 
 DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, const DecodeOptions& options) {
   const std::string name = in.header().name;
-  Decoder decoder(out, options, name);
-  ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); });
+  if (options.only_chip >= 0 && static_cast<std::size_t>(options.only_chip) >= chain.size())
+    throw std::invalid_argument("chip " + std::to_string(options.only_chip) + ": the chain has " +
+                                std::to_string(chain.size()) + " chips (0.." + std::to_string(chain.size() - 1) + ")");
+  Decoder decoder(out, options, name, ChipNumbering(options.number_from, chain.size()));
+  ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); }, options.number_from);
   TraceEvent e;
   std::vector<std::uint8_t> rx;
   double previous = 0;  // display time of the end of the event before (a frame's CS rising edge)
@@ -192,8 +200,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       continue;
     }
     if (e.chip >= chain.size())
-      throw TraceError(name, e.line, "event for chip " + std::to_string(e.chip) + ", but the chain has " +
-                                         std::to_string(chain.size()) + " chips (see --chain)");
+      throw TraceError(name, e.line, trace_chip_outside_chain(e.chip, chain.size()));
     tracker.apply(e);
     const double t = display_seconds(e.tick, e.source_time);
     decoder.pin(e, t, previous);

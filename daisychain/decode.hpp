@@ -8,6 +8,7 @@
 #include <iosfwd>
 
 #include "daisychain/chain.hpp"
+#include "daisychain/chip_numbering.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -16,7 +17,8 @@ namespace l6470emu {
 struct DecodeOptions {
   bool show_nops = false;        ///< also list NOP bytes
   std::size_t max_repeats = 10;  ///< each kind of diagnostic shown at most this often per chip (0 = all)
-  int only_chip = -1;            ///< show only this chip's lines (and frame-level diagnostics); -1 = all
+  int only_chip = -1;            ///< show only this chip's lines (and frame-level diagnostics), as numbered; -1 = all
+  NumberFrom number_from = NumberFrom::miso;  ///< how the log numbers the chips (only_chip too)
 };
 
 /// Counts of what a decode found.
@@ -30,7 +32,9 @@ struct DecodeSummary {
 };
 
 /// Writes the log of `in`, run through `chain` (fresh, as the capture began), to `out`.
-/// Throws TraceError for malformed input and events naming chips outside the chain.
+/// Throws TraceError for malformed input and events naming chips outside the chain, and
+/// std::invalid_argument for an only_chip outside the chain. The log has no header: the
+/// caller says which numbering it uses (describe_numbering).
 DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, const DecodeOptions& options = {});
 
 }  // namespace l6470emu

@@ -75,8 +75,7 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
       continue;
     }
     if (e.chip >= n)
-      throw TraceError(trace.header.name, e.line, "event for chip " + std::to_string(e.chip) + ", but the chain has " +
-                                                      std::to_string(n) + " chips (see --chain)");
+      throw TraceError(trace.header.name, e.line, trace_chip_outside_chain(e.chip, n));
     tracker.apply(e);
     const std::uint64_t ns = ns_from_ticks(e.tick);
     if (e.kind == TraceEventKind::pin) {

@@ -89,17 +89,21 @@ class Sampler {
  public:
   Sampler(Chain& chain, const MotionOptions& o, Tick from, Tick to, Tick step)
       : chain_(chain), from_(from), to_(to), step_(step), wanted_(chain.size(), -1) {
+    const ChipNumbering numbering(o.number_from, chain.size());
     std::vector<std::size_t> chips = o.chips;
     if (chips.empty())
-      for (std::size_t k = 0; k < chain.size(); ++k) chips.push_back(k);
-    for (std::size_t k : chips) {
-      if (k >= chain.size())
-        throw std::invalid_argument("chip " + std::to_string(k) + ": the chain has " + std::to_string(chain.size()) +
-                                    " chips (0.." + std::to_string(chain.size() - 1) + ")");
+      for (std::size_t u = 0; u < chain.size(); ++u) chips.push_back(u);
+    for (std::size_t u : chips) {
+      if (u >= chain.size())
+        throw std::invalid_argument("chip " + std::to_string(u) + ": the chain has " + std::to_string(chain.size()) +
+                                    " chips (0.." + std::to_string(chain.size() - 1) + "; " + numbering.description() +
+                                    ")");
+      const std::size_t k = numbering.index_of(u);
       if (wanted_[k] >= 0) continue;
       wanted_[k] = static_cast<int>(series_.size());
       ChipMotion m;
       m.chip = k;
+      m.number = u;
       m.variant = std::string(chain.chip(k).variant().name);
       series_.push_back(std::move(m));
     }
@@ -252,8 +256,7 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
     }
     if (e.kind != TraceEventKind::frame && e.chip >= chain.size())
       throw TraceError(in.header().name, e.line,
-                       "event for chip " + std::to_string(e.chip) + ", but the chain has " +
-                           std::to_string(chain.size()) + " chips (see --chain)");
+                       trace_chip_outside_chain(e.chip, chain.size()));
     // Up to the moment the event acts (a frame's CS rising edge, when the chips decode).
     sampler.run_until(at);
     if (e.kind == TraceEventKind::frame) {

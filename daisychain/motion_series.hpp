@@ -11,6 +11,7 @@
 #include "core/tick.hpp"
 #include "core/variant.hpp"
 #include "daisychain/chain.hpp"
+#include "daisychain/chip_numbering.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -38,7 +39,8 @@ struct CommandMark {
 
 /// One chip's series.
 struct ChipMotion {
-  std::size_t chip = 0;
+  std::size_t chip = 0;               ///< chain index (0 drives MISO)
+  std::size_t number = 0;             ///< the chip's number as MotionOptions::number_from counts
   std::string variant;                ///< "L6470"
   unsigned microsteps_per_step = 128; ///< of the STEP_SEL in force at the window's end
   std::vector<MotionSample> samples;  ///< in time order, at most MotionOptions::max_points
@@ -48,7 +50,8 @@ struct ChipMotion {
 
 /// Choices for sample_motion.
 struct MotionOptions {
-  std::vector<std::size_t> chips;  ///< chips to sample (empty = all)
+  std::vector<std::size_t> chips;  ///< chips to sample, numbered as number_from says (empty = all)
+  NumberFrom number_from = NumberFrom::miso;  ///< how `chips` and ChipMotion::number count
   Tick from = 0;                   ///< the window: samples and commands from this tick ...
   Tick to = kNever;                ///< ... up to this one (kNever = the trace's end plus `tail`)
   /// Past the trace's last event, motion still going is followed for at most this long.

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "daisychain/explain.hpp"
 
@@ -28,8 +29,8 @@ double display_seconds(Tick tick, double source_time) {
   return static_cast<double>(tick) / static_cast<double>(kTicksPerSecond);
 }
 
-ProtocolTracker::ProtocolTracker(Chain& chain, Observer observer)
-    : chain_(chain), observer_(std::move(observer)), chips_(chain.size()) {
+ProtocolTracker::ProtocolTracker(Chain& chain, Observer observer, NumberFrom numbering)
+    : chain_(chain), observer_(std::move(observer)), numbering_(numbering, chain.size()), chips_(chain.size()) {
   for (std::size_t k = 0; k < chain_.size(); ++k)
     chain_.chip(k).set_diagnostic_sink([this, k](const Diagnostic& d) { diagnostics_.push_back({k, d}); });
 }
@@ -132,11 +133,17 @@ std::string ProtocolTracker::host_byte_for(std::size_t k) const {
   return "its byte";
 }
 
+std::string ProtocolTracker::chip_range(std::size_t first, std::size_t last) const {
+  std::size_t lo = numbering_.number_of(first), hi = numbering_.number_of(last);
+  if (lo > hi) std::swap(lo, hi);
+  return "chips " + std::to_string(lo) + ".." + std::to_string(hi);
+}
+
 std::string ProtocolTracker::origin_of(std::size_t k) const {
   const std::size_t n = chain_.size(), len = frame_.mosi.size();
   if (len >= n) return "MOSI byte " + std::to_string(len - n + k);
   if (k >= n - len) return "MOSI byte " + std::to_string(k - (n - len));
-  return "the byte chip " + std::to_string(k + len) + " left in the chain";
+  return "the byte " + numbering_.label(k + len) + " left in the chain";
 }
 
 void ProtocolTracker::end_frame() {
@@ -253,11 +260,12 @@ void ProtocolTracker::end_frame() {
       } else if (len > n) {
         e.text = std::to_string(len) + " bytes for a chain of " + std::to_string(n) + ": MOSI bytes 0.." +
                  std::to_string(len - n - 1) + " pass through the chain undecoded; chip k decodes MOSI byte " +
-                 std::to_string(len - n) + "+k";
+                 (numbering_.from() == NumberFrom::miso ? std::to_string(len - n) + "+k" : std::to_string(len - 1) + "-k");
       } else {
         e.text = std::to_string(len) + " bytes for a chain of " + std::to_string(n) + ": " +
-                 (n - len == 1 ? std::string("chip 0 decodes a byte") : "chips 0.." + std::to_string(n - len - 1) + " decode bytes") +
-                 " left in the chain, not host bytes (chip 0 decodes " + byte_hex(chips_[0].byte) + ", " + origin_of(0) + ")";
+                 (n - len == 1 ? numbering_.label(0) + " decodes a byte" : chip_range(0, n - len - 1) + " decode bytes") +
+                 " left in the chain, not host bytes (" + numbering_.label(0) + " decodes " + byte_hex(chips_[0].byte) + ", " +
+                 origin_of(0) + ")";
       }
       report(std::move(e));
     }
@@ -316,16 +324,16 @@ std::string ProtocolTracker::describe_miso(std::size_t i) const {
   if (i >= n) return "MOSI byte " + std::to_string(i - n) + " coming back through the chain (frame longer than the chain)";
   const ChipTrack& c = chips_[i];
   const Answer& a = c.answer;
-  if (!c.enabled) return "chip " + std::to_string(i) + ": in standby, drives 0x00";
-  if (!a.active) return "chip " + std::to_string(i) + ": no answer pending (0x00)";
-  return "chip " + std::to_string(i) + ": byte " + std::to_string(a.loaded + 1) + " of " + std::to_string(a.len) +
+  if (!c.enabled) return numbering_.label(i) + ": in standby, drives 0x00";
+  if (!a.active) return numbering_.label(i) + ": no answer pending (0x00)";
+  return numbering_.label(i) + ": byte " + std::to_string(a.loaded + 1) + " of " + std::to_string(a.len) +
          " of the " + opcode_name(a.opcode, *a.table) + " answer (decoded in frame " + std::to_string(a.frame + 1) +
          ", " + seconds_text(display_seconds(a.tick, a.source_time)) + ")";
 }
 
 std::string ProtocolTracker::describe_decode(std::size_t k) const {
   const ChipTrack& c = chips_[k];
-  std::string s = "chip " + std::to_string(k) + ": ";
+  std::string s = numbering_.label(k) + ": ";
   if (!c.enabled) return s + "in standby, ignores " + byte_hex(c.byte);
   if (c.was_collecting) {
     const Collect& col = c.collect;

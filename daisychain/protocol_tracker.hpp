@@ -16,6 +16,7 @@
 #include "core/registers.hpp"
 #include "core/variant.hpp"
 #include "daisychain/chain.hpp"
+#include "daisychain/chip_numbering.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -73,8 +74,10 @@ class ProtocolTracker {
   using Observer = std::function<void(const ProtocolEvent&)>;
 
   /// Tracks `chain` (it must outlive the tracker; its chips' diagnostic sinks are taken over).
-  /// Without an observer no events are built (cheap: replay only asks describe_*).
-  explicit ProtocolTracker(Chain& chain, Observer observer = {});
+  /// Without an observer no events are built (cheap: replay only asks describe_*). Texts
+  /// (diagnostics, describe_*) number the chips as `numbering` says; ProtocolEvent::chip and
+  /// the arguments of describe_* stay chain indices.
+  explicit ProtocolTracker(Chain& chain, Observer observer = {}, NumberFrom numbering = NumberFrom::miso);
   /// Gives the chips their diagnostic sinks back (empty).
   ~ProtocolTracker();
   ProtocolTracker(const ProtocolTracker&) = delete;
@@ -104,6 +107,8 @@ class ProtocolTracker {
   /// Frames seen so far.
   std::uint64_t frames() const { return frame_no_; }
   Chain& chain() { return chain_; }
+  /// How the texts number the chips.
+  const ChipNumbering& numbering() const { return numbering_; }
 
  private:
   struct Answer {
@@ -146,10 +151,12 @@ class ProtocolTracker {
   void report(ProtocolEvent&& e);
   ProtocolEvent event_here(ProtocolEvent::Kind kind, std::size_t chip) const;
   std::string origin_of(std::size_t k) const;
+  std::string chip_range(std::size_t first, std::size_t last) const;  // "chips 0..2" in user numbers
   std::string host_byte_for(std::size_t k) const;
 
   Chain& chain_;
   Observer observer_;
+  ChipNumbering numbering_;
   std::vector<ChipTrack> chips_;
   struct PendingDiagnostic {
     std::size_t chip;

@@ -47,7 +47,8 @@ class Replayer {
  public:
   Replayer(TraceReader& in, Chain& chain, const ReplayOptions& options,
            const std::function<void(const Divergence&)>& on_divergence)
-      : in_(in), chain_(chain), options_(options), on_divergence_(on_divergence), tracker_(chain), name_(in.header().name) {}
+      : in_(in), chain_(chain), options_(options), on_divergence_(on_divergence), tracker_(chain, {}, options.number_from),
+        name_(in.header().name) {}
 
   ReplayResult run() {
     TraceEvent e;
@@ -80,8 +81,7 @@ class Replayer {
         continue;
       }
       if (e.chip >= n)
-        throw TraceError(name_, e.line, "event for chip " + std::to_string(e.chip) + ", but the chain has " +
-                                            std::to_string(n) + " chips (see --chain)");
+        throw TraceError(name_, e.line, trace_chip_outside_chain(e.chip, n));
       if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
         if (!options_.compare_pins) continue;
         chain_.advance_to(e.tick);
@@ -146,13 +146,16 @@ class Replayer {
       r += "    (the captured chain answered where " + std::to_string(n) +
            " emulated chips only pass MOSI back: is the real chain longer? see --chain)\n";
     r += "  what each chip decodes at this frame's CS rising edge:\n";
-    for (std::size_t k = 0; k < n && k < kMaxChipLines; ++k) r += "    " + tracker_.describe_decode(k) + "\n";
+    // In the order the user counts the chips.
+    const ChipNumbering& numbering = tracker_.numbering();
+    for (std::size_t u = 0; u < n && u < kMaxChipLines; ++u)
+      r += "    " + tracker_.describe_decode(numbering.index_of(u)) + "\n";
     if (n > kMaxChipLines) r += "    ... (" + std::to_string(n - kMaxChipLines) + " more chips)\n";
     std::size_t dumps = 0;
     for (std::size_t i : bad) {
       if (i >= n || dumps == kMaxDumps) continue;
       ++dumps;
-      r += "  chip " + std::to_string(i) + " state (emulated, as it answered):\n";
+      r += "  " + numbering.label(i) + " state (emulated, as it answered):\n";
       r += indent(chain_.chip(i).dump(), "    ");
     }
     d.report = std::move(r);
@@ -170,9 +173,9 @@ class Replayer {
       return std::string(l ? "high" : "low") + (busy ? (l ? " (released)" : " (busy)") : (l ? " (no alarm)" : " (alarm)"));
     };
     d.summary = where(name_, e) + ": " + time_text(e.tick, e.source_time) + " (after frame " +
-                std::to_string(d.frame) + "): chip " + std::to_string(e.chip) + " " + std::string(to_string(e.pin)) +
+                std::to_string(d.frame) + "): " + tracker_.numbering().label(e.chip) + " " + std::string(to_string(e.pin)) +
                 " expected " + level(e.value != 0) + ", emulated " + level(emulated);
-    d.report = d.summary + "\n  chip " + std::to_string(e.chip) + " state (emulated):\n" +
+    d.report = d.summary + "\n  " + tracker_.numbering().label(e.chip) + " state (emulated):\n" +
                indent(chain_.chip(e.chip).dump(), "    ");
     return d;
   }

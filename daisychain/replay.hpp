@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "daisychain/chain.hpp"
+#include "daisychain/chip_numbering.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -19,6 +20,7 @@ struct ReplayOptions {
   bool keep_going = false;        ///< report every divergence instead of stopping at the first
   std::size_t max_reports = 100;  ///< with keep_going: full reports kept for this many (0 = all); all are counted
   bool compare_pins = true;       ///< check the trace's BUSY/FLAG observations
+  NumberFrom number_from = NumberFrom::miso;  ///< how the reports number the chips
 };
 
 /// One point where the emulator and the capture disagree.
@@ -46,7 +48,8 @@ struct ReplayResult {
 
 /// Replays `in` through `chain` (fresh, as when the capture began). `on_divergence`, when
 /// given, sees each reported divergence as soon as it is found. Throws TraceError for
-/// malformed input and events naming chips outside the chain.
+/// malformed input and events naming chips outside the chain. The reports do not say which
+/// chip numbering they use: the caller says it once (describe_numbering).
 ReplayResult replay_trace(TraceReader& in, Chain& chain, const ReplayOptions& options = {},
                           const std::function<void(const Divergence&)>& on_divergence = {});
 

@@ -20,7 +20,8 @@ namespace l6470emu {
 /// How often each kind of chip diagnostic is logged in full per chip.
 constexpr std::uint64_t kDiagnosticRepeats = 10;
 
-Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : log_(log), time_(config.time, host) {
+Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host)
+    : log_(log), time_(config.time, host), numbering_(config.numbering) {
   unsigned spi_minor = 0;
   for (const ChainConfig& cc : config.chains) {
     std::vector<Chip> chips;
@@ -34,7 +35,7 @@ Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : l
     cd->spi.bufsiz = cc.bufsiz;
     const std::size_t ci = chains_.size();
     for (std::size_t k = 0; k < cd->chain.size(); ++k) {
-      const std::string where = cd->name + ": chip " + std::to_string(k) + ": ";
+      const std::string where = cd->name + ": " + ChipNumbering(numbering_, cd->chain.size()).label(k) + ": ";
       // A driver looping on a bad command must not flood the log: each kind is shown
       // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
       cd->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {

@@ -106,6 +106,11 @@ class Board {
   std::size_t spidev_node(std::size_t chain) const;
   /// Number of chips of chain `chain`.
   std::size_t chip_count(std::size_t chain) const;
+  /// How diagnostics and `ctl` number the chips (the config's numbering=). Chip arguments of
+  /// Board's own functions are always chain indices (0 drives MISO).
+  NumberFrom numbering() const { return numbering_; }
+  /// The numbering of chain `chain`: its chain indices as users see them.
+  ChipNumbering chip_numbering(std::size_t chain) const { return ChipNumbering(numbering_, chip_count(chain)); }
   /// "spidev0.0 (3 x L6470, gpiochip0)".
   std::string chain_summary(std::size_t chain) const;
   /// Index of the chain on node path or name ("spidev0.0", "/dev/spidev0.0", "0.0"), or -1.
@@ -213,6 +218,7 @@ class Board {
 
   DiagnosticLog& log_;
   BoardTime time_;
+  NumberFrom numbering_ = NumberFrom::miso;
   std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last message ends
   std::vector<DeviceNode> nodes_;
   std::vector<std::unique_ptr<ChainDev>> chains_;

@@ -36,7 +36,7 @@ struct KeySpec {
 };
 
 // Every key, in the order the docs table lists them.
-constexpr std::array<KeySpec, 14> kKeys{{
+constexpr std::array<KeySpec, 15> kKeys{{
     {"chips", Scope::chain, "chips=2xL6470,L6480"},
     {"bus", Scope::chain, "bus=0"},
     {"cs", Scope::chain, "cs=1"},
@@ -51,6 +51,7 @@ constexpr std::array<KeySpec, 14> kKeys{{
     {"log", Scope::board, "log=/tmp/l6470emu.log"},
     {"socket", Scope::board, "socket=/tmp/l6470emu.sock"},
     {"trace", Scope::board, "trace=run.trace"},
+    {"numbering", Scope::board, "numbering=mosi"},
 }};
 
 const KeySpec* find_key(std::string_view name) {
@@ -219,14 +220,19 @@ struct Parser {
   std::string_view origin;
   std::string error;
   unsigned clause_no = 0;
+  unsigned line_no = 0;     // line of the clause being parsed (1-based)
+  bool show_line = false;   // the text has several lines: errors name the line too
   std::map<std::string, Setting, std::less<>> board_keys;  // board-wide key -> where it was set
   std::vector<unsigned> chain_clause;                      // clause of each chain
+  std::vector<unsigned> chain_line;                        // line of each chain
   std::vector<bool> chain_gpiochip_given;                  // gpiochip= written for each chain
 
   bool fail(const std::string& what) {
     if (error.empty()) {
       std::ostringstream o;
-      o << "l6470emu: config " << shown_text(origin, 200) << ", clause " << clause_no << ": " << what;
+      o << "l6470emu: config " << shown_text(origin, 200);
+      if (show_line) o << ":" << line_no;
+      o << ", clause " << clause_no << ": " << what;
       error = o.str();
     }
     return false;
@@ -349,6 +355,11 @@ struct Parser {
     } else if (k == "trace") {
       if (value.back() == '/') return fail("trace " + q + " names a directory; give a file");
       cfg.trace = std::string(value);
+    } else if (k == "numbering") {
+      const auto from = number_from_named(value);
+      if (!from)
+        return fail("numbering must be miso (chip 0 drives MISO) or mosi (chip 0 reads the host's MOSI), not " + q);
+      cfg.numbering = *from;
     }
     if ((k == "log" || k == "trace") && !cfg.trace.empty() && cfg.trace == cfg.log)
       return fail("log= and trace= name the same file " + q + ": diagnostics would be mixed into the trace");
@@ -457,6 +468,7 @@ struct Parser {
                     std::to_string(chain_clause[i]) + " and this one)");
     }
     chain_clause.push_back(clause_no);
+    chain_line.push_back(line_no);
     chain_gpiochip_given.push_back(in_clause.count("gpiochip") != 0);
     cfg.chains.push_back(std::move(chain));
     return true;
@@ -473,6 +485,7 @@ struct Parser {
       while (used.count(n)) ++n;
       if (n > kMaxGpiochip) {
         clause_no = chain_clause[i];
+        line_no = chain_line[i];
         return fail("no free gpiochip number left (0..1023): write gpiochip=none");
       }
       cfg.chains[i].gpiochip = n;
@@ -526,15 +539,18 @@ std::string quoted_text(std::string_view text) {
 }
 
 ParseResult parse_board_config(std::string_view text, std::string_view origin) {
-  Parser p{origin, {}, 0, {}, {}, {}};
+  Parser p{};
+  p.origin = origin;
   if (text.size() > kMaxBytes)
     return {std::nullopt, {"l6470emu: config " + shown_text(origin, 200) +
                            ": longer than 1 MiB (a board description is a few lines)"}};
   BoardConfig cfg;
   // Lines end at newlines and '#' comments run to the end of the line; ';' separates clauses
   // within a line. Clauses are numbered through the whole text.
+  p.show_line = text.find('\n') != std::string_view::npos;
   std::size_t line_start = 0;
   while (line_start <= text.size()) {
+    ++p.line_no;
     std::size_t line_end = text.find('\n', line_start);
     if (line_end == std::string_view::npos) line_end = text.size();
     std::string_view line = text.substr(line_start, line_end - line_start);
@@ -617,6 +633,7 @@ std::string describe_board_config(const BoardConfig& config) {
   if (config.log != "stderr") o << "log=" << config.log << "\n";
   if (!config.socket.empty()) o << "socket=" << config.socket << "\n";
   if (!config.trace.empty()) o << "trace=" << config.trace << "\n";
+  if (config.numbering != NumberFrom::miso) o << "numbering=" << to_string(config.numbering) << "\n";
   return o.str();
 }
 

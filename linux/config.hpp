@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/variant.hpp"
+#include "daisychain/chip_numbering.hpp"
 
 namespace l6470emu {
 
@@ -28,7 +29,7 @@ struct ChainConfig {
   unsigned bus = 0;                        ///< SPI bus number B of /dev/spidevB.C
   unsigned cs = 0;                         ///< chip select C
   std::string path;                        ///< device node, default /dev/spidevB.C
-  std::vector<const Variant*> chips;       ///< chip 0 drives MISO
+  std::vector<const Variant*> chips;       ///< the chain's order: chips[0] drives MISO, whatever the numbering
   std::optional<unsigned> gpiochip;        ///< N of /dev/gpiochipN; none = no gpiochip
   std::uint32_t max_speed_hz = 5'000'000;  ///< the device's spi-max-frequency (RD_MAX_SPEED_HZ at open)
   std::uint8_t mode = 0;                   ///< SPI mode the device starts in (as a device tree sets it)
@@ -42,6 +43,7 @@ struct BoardConfig {
   std::string log = "stderr";  ///< where diagnostics go: "stderr", "off" or a file path
   std::string socket;          ///< daemon socket (preload: forward to it instead of emulating in process)
   std::string trace;           ///< record every chain into this native trace file ("" = no recording)
+  NumberFrom numbering = NumberFrom::miso;  ///< how diagnostics and `ctl` number the chips (numbering=)
 };
 
 /// A config error: one line saying where and what.
@@ -56,7 +58,8 @@ struct ConfigError {
 ///   [speed=HZ] [mode=0..3] [bufsiz=N]
 /// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
 /// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual
-/// time), log=stderr|off|FILE, socket=PATH, trace=FILE. Every value is checked against its
+/// time), log=stderr|off|FILE, socket=PATH, trace=FILE, numbering=miso|mosi (which end chip 0
+/// is at in diagnostics and `ctl`; chips= always lists the MISO end first). Every value is checked against its
 /// range; docs/linux.md has the table. `origin` names the source in error messages
 /// ("L6470EMU_CHAIN", a file name). Returns the config, or the first error, on one line:
 /// "l6470emu: config ORIGIN, clause N: what", user text quoted by quoted_text.

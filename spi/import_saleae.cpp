@@ -202,10 +202,26 @@ class SaleaeImporter {
     any_unknown_ = false;
   }
 
+  /// The file gave no frame: say why, naming the analyzers when --select matched none.
+  [[noreturn]] void no_frames() const {
+    if (!options_.select.empty() && !other_names_.empty()) {
+      std::string names;
+      for (const std::string& n : other_names_) names += (names.empty() ? "" : ", ") + quote(n);
+      throw TraceError(name_, 0, "no rows of an analyzer called " + quote(options_.select) + " (the file has " + names +
+                                     "): see --select");
+    }
+    throw TraceError(name_, 0, "no SPI frames in the file");
+  }
+
   bool selected(const LineCursor& lines) {
     if (col_name_ < 0) return true;
     const std::string_view n = fields_[static_cast<std::size_t>(col_name_)];
-    if (!options_.select.empty()) return n == options_.select;
+    if (!options_.select.empty()) {
+      if (n == options_.select) return true;
+      if (other_names_.size() < 8 && std::find(other_names_.begin(), other_names_.end(), n) == other_names_.end())
+        other_names_.emplace_back(n);
+      return false;
+    }
     if (analyzer_.empty()) {
       analyzer_ = std::string(n);
       return true;
@@ -289,7 +305,7 @@ class SaleaeImporter {
     if (errors)
       trace_.header.notes.push_back(std::to_string(errors) +
                                     " \"error\" rows ignored (the analyzer saw the clock in the wrong state at CS)");
-    if (trace_.frame_count() == 0) throw TraceError(name_, 0, "no SPI frames in the file");
+    if (trace_.frame_count() == 0) no_frames();
   }
 
   void run_logic1(LineCursor& lines) {
@@ -320,7 +336,7 @@ class SaleaeImporter {
     if (open) emit(start, last, open_line);
     trace_.header.notes.push_back(
         "Logic 1.x export: CS frames from Packet ID, frame times from the first and last byte");
-    if (trace_.frame_count() == 0) throw TraceError(name_, 0, "no SPI frames in the file");
+    if (trace_.frame_count() == 0) no_frames();
   }
 
   std::string_view text_;
@@ -333,6 +349,7 @@ class SaleaeImporter {
   int col_name_ = -1, col_type_ = -1, col_start_ = -1, col_duration_ = -1, col_mosi_ = -1, col_miso_ = -1;
   int col_time_ = -1, col_packet_ = -1;
   std::string analyzer_;
+  std::vector<std::string> other_names_;  // with --select: the other analyzers seen (a few)
   std::vector<std::string_view> fields_;
   std::vector<std::uint8_t> mosi_, miso_, known_;
   bool any_unknown_ = false;

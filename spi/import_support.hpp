@@ -49,9 +49,21 @@ class LineCursor {
 /// Longest stretch of input a message quotes (bytes; a longer one is cut and ends in "…").
 inline constexpr std::size_t kQuoteMax = 60;
 
+/// The length of the well-formed UTF-8 sequence of 2 to 4 bytes at s[i], or 0.
+inline std::size_t utf8_sequence(std::string_view s, std::size_t i) {
+  const auto c = static_cast<unsigned char>(s[i]);
+  const std::size_t len = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
+  if (len == 0 || i + len > s.size()) return 0;
+  for (std::size_t k = 1; k < len; ++k)
+    if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) return 0;
+  return len;
+}
+
+
 /// Input text for a message: cut after kQuoteMax bytes (never inside a UTF-8 sequence) with
 /// "…" appended, control characters as \xNN, so that one bad token of a huge or binary file
-/// still gives one short, printable line.
+/// still gives one short, printable line. Bytes that are not part of a well-formed UTF-8
+/// sequence (a binary file, Latin-1 text) are shown as \xNN too, so the line names the byte.
 inline std::string printable(std::string_view s) {
   std::size_t n = s.size();
   if (n > kQuoteMax) {
@@ -62,7 +74,14 @@ inline std::string printable(std::string_view s) {
   q.reserve(n + 4);
   for (std::size_t i = 0; i < n; ++i) {
     const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x20 || c == 0x7F) {
+    if (c >= 0x80) {
+      if (const std::size_t len = utf8_sequence(s.substr(0, n), i); len != 0) {
+        q.append(s.substr(i, len));
+        i += len - 1;
+        continue;
+      }
+    }
+    if (c < 0x20 || c >= 0x7F) {
       static constexpr char kHex[] = "0123456789ABCDEF";
       q += "\\x";
       q += kHex[c >> 4];

@@ -14,17 +14,19 @@ namespace l6470emu {
 
 int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
   try {
+    const NumberFrom number_from = number_from_option(args.number_from);
     const TraceFile file(args.trace.path, input_options(args.trace));
     std::string how;
     const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
     Chain chain = make_chain(variants);
     print_notes(file.header(), err);
     out << "# " << file.path() << " (" << file.header().format << "), chain " << chain_spec_of(variants) << " (" << how
-        << "); chip 0 drives MISO\n";
+        << "); " << describe_numbering(number_from) << "\n";
     DecodeOptions options;
     options.show_nops = args.nops;
     options.max_repeats = args.max_repeats;
     options.only_chip = args.chip;
+    options.number_from = number_from;
     if (args.chip >= 0 && static_cast<std::size_t>(args.chip) >= chain.size())
       throw std::invalid_argument("--chip " + std::to_string(args.chip) + ": the chain has " +
                                   std::to_string(chain.size()) + " chips");

@@ -59,7 +59,7 @@ std::vector<std::string> plot_command(const std::vector<std::string>& args) {
 namespace {
 
 struct PlotArgs {
-  std::string trace, output, chips, from, to, chain, format, select, max_points, title, size, dpi;
+  std::string trace, output, chips, from, to, chain, format, select, max_points, title, size, dpi, number_from;
 };
 
 [[noreturn]] void run_plot(const PlotArgs& a, const CLI::App& sub) {
@@ -68,7 +68,7 @@ struct PlotArgs {
   const std::pair<const char*, const std::string*> options[] = {
       {"--output", &a.output}, {"--chips", &a.chips},   {"--from", &a.from},   {"--to", &a.to},
       {"--chain", &a.chain},   {"--format", &a.format}, {"--select", &a.select}, {"--max-points", &a.max_points},
-      {"--title", &a.title},   {"--size", &a.size},     {"--dpi", &a.dpi}};
+      {"--title", &a.title},   {"--size", &a.size},     {"--dpi", &a.dpi},     {"--number-from", &a.number_from}};
   for (const auto& [name, value] : options)
     if (sub.count(name) > 0) args.push_back(std::string(name) + "=" + *value);
 
@@ -101,7 +101,9 @@ void add_plot_command(CLI::App& app) {
               "from a trace replayed through the emulator (needs python3-matplotlib; exit 2 = bad input)");
   p->add_option("TRACE", a->trace, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr");
   p->add_option("-o,--output", a->output, "picture to write: .png or .svg");
-  p->add_option("--chips", a->chips, "chips to draw: 0,2 or 1-3 (default all; 0 drives MISO)");
+  p->add_option("--chips", a->chips, "chips to draw: 0,2 or 1-3 (default all; numbered as --number-from says)");
+  p->add_option("--number-from", a->number_from,
+                "chip 0 is the chip driving MISO (miso, the default) or the one reading the host's MOSI (mosi)");
   p->add_option("--from", a->from, "window start, seconds from the trace's start (a capture's own clock counts from 0 here)");
   p->add_option("--to", a->to, "window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)");
   p->add_option("--chain", a->chain, "the emulated chain (3, 2*L6470,L6480); default: the trace's own");

@@ -12,6 +12,7 @@ namespace l6470emu {
 
 int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
   try {
+    const NumberFrom number_from = number_from_option(args.number_from);
     const TraceFile file(args.trace.path, input_options(args.trace));
     std::string how;
     const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
@@ -23,11 +24,16 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
     options.keep_going = args.keep_going;
     options.max_reports = args.max_reports;
     options.compare_pins = !args.no_pins;
+    options.number_from = number_from;
     std::unique_ptr<TraceReader> reader = file.read();
     ProgressBar bar = ProgressBar::on_stderr("replaying " + file.path());
     ProgressTraceReader watched(*reader, bar);
+    bool numbering_said = false;
     const ReplayResult r = replay_trace(watched, chain, options, [&](const Divergence& d) {
       bar.clear();
+      // The reports name chips: say once, before the first, how they are numbered.
+      if (!numbering_said) out << "# " << describe_numbering(number_from) << "\n";
+      numbering_said = true;
       out << (args.quiet ? d.summary : d.report) << "\n";
     });
     bar.finish();

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "linux/config.hpp"
 #include "linux/serve/control.hpp"
@@ -28,6 +29,9 @@ ServeCommands::ServeCommands(CLI::App& app) {
                      "record every chain into this native trace, flushed frame by frame "
                      "(several chains: the chain's name goes before the extension)");
 
+  serve_->add_option("--number-from", serve_number_from_,
+                     "which end chip 0 is at in diagnostics and ctl: miso (chip 0 drives MISO) or mosi (chip 0 reads "
+                     "the host's MOSI); default the board's numbering=, else miso");
   serve_->add_flag("--cuse", cuse_,
                    "also serve each chain as a real character device /dev/spidevB.C through CUSE "
                    "(root; modprobe cuse), for every program, static or not");
@@ -41,6 +45,8 @@ ServeCommands::ServeCommands(CLI::App& app) {
   ctl_ = app.add_subcommand("ctl", "control a running daemon: " + std::string("status, get, dump, sw, pin, fault, adc, "
                                                                                "time, advance, chains, trace (ctl help)"));
   ctl_->add_option("--socket", socket_, "the daemon's socket (default as for serve)");
+  ctl_->add_option("--number-from", ctl_number_from_,
+                   "count chips from the miso or the mosi end for this command (default: the daemon's numbering=)");
   // Only the command word is parsed here; everything after it (--chip K, --chain NAME, values)
   // goes to the daemon untouched, in order.
   ctl_->add_option("command", command_word_, "the command (its arguments follow it)")->required();
@@ -71,6 +77,16 @@ std::optional<int> ServeCommands::run() {
     if (virtual_time_) config.time.virtual_time = true;
     if (!log_.empty()) config.log = log_;
     if (!record_.empty()) config.trace = record_;
+    if (!serve_number_from_.empty()) {
+      const auto from = number_from_named(serve_number_from_);
+      if (!from) {
+        std::cerr << "l6470emu serve: --number-from must be miso (chip 0 drives MISO) or mosi (chip 0 reads the host's "
+                     "MOSI), not '"
+                  << shown_text(serve_number_from_) << "'\n";
+        return 2;
+      }
+      config.numbering = *from;
+    }
     const std::string socket = !socket_.empty() ? socket_ : !config.socket.empty() ? config.socket : default_socket_path();
     FrontEnds front_ends;
     if (cuse_ || uhid_) {
@@ -86,13 +102,22 @@ std::optional<int> ServeCommands::run() {
   if (ctl_ && *ctl_) {
     std::vector<std::string> all = {command_word_};
     for (const auto& extra : ctl_->remaining()) all.push_back(extra);
+    if (!ctl_number_from_.empty()) {  // the daemon checks it, as when it follows the command
+      all.push_back("--number-from");
+      all.push_back(ctl_number_from_);
+    }
     // The daemon runs elsewhere: a relative trace file is meant from here.
     if (all.size() >= 3 && all[0] == "trace" && all[1] == "start" && !all[2].empty() && all[2][0] != '/' && all[2][0] != '-')
       all[2] = std::filesystem::absolute(all[2]).lexically_normal().string();
     std::string command;
     for (const auto& w : all) command += (command.empty() ? "" : " ") + w;
     if (command == "help" || command == "--help") {
-      std::cout << control_help();
+      // The daemon's help says how it numbers chips; without a daemon, the general text.
+      std::ostringstream help, quiet;
+      if (run_ctl(socket_.empty() ? default_socket_path() : socket_, "help", help, quiet) == 0)
+        std::cout << help.str();
+      else
+        std::cout << control_help();
       return 0;
     }
     return run_ctl(socket_.empty() ? default_socket_path() : socket_, command, std::cout, std::cerr);

@@ -32,6 +32,8 @@ class ServeCommands {
   std::string node_owner_ = "root";
   std::string node_group_ = "root";
   std::string node_mode_ = "0660";
+  std::string serve_number_from_;  // serve --number-from (overrides numbering=)
+  std::string ctl_number_from_;    // ctl --number-from before the command word
   std::string command_word_;  // the ctl command; its arguments come from remaining()
 };
 

@@ -64,7 +64,7 @@ FrontEnds kernel_front_ends(bool cuse, bool uhid, NodeAccess access) {
       kept->bridges = std::make_unique<UhidGpioBridges>(board, access);
       if (error = kept->bridges->start(); !error.empty()) return nullptr;
       for (const auto& n : kept->bridges->nodes())
-        out << "  kernel node " << n.gpiochip << " [cp2112_gpio] = chip " << n.chip << " of "
+        out << "  kernel node " << n.gpiochip << " [cp2112_gpio] = " << board.chip_numbering(n.chain).label(n.chip) << " of "
             << board.nodes()[board.spidev_node(n.chain)].name << ": 0 BUSY, 1 FLAG, 2 SW, 3 STCK, 4 STBY_RST\n";
     }
     return kept;

@@ -27,6 +27,14 @@ TraceInputOptions input_options(const TraceArgs& args) {
   return o;
 }
 
+NumberFrom number_from_option(const std::string& text) {
+  try {
+    return parse_number_from(text);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--number-from: ") + e.what());
+  }
+}
+
 void print_notes(const TraceHeader& header, std::ostream& err) {
   for (const std::string& n : header.notes) err << "note: " << header.name << ": " << n << "\n";
 }
@@ -50,6 +58,11 @@ void add_trace_options(CLI::App* sub, TraceArgs& a) {
                   "sigrok-cli decoder for VCD/.sr captures (default spi:clk=SCK:mosi=MOSI:miso=MISO:cs=CS:cpol=1:cpha=1)");
 }
 
+void add_number_from_option(CLI::App* sub, std::string& value) {
+  sub->add_option("--number-from", value,
+                  "which end chip 0 is at: miso (chip 0 drives MISO, the default) or mosi (chip 0 reads the host's MOSI)");
+}
+
 /// Ends the program with `status` when it is not 0 (CLI11 returns it from main quietly).
 void finish(int status) {
   if (status != 0) throw CLI::RuntimeError(status);
@@ -67,6 +80,7 @@ void add_trace_commands(CLI::App& app) {
   r->add_option("--max-reports", replay->max_reports, "with --continue: full reports for this many (0 = all)");
   r->add_flag("--no-pins", replay->no_pins, "do not compare the trace's BUSY/FLAG levels");
   r->add_flag("--quiet", replay->quiet, "one line per divergence instead of the full report");
+  add_number_from_option(r, replay->number_from);
   r->callback([replay] { finish(run_replay(*replay, std::cout, std::cerr)); });
 
   auto decode = std::make_shared<DecodeArgs>();
@@ -74,7 +88,9 @@ void add_trace_commands(CLI::App& app) {
   add_trace_options(d, decode->trace);
   d->add_flag("--nops", decode->nops, "also list NOPs and STCK edges");
   d->add_option("--max-repeats", decode->max_repeats, "show each kind of diagnostic at most this often per chip (0 = all)");
-  d->add_option("--chip", decode->chip, "show only this chip's lines (0 = the chip driving MISO)")->check(CLI::Range(0, 255));
+  d->add_option("--chip", decode->chip, "show only this chip's lines (numbered as --number-from says)")
+      ->check(CLI::Range(0, 255));
+  add_number_from_option(d, decode->number_from);
   d->callback([decode] { finish(run_decode(*decode, std::cout, std::cerr)); });
 
   auto convert = std::make_shared<ConvertArgs>();

@@ -8,6 +8,7 @@
 #include <iosfwd>
 #include <string>
 
+#include "daisychain/chip_numbering.hpp"
 #include "tools/trace_input.hpp"
 
 namespace CLI {
@@ -30,6 +31,10 @@ struct TraceArgs {
 /// format or framing name.
 TraceInputOptions input_options(const TraceArgs& args);
 
+/// The value of a --number-from option ("miso" or "mosi"). Throws std::invalid_argument
+/// with one line starting "--number-from: " for anything else.
+NumberFrom number_from_option(const std::string& text);
+
 /// Prints the importer's notes about `header` to `err`, one "note:" line each.
 void print_notes(const TraceHeader& header, std::ostream& err);
 
@@ -42,6 +47,7 @@ struct ReplayArgs {
   std::size_t max_reports = 100;
   bool no_pins = false;       ///< do not check BUSY/FLAG observations
   bool quiet = false;         ///< summary line only
+  std::string number_from = "miso";  ///< how reports number the chips: miso or mosi
 };
 /// `l6470emu replay`: 0 when every captured MISO byte and pin level matched, 1 when not, 2 on bad input.
 int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err);
@@ -50,7 +56,8 @@ struct DecodeArgs {
   TraceArgs trace;
   bool nops = false;
   std::size_t max_repeats = 10;
-  int chip = -1;  ///< only this chip's lines
+  int chip = -1;  ///< only this chip's lines (numbered as number_from says)
+  std::string number_from = "miso";  ///< how the log numbers the chips: miso or mosi
 };
 /// `l6470emu decode`: 0, or 2 on bad input.
 int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err);

@@ -180,11 +180,14 @@ std::string UhidGpioBridges::start() {
       Board& board = impl.board;
       Cp2112Pins pins{[&board, c, k](Pin p) { return board.pin_level(c, k, p); },
                       [&board, c, k](Pin p, bool level) { board.drive_pin(c, k, p, level); }};
-      b.reports = std::make_unique<Cp2112Reports>(pins, "L6470 chip " + std::to_string(k) + " of " + spidev, b.uniq);
+      // What users read (the HID name, the report label) numbers the chip as the board does;
+      // phys and uniq keep the chain index, which never changes with the numbering.
+      const std::size_t number = board.chip_numbering(c).number_of(k);
+      b.reports = std::make_unique<Cp2112Reports>(pins, "L6470 chip " + std::to_string(number) + " of " + spidev, b.uniq);
       uhid_event ev{};
       ev.type = UHID_CREATE2;
       std::snprintf(reinterpret_cast<char*>(ev.u.create2.name), sizeof ev.u.create2.name, "l6470emu %s chip %zu",
-                    spidev.c_str(), k);
+                    spidev.c_str(), number);
       std::snprintf(reinterpret_cast<char*>(ev.u.create2.phys), sizeof ev.u.create2.phys, "l6470emu/%s/%zu",
                     spidev.c_str(), k);
       std::snprintf(reinterpret_cast<char*>(ev.u.create2.uniq), sizeof ev.u.create2.uniq, "%s", b.uniq.c_str());
@@ -209,7 +212,7 @@ std::string UhidGpioBridges::start() {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     impl.nodes.push_back(b.node);
     if (b.node.gpiochip.empty())
-      return "the kernel registered no gpiochip for chip " + std::to_string(b.node.chip) + " of " +
+      return "the kernel registered no gpiochip for " + impl.board.chip_numbering(b.node.chain).label(b.node.chip) + " of " +
              impl.board.nodes()[impl.board.spidev_node(b.node.chain)].name + " within 10 s (is the hid-cp2112 module loaded?)";
     for (int i = 0; i < 200; ++i) {
       struct stat st{};

@@ -13,7 +13,8 @@ namespace {
 struct Args {
   std::vector<std::string> words;   // positional words after the command
   std::string chain;                // --chain NAME ("" = the first chain)
-  long chip = -1;                   // --chip K (-1 = not given)
+  long chip = -1;                   // --chip K as the user numbers it (-1 = not given)
+  std::optional<NumberFrom> number_from;  // --number-from miso|mosi (none = the board's)
   std::string error;
 };
 
@@ -21,7 +22,7 @@ Args parse_args(const std::vector<std::string>& all) {
   Args a;
   for (std::size_t i = 1; i < all.size(); ++i) {
     const std::string& w = all[i];
-    if (w == "--chain" || w == "--chip") {
+    if (w == "--chain" || w == "--chip" || w == "--number-from") {
       if (i + 1 >= all.size()) {
         a.error = w + " needs a value";
         return a;
@@ -29,6 +30,9 @@ Args parse_args(const std::vector<std::string>& all) {
       const std::string& v = all[++i];
       if (w == "--chain") {
         a.chain = v;
+      } else if (w == "--number-from") {
+        a.number_from = number_from_named(v);
+        if (!a.number_from) a.error = "--number-from must be miso (chip 0 drives MISO) or mosi (chip 0 reads the host's MOSI), not '" + v + "'";
       } else {
         char* end = nullptr;
         a.chip = std::strtol(v.c_str(), &end, 10);
@@ -55,8 +59,12 @@ const RegisterInfo* register_named(const Variant& v, const std::string& name) {
 
 }  // namespace
 
-std::string control_help() {
-  return "l6470emu ctl commands (chip numbers: chip 0 drives MISO; --chain NAME picks a chain, default the first):\n"
+std::string control_help(std::optional<NumberFrom> numbering) {
+  const std::string numbers = numbering ? describe_numbering(*numbering) + ", as the daemon's numbering= says"
+                                        : "chip numbers count as the daemon's numbering= says (miso unless set: chip 0 "
+                                          "drives MISO)";
+  return "l6470emu ctl commands (--chain NAME picks a chain, default the first):\n"
+         "  " + numbers + "; --number-from miso|mosi counts from the MISO or the MOSI end for one command\n"
          "  chains                              the emulated chains and their gpiochips\n"
          "  status [--chip K]                   STATUS of each chip, read without clearing anything\n"
          "  get REGISTER [--chip K]             a register as GetParam would return it, without side effects\n"
@@ -81,7 +89,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
   }
   std::ostringstream o;
   if (all.empty() || all[0] == "help" || all[0] == "--help") {
-    out = control_help();
+    out = control_help(board.numbering());
     return all.empty() ? 2 : 0;
   }
   const std::string& cmd = all[0];
@@ -90,6 +98,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     out = "ctl: " + a.error + "\n";
     return 2;
   }
+  const NumberFrom number_from = a.number_from.value_or(board.numbering());
   if (board.chain_count() == 0) {
     out = "ctl: the daemon has no chain\n";
     return 1;
@@ -106,10 +115,14 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     out = "ctl: chip " + std::to_string(a.chip) + " does not exist (the chain has " + std::to_string(chips) + ")\n";
     return 1;
   }
+  // --chip K is the user's number; k below is always the chain index.
+  const ChipNumbering numbering(number_from, chips);
+  const auto label = [&](std::size_t k) { return numbering.label(k); };
+  const auto said = [&] { o << "# " << numbering.description() << "\n"; };
   // Writes need a chip unless the chain has only one.
   auto target_chip = [&](std::size_t& k) {
     if (a.chip >= 0) {
-      k = static_cast<std::size_t>(a.chip);
+      k = numbering.index_of(static_cast<std::size_t>(a.chip));
       return true;
     }
     if (chips == 1) {
@@ -119,19 +132,22 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     out = "ctl: the chain has " + std::to_string(chips) + " chips: say which with --chip K\n";
     return false;
   };
+  // Every chip in the user's order (or the --chip one), as chain indices.
   auto for_chips = [&](auto&& f) {
     const std::size_t lo = a.chip >= 0 ? static_cast<std::size_t>(a.chip) : 0;
     const std::size_t hi = a.chip >= 0 ? lo + 1 : chips;
-    for (std::size_t k = lo; k < hi; ++k) f(k);
+    for (std::size_t u = lo; u < hi; ++u) f(numbering.index_of(u));
   };
 
   if (cmd == "chains") {
     for (std::size_t i = 0; i < board.chain_count(); ++i) o << board.chain_summary(i) << "\n";
+    said();
   } else if (cmd == "status") {
+    said();
     board.with_chain(ci, [&](Chain& c) {
       for_chips([&](std::size_t k) {
         const Chip& chip = c.chip(k);
-        o << "chip " << k << " (" << chip.variant().name << "): STATUS " << hex(chip.status(), 4) << "  "
+        o << label(k) << " (" << chip.variant().name << "): STATUS " << hex(chip.status(), 4) << "  "
           << describe_status(chip.variant().status, chip.status()) << "\n";
       });
     });
@@ -150,7 +166,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
           return;
         }
         const std::uint32_t v = chip.peek(r->id);
-        o << "chip " << k << ": " << r->name << " = " << hex(v, (r->bits + 3) / 4);
+        o << label(k) << ": " << r->name << " = " << hex(v, (r->bits + 3) / 4);
         if (r->is_signed()) o << " (" << sign_extend(v, r->bits) << ")";
         o << "\n";
       });
@@ -160,8 +176,9 @@ int run_control(Board& board, const std::string& command, std::string& out) {
       return 1;
     }
   } else if (cmd == "dump") {
+    said();
     board.with_chain(ci, [&](Chain& c) {
-      for_chips([&](std::size_t k) { o << "== chip " << k << " ==\n" << c.chip(k).dump() << "\n"; });
+      for_chips([&](std::size_t k) { o << "== " << label(k) << " ==\n" << c.chip(k).dump() << "\n"; });
     });
     o << board.describe_handles();
   } else if (cmd == "sw" || cmd == "pin") {
@@ -193,7 +210,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
       level = a.words[1] == "1";
     }
     board.drive_pin(ci, k, pin, level);
-    o << "chip " << k << ": " << pin_name(pin) << " " << (level ? "high" : "low") << "\n";
+    o << label(k) << ": " << pin_name(pin) << " " << (level ? "high" : "low") << "\n";
   } else if (cmd == "fault") {
     std::size_t k = 0;
     if (!target_chip(k)) return 2;
@@ -234,7 +251,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
         return 2;
       }
     }
-    o << "chip " << k << ": " << f << " " << v << "\n";
+    o << label(k) << ": " << f << " " << v << "\n";
   } else if (cmd == "adc") {
     std::size_t k = 0;
     if (!target_chip(k)) return 2;
@@ -245,7 +262,7 @@ int run_control(Board& board, const std::string& command, std::string& out) {
       return 2;
     }
     board.inject_fault(ci, k, TraceFault::ADCIN, static_cast<std::uint8_t>(code));
-    o << "chip " << k << ": ADC_OUT " << code << "\n";
+    o << label(k) << ": ADC_OUT " << code << "\n";
   } else if (cmd == "time") {
     for (std::size_t i = 0; i < board.chain_count(); ++i) {
       const Tick t = board.now(i);

@@ -200,6 +200,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   for (std::size_t i = 0; i < board.chain_count(); ++i) out << "  " << board.chain_summary(i) << "\n";
   out << "  " << (config.time.virtual_time ? std::string("virtual time") : "wall clock x " + std::to_string(config.time.scale))
       << "\n";
+  out << "  " << describe_numbering(config.numbering) << " (ctl and diagnostics; numbering=)\n";
   for (std::size_t i = 0; i < board.chain_count(); ++i)
     if (const std::string path = board.recording_path(i); !path.empty()) out << "  recording to " << path << "\n";
   out << "run programs with: LD_PRELOAD=<path>/libl6470emu-preload.so L6470EMU_SOCKET=" << socket_path << " <program>\n";

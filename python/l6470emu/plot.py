@@ -34,7 +34,7 @@ class PlotError(ValueError):
 
 
 def parse_chips(text: str) -> List[int]:
-    """A chip list as the command line gives it: "0,2", "1-3", "0,2-4" (0 drives MISO)."""
+    """A chip list as the command line gives it: "0,2", "1-3", "0,2-4" (numbered as --number-from says)."""
     chips: List[int] = []
     for part in text.split(","):
         part = part.strip()
@@ -50,7 +50,7 @@ def parse_chips(text: str) -> List[int]:
     return sorted(set(chips))
 
 
-def _motion_of(source, chain, chips, start, end, format, select, max_points):
+def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from):
     """l6470emu.motion() of a Motion (as is), a Chain recording into memory, a Trace or a path."""
     if isinstance(source, _l6470emu.Motion):
         return source
@@ -61,7 +61,7 @@ def _motion_of(source, chain, chips, start, end, format, select, max_points):
             end = source.now_seconds  # a live chain: up to its present
         source = source.trace if source.trace is not None else source.record_path
     return _l6470emu.motion(source, chain, format=format, select=select, chips=chips, start=start, end=end,
-                            max_points=max_points)
+                            max_points=max_points, number_from=number_from)
 
 
 def _time_scale(motion) -> tuple:
@@ -75,18 +75,20 @@ def _time_scale(motion) -> tuple:
 
 def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
-           title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None):
+           title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None,
+           number_from: str = "miso"):
     """The picture as a matplotlib Figure (not shown, not saved; pyplot is not used).
 
     source: a trace file (any format the l6470emu program reads), a Trace, a Chain made with
-    record=True, or a Motion from l6470emu.motion(). The other arguments are motion()'s, and
+    record=True, or a Motion from l6470emu.motion() (which brings its own numbering). The other
+    arguments are motion()'s (number_from: chip 0 at the "miso" or the "mosi" end), and
     position_unit = (name, microsteps per unit), e.g. ("rev", 25600), to draw positions in
     another unit than ABS_POS's microsteps.
     """
     import numpy as np
     from matplotlib.figure import Figure
 
-    motion = _motion_of(source, chain, chips, start, end, format, select, max_points)
+    motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from)
     scale, unit = _time_scale(motion)
     pos_unit, per_unit = position_unit if position_unit is not None else ("microsteps", 1.0)
     if not per_unit > 0:
@@ -101,7 +103,7 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
         t = np.asarray(c.ticks, dtype=np.float64) * SECONDS_PER_TICK * scale
         pos = np.asarray(c.abs_pos, dtype=np.float64) / per_unit
         speed = np.asarray(c.speed, dtype=np.float64) * STEPS_PER_S_PER_SPEED_UNIT
-        name = f"chip {c.chip} {c.variant} (1/{c.microsteps_per_step})"
+        name = f"chip {c.number} {c.variant} (1/{c.microsteps_per_step})"
         pos_ax.plot(t, pos, color=colour, linewidth=1.6, label=name)
         speed_ax.plot(t, speed, color=colour, linewidth=1.4)
         if c.commands and len(t):
@@ -116,7 +118,7 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
             y = lane + 0.1 + 0.7 * np.asarray(levels, dtype=np.float64)
             pin_ax.plot(t, y, drawstyle="steps-post", color=colour, linewidth=1.2)
             pin_ax.fill_between(t, lane + 0.1, y, step="post", color=colour, alpha=0.2, linewidth=0)
-            labels.append((lane + 0.45, f"{pin}{c.chip}"))
+            labels.append((lane + 0.45, f"{pin}{c.number}"))
     if total_commands <= MAX_LABELLED_COMMANDS:
         # Labels of commands close together in time (any chip) are stacked, not overprinted.
         close = (motion.end - motion.start) * SECONDS_PER_TICK * scale / 40
@@ -143,6 +145,8 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
         if total_commands > MAX_LABELLED_COMMANDS:
             title += f" ({total_commands} commands: markers only)"
     fig.suptitle(title, fontsize=11)
+    # Which end chip 0 is at, once, under the picture.
+    fig.text(0.005, 0.002, motion.numbering, fontsize=7, color="0.35", ha="left", va="bottom")
     return fig
 
 
@@ -168,7 +172,9 @@ def _arguments(argv):
         description="Draw each chip's position, speed, BUSY/FLAG/SW and commands against time, from a trace.")
     p.add_argument("trace", help="trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
     p.add_argument("-o", "--output", required=True, help="picture to write: .png or .svg")
-    p.add_argument("--chips", help="chips to draw: 0,2 or 1-3 (default all; 0 drives MISO)")
+    p.add_argument("--chips", help="chips to draw: 0,2 or 1-3 (default all; numbered as --number-from says)")
+    p.add_argument("--number-from", default="miso",
+                   help="chip 0 is the chip driving MISO (miso, the default) or the one reading the host's MOSI (mosi)")
     p.add_argument("--from", dest="start", type=float,
                    help="window start, seconds from the trace's start (a capture's own clock counts from 0 here)")
     p.add_argument("--to", dest="end", type=float,
@@ -206,6 +212,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             raise PlotError(f"--max-points {args.max_points}: at least 64")
         if args.dpi < 10 or args.dpi > 1200:
             raise PlotError(f"--dpi {args.dpi}: from 10 to 1200")
+        if args.number_from.lower() not in ("miso", "mosi"):
+            raise PlotError(f"--number-from {args.number_from!r}: write miso (chip 0 drives MISO) or mosi "
+                            "(chip 0 reads the host's MOSI)")
         chips = parse_chips(args.chips) if args.chips is not None else None
         if not Path(args.trace).exists():
             raise PlotError(f"{args.trace}: no such file")
@@ -215,7 +224,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         matplotlib.use("Agg")
         out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
                    format=args.format, select=args.select, max_points=args.max_points, title=args.title,
-                   size=(width, height), dpi=args.dpi)
+                   size=(width, height), dpi=args.dpi, number_from=args.number_from)
     except (ValueError, TypeError, OSError, RuntimeError) as e:  # TraceError is a ValueError
         print(f"l6470emu plot: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

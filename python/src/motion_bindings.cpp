@@ -21,6 +21,7 @@ namespace {
 /// One chip's series as Python lists (the plot module makes arrays of them).
 struct PyChipMotion {
   std::size_t chip = 0;
+  std::size_t number = 0;
   std::string variant;
   unsigned microsteps_per_step = 0;
   std::vector<Tick> ticks;
@@ -33,13 +34,14 @@ struct PyChipMotion {
 
 struct PyMotion {
   Tick start = 0, end = 0, trace_end = 0;
-  std::string chain, how;
+  std::string chain, how, number_from = "miso", numbering;
   std::vector<PyChipMotion> chips;
 };
 
 PyChipMotion chip_of(ChipMotion&& m) {
   PyChipMotion p;
   p.chip = m.chip;
+  p.number = m.number;
   p.variant = std::move(m.variant);
   p.microsteps_per_step = m.microsteps_per_step;
   const std::size_t n = m.samples.size();
@@ -85,7 +87,8 @@ void bind_motion(py::module_& m) {
   py::class_<PyChipMotion>(m, "ChipMotion", R"(One chip's series, sampled where they change: lists of equal length,
 in the datasheet's units (ABS_POS in microsteps of the STEP_SEL in force, SPEED in 2^-28 full
 step per tick, negative in reverse; pins as levels, False = pulled low).)")
-      .def_readonly("chip", &PyChipMotion::chip, "the chip (0 drives MISO)")
+      .def_readonly("chip", &PyChipMotion::chip, "the chip's index in the chain (0 drives MISO)")
+      .def_readonly("number", &PyChipMotion::number, "the chip's number as motion()'s number_from counts (to show)")
       .def_readonly("variant", &PyChipMotion::variant, "\"L6470\", ...")
       .def_readonly("microsteps_per_step", &PyChipMotion::microsteps_per_step, "of the STEP_SEL in force at the end")
       .def_readonly("ticks", &PyChipMotion::ticks, "sample times, 250 ns ticks")
@@ -100,7 +103,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       .def_readonly("commands_dropped", &PyChipMotion::commands_dropped, "commands beyond max_commands, not listed")
       .def("__len__", [](const PyChipMotion& c) { return c.ticks.size(); })
       .def("__repr__", [](const PyChipMotion& c) {
-        return "ChipMotion(chip " + std::to_string(c.chip) + " " + c.variant + ", " + std::to_string(c.ticks.size()) +
+        return "ChipMotion(chip " + std::to_string(c.number) + " " + c.variant + ", " + std::to_string(c.ticks.size()) +
                " samples, " + std::to_string(c.commands.size()) + " commands)";
       });
 
@@ -111,6 +114,8 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       .def_readonly("chain", &PyMotion::chain, "the emulated chain, chip 0 first (\"3*L6470\")")
       .def_readonly("how", &PyMotion::how, "where the chain came from, in words")
       .def_readonly("chips", &PyMotion::chips, "one ChipMotion per chip asked for")
+      .def_readonly("number_from", &PyMotion::number_from, "how chip numbers count: \"miso\" or \"mosi\"")
+      .def_readonly("numbering", &PyMotion::numbering, "what the chip numbers mean, in words")
       .def("__repr__", [](const PyMotion& p) {
         return "Motion(chain " + p.chain + ", " + std::to_string(p.chips.size()) + " chips, ticks " +
                std::to_string(p.start) + ".." + std::to_string(p.end) + ")";
@@ -119,19 +124,26 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
   m.def(
       "motion",
       [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
-         py::handle end, std::size_t max_points, std::size_t max_commands) {
+         py::handle end, std::size_t max_points, std::size_t max_commands, const std::string& number_from) {
         MotionOptions o;
+        try {
+          o.number_from = parse_number_from(number_from);
+        } catch (const std::invalid_argument& e) {
+          throw py::value_error(std::string("number_from: ") + e.what());
+        }
         o.from = tick_from_seconds(start, "start", 0);
         o.to = tick_from_seconds(end, "end", kNever);
         o.max_points = max_points;
         o.max_commands = max_commands;
         if (!chips.is_none()) {
           if (!py::isinstance<py::sequence>(chips) || py::isinstance<py::str>(chips))
-            throw py::type_error("chips: a list of chip numbers (0 drives MISO) is needed");
+            throw py::type_error("chips: a list of chip numbers (counted as number_from says) is needed");
           for (py::handle c : chips) o.chips.push_back(static_cast<std::size_t>(int_in_range(c, "chips", 0, 255)));
           if (o.chips.empty()) throw py::value_error("chips: the list is empty (None = every chip)");
         }
         PyMotion result;
+        result.number_from = to_string(o.number_from);
+        result.numbering = describe_numbering(o.number_from);
         const Source source = source_of(trace, chain, format, select);
         result.how = source.how;
         {
@@ -154,12 +166,13 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("select") = "", py::arg("chips") = py::none(), py::arg("start") = py::none(), py::arg("end") = py::none(),
-      py::arg("max_points") = 4000, py::arg("max_commands") = 2000,
+      py::arg("max_points") = 4000, py::arg("max_commands") = 2000, py::arg("number_from") = "miso",
       R"(Replays a trace through a fresh emulated chain and samples what each chip did.
 
 trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
 program reads. chain: the chain (default: the trace's own; for a file without one, guessed
-from its frame lengths). chips: chip numbers to sample (default all). start, end: the window
+from its frame lengths). chips: chip numbers to sample (default all), counted from the MISO
+end (number_from="miso", chip 0 drives MISO) or the MOSI end ("mosi"). start, end: the window
 in seconds from the trace's start (end None: the trace's end, plus up to 1 s while a move is
 still going). Samples are the chips' exact states at their ticks: at the window's edges,
 after every event that touches a chip, at every change of the motion rule (the ends of

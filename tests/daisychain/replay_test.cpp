@@ -124,7 +124,7 @@ TEST(Replay, RejectsEventsForChipsOutsideTheChain) {
     replay_text("l6470emu-trace 1\n0 pin 4 SW 0\n", 3);
     FAIL();
   } catch (const TraceError& e) {
-    EXPECT_EQ(std::string(e.what()), "t.trace:2: event for chip 4, but the chain has 3 chips (see --chain)");
+    EXPECT_EQ(std::string(e.what()), "t.trace:2: event for chip 4 (trace files count from the MISO end), but the chain has 3 chips (see --chain)");
   }
 }
 

@@ -47,14 +47,20 @@ TEST(BoardConfig, ErrorsNameTheClauseAndTheProblem) {
   EXPECT_FALSE(r.config);
 }
 
-// The first error of `text`, without the "l6470emu: config T, clause N: " prefix (checked here).
+// The first error of `text`, without the "l6470emu: config T, clause N: " prefix (checked here;
+// "T:LINE, clause N" for a text of several lines).
 std::string error_of(std::string_view text, unsigned clause = 1) {
   const auto r = parse_board_config(text, "T");
   if (r.config) return "(accepted)";
+  std::string message = r.error.message;
+  if (message.rfind("l6470emu: config T:", 0) == 0) {  // the line: digits up to the comma
+    const std::size_t comma = message.find(',');
+    message = "l6470emu: config T" + message.substr(comma);
+  }
   const std::string prefix = "l6470emu: config T, clause " + std::to_string(clause) + ": ";
-  if (r.error.message.rfind(prefix, 0) != 0) return "(prefix) " + r.error.message;
-  EXPECT_EQ(r.error.message.find('\n'), std::string::npos) << r.error.message;
-  return r.error.message.substr(prefix.size());
+  if (message.rfind(prefix, 0) != 0) return "(prefix) " + r.error.message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  return message.substr(prefix.size());
 }
 
 bool contains(const std::string& text, std::string_view part) { return text.find(part) != std::string::npos; }
@@ -246,7 +252,7 @@ TEST(BoardConfig, ACommentRunsToTheEndOfTheLineEvenPastASemicolon) {
   EXPECT_EQ(r.config->chains.size(), 1u);
   EXPECT_EQ(error_of("bus=0 chips=L6470 # ok\n; colour=red", 3), "unknown key 'colour' (chain keys: chips, bus, cs, "
                                                                  "path, gpiochip, speed, mode, bufsiz; board-wide keys: "
-                                                                 "time, scale, idle, log, socket, trace)");
+                                                                 "time, scale, idle, log, socket, trace, numbering)");
 }
 
 TEST(BoardConfig, DefaultGpiochipsAvoidTheNumbersOtherChainsAskFor) {
@@ -307,7 +313,41 @@ TEST(BoardConfigFile, AFileIsParsedWithItsNameAsTheOrigin) {
   EXPECT_EQ(r.config->chains.size(), 2u);
   EXPECT_EQ(r.config->time.idle_ns, 0);
   r = load_board_config_file(dir.file("bad.conf", "bus=0 chips=L6470\n\nmode=9 chips=L6470\n"));
-  EXPECT_EQ(r.error.message, "l6470emu: config " + dir.path + "/bad.conf, clause 3: mode must be an SPI mode from 0 to 3, not '9'");
+  EXPECT_EQ(r.error.message, "l6470emu: config " + dir.path + "/bad.conf:3, clause 3: mode must be an SPI mode from 0 to 3, not '9'");
+}
+
+TEST(BoardConfigFile, AnErrorNamesTheLineAsWellAsTheClauseWhenTheTextHasSeveralLines) {
+  // Two clauses on line 1, the bad one on line 2 is clause 3.
+  auto r = parse_board_config("bus=0 chips=L6470; time=virtual\nbus=1 chips=3xL6499\n", "board.conf");
+  EXPECT_EQ(r.error.message.rfind("l6470emu: config board.conf:2, clause 3: unknown chip variant 'L6499'", 0), 0u)
+      << r.error.message;
+  // A gpiochip clash found after the last line still points at its chain's line.
+  r = parse_board_config("bus=0 chips=L6470 gpiochip=1023\n\nbus=1 chips=L6470\n", "board.conf");
+  ASSERT_TRUE(r.config) << r.error.message;
+  // One line (L6470EMU_CHAIN, --chain): the clause says where.
+  r = parse_board_config("bus=0 chips=L6470; mode=9 chips=L6470", "L6470EMU_CHAIN");
+  EXPECT_EQ(r.error.message.rfind("l6470emu: config L6470EMU_CHAIN, clause 2: ", 0), 0u) << r.error.message;
+}
+
+TEST(BoardConfigNumbering, NumberingSaysWhichEndChipZeroIsAtAndDefaultsToMiso) {
+  auto r = parse_board_config("bus=0 chips=3xL6470", "T");
+  ASSERT_TRUE(r.config);
+  EXPECT_EQ(r.config->numbering, NumberFrom::miso);
+  r = parse_board_config("bus=0 chips=3xL6470 numbering=mosi", "T");
+  ASSERT_TRUE(r.config);
+  EXPECT_EQ(r.config->numbering, NumberFrom::mosi);
+  EXPECT_NE(describe_board_config(*r.config).find("numbering=mosi\n"), std::string::npos);
+  r = parse_board_config("bus=0 chips=3xL6470; numbering=MISO", "T");
+  ASSERT_TRUE(r.config);
+  EXPECT_EQ(r.config->numbering, NumberFrom::miso);
+}
+
+TEST(BoardConfigNumbering, AnUnknownNumberingIsOneLineNamingTheClauseAndTheChoices) {
+  const auto r = parse_board_config("bus=0 chips=3xL6470 numbering=x", "T");
+  EXPECT_EQ(r.error.message, "l6470emu: config T, clause 1: numbering must be miso (chip 0 drives MISO) or mosi (chip 0 "
+                             "reads the host's MOSI), not 'x'");
+  const auto twice = parse_board_config("bus=0 chips=L6470 numbering=mosi; numbering=miso", "T");
+  EXPECT_NE(twice.error.message.find("numbering= is given twice"), std::string::npos) << twice.error.message;
 }
 
 TEST(BoardConfigFile, ADirectoryIsSaidToBeADirectoryAndAMissingFileSaysWhy) {

@@ -40,5 +40,27 @@ TEST(BoardDiagnostics, ADriverLoopingOnABadCommandGetsTenLinesAndATallyAtEachPow
   EXPECT_EQ(lines[12], "l6470emu: spidev0.0: chip 0: WRONG_CMD: 10000 so far");
 }
 
+TEST(BoardDiagnostics, NameTheChipAsTheBoardsNumberingCountsIt) {
+  const std::string path = temp_socket_path("diag-mosi") + ".log";
+  {
+    ParseResult p = parse_board_config("bus=0 cs=0 chips=2xL6470 mode=3 numbering=mosi; time=virtual", "test");
+    ASSERT_TRUE(p.config);
+    DiagnosticLog log(path);
+    Board board(*p.config, log);
+    const NewFile f = board.open(0, true);
+    spi_ioc_transfer x{};
+    x.tx_buf = 1;
+    x.len = 2;
+    const std::uint8_t tx[2] = {0xEB, 0x00};  // the chain's chip 0 (the MISO end) gets 0xEB
+    ASSERT_EQ(board.spi_message(f.handle, {&x, 1}, tx, {}), 2);
+    close(f.fd);
+  }
+  std::ifstream in(path);
+  std::string first;
+  std::getline(in, first);
+  unlink(path.c_str());
+  EXPECT_EQ(first, "l6470emu: spidev0.0: chip 1: WRONG_CMD: byte 0xEB: reserved opcode");
+}
+
 }  // namespace
 }  // namespace l6470emu::test

@@ -99,6 +99,7 @@ def test_a_long_run_is_bounded_and_keeps_its_extremes():
     (["{three}", "-o", "x.png", "--chips", "x"], "--chips 'x'"),
     (["{three}", "-o", "x.png", "--chips", "7"], "chip 7: the chain has 3 chips"),
     (["{three}", "-o", "x.png", "--chips", "3-1"], "--chips '3-1'"),
+    (["{three}", "-o", "x.png", "--number-from", "x"], "--number-from 'x': write miso"),
     (["{three}", "-o", "x.png", "--from", "0.5", "--to", "0.2"], "the window is empty"),
     (["{three}", "-o", "x.png", "--from", "1000"], "the window is empty"),
     (["{three}", "-o", "x.png", "--from", "soon"], "--from"),
@@ -119,3 +120,10 @@ def test_bad_input_is_one_line_and_exit_status_2(tmp_path, args, says):
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1, r.stderr
     assert lines[0].startswith("l6470emu plot: ") and says in lines[0], lines[0]
+
+
+def test_chips_numbered_from_the_mosi_end_are_labelled_so_and_the_picture_says_which_end():
+    fig = l6470emu.plot.figure(FIXTURES / "three_chips.trace", chips=[0], number_from="mosi")
+    assert any("count from the MOSI end" in t.get_text() for t in fig.texts)
+    labels = [line.get_label() for line in fig.axes[0].get_lines() if not line.get_label().startswith("_")]
+    assert labels == ["chip 0 L6470 (1/128)"]

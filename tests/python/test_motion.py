@@ -34,6 +34,15 @@ def test_chips_and_window_choose_what_is_sampled():
         assert c.ticks[0] == m.start and c.ticks[-1] == m.end
 
 
+def test_chips_counted_from_the_mosi_end_are_the_chains_chips_from_the_other_end():
+    m = l6470emu.motion(FIXTURES / "three_chips.trace", chips=[0], number_from="mosi")
+    assert [(c.chip, c.number) for c in m.chips] == [(2, 0)]
+    assert m.number_from == "mosi" and "count from the MOSI end" in m.numbering
+    default = l6470emu.motion(FIXTURES / "three_chips.trace", chips=[0])
+    assert [(c.chip, c.number) for c in default.chips] == [(0, 0)]
+    assert "count from the MISO end" in default.numbering
+
+
 def test_every_format_the_program_reads_can_be_sampled():
     for name in ("single_chip.trace", "saleae_logic2.csv", "umockdev_spidev.ioctl", "ftrace_spi_set_cs.txt",
                  "sigrok_spi.json"):
@@ -48,6 +57,7 @@ def test_every_format_the_program_reads_can_be_sampled():
     ({"start": 0.5, "end": 0.1}, ValueError, "the window is empty"),
     ({"start": -1.0}, ValueError, "start = -1.0"),
     ({"end": "soon"}, TypeError, "end: seconds"),
+    ({"number_from": "x"}, ValueError, "number_from: 'x' is not a chip numbering"),
 ])
 def test_mistakes_are_value_or_type_errors_naming_them(kwargs, error, says):
     with pytest.raises(error, match=says):

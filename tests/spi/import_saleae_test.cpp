@@ -135,6 +135,17 @@ TEST(SaleaeImport, ChoosesOneAnalyzerWhenTheTableHasSeveral) {
   EXPECT_EQ(bytes(t[0].mosi), Bytes{0xD0});
 }
 
+TEST(SaleaeImport, ASelectThatMatchesNoAnalyzerNamesTheOnesTheFileHas) {
+  ImportOptions o;
+  o.select = "SPI 3";
+  try {
+    import_saleae_csv(kHeader + "\"SPI\",\"enable\",0,2e-08,,\n\"SPI 2\",\"result\",0.0000001,1e-06,0x11,0x22\n", "two.csv", o);
+    FAIL() << "no error";
+  } catch (const TraceError& e) {
+    EXPECT_EQ(std::string(e.what()), "two.csv: no rows of an analyzer called \"SPI 3\" (the file has \"SPI\", \"SPI 2\"): see --select");
+  }
+}
+
 TEST(SaleaeImport, RejectsBadInputWithOneLineErrors) {
   const std::string open = "\"SPI\",\"enable\",0.1,2e-08,,\n";
   EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0xD0,0xZZ\n"),

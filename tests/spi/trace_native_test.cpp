@@ -224,6 +224,14 @@ TEST(NativeTrace, QuotesAHugeBadTokenShortAndEscapesControlCharacters) {
   EXPECT_NE(mu.find(std::string(59, 'a') + "\u2026"), std::string::npos) << mu;
 }
 
+TEST(NativeTrace, NamesBytesThatAreNotTextByTheirValue) {
+  const std::string head = "l6470emu-trace 1\n";
+  // Binary junk and Latin-1 are shown as \xNN; well-formed UTF-8 stays as it is.
+  EXPECT_EQ(error_of(head + "0 frame \xFF\xFE\n"), "t.trace:2: MOSI \"\\xFF\\xFE\" is not a byte (two hex digits)");
+  EXPECT_EQ(error_of(head + "0 frame D\xE9\n"), "t.trace:2: MOSI \"D\\xE9\" is not a byte (two hex digits)");
+  EXPECT_EQ(error_of(head + "0 frame \xC2\xB5s\n"), "t.trace:2: MOSI \"\u00b5s\" is not a byte (two hex digits)");
+}
+
 TEST(NativeTrace, ClosesItsFileWhenTheHeaderIsMalformed) {
   TempDir dir;
   const std::string path = dir.file("bad.trace");

@@ -139,5 +139,41 @@ TEST(ReplayCommand, NamesTheFileLineAndByteWhereAGzipTraceIsCutShort) {
   EXPECT_NE(r.out.find(": the gzip data ends early, after "), std::string::npos) << r.out;
 }
 
+TEST(DecodeCommand, NumbersChipsFromTheMosiEndWhenAskedAndSaysSo) {
+  const RunResult r = l6470emu("decode --number-from mosi " + fixture_path("three_chips.trace"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("chain 3*L6470 (from the trace); chip numbers count from the MOSI end"), std::string::npos) << r.out;
+  // The thermal warning happened on the chain's chip 2, the one nearest the host's MOSI.
+  EXPECT_NE(r.out.find("chip 0   fault THERMAL warning"), std::string::npos) << r.out;
+  const RunResult miso = l6470emu("decode " + fixture_path("three_chips.trace"));
+  EXPECT_NE(miso.out.find("chip numbers count from the MISO end"), std::string::npos) << miso.out;
+  EXPECT_NE(miso.out.find("chip 2   fault THERMAL warning"), std::string::npos) << miso.out;
+  const RunResult only = l6470emu("decode --number-from mosi --chip 0 " + fixture_path("three_chips.trace"));
+  EXPECT_NE(only.out.find("chip 0   fault THERMAL warning"), std::string::npos) << only.out;
+  EXPECT_EQ(only.out.find("chip 2 "), std::string::npos) << only.out;
+}
+
+TEST(ReplayCommand, SaysHowItNumbersChipsBeforeTheFirstReport) {
+  const RunResult r = l6470emu("replay --number-from mosi --chain 3 " + fixture_path("ftrace_spi_set_cs.txt"));
+  EXPECT_EQ(r.status, 1) << r.out;
+  const auto said = r.out.find("# chip numbers count from the MOSI end");
+  const auto report = r.out.find("frame 23 at t=1523.803136000 s: MISO byte 0 expected 0xF0");
+  ASSERT_NE(said, std::string::npos) << r.out;
+  EXPECT_LT(said, report) << r.out;
+  // MISO byte 0 comes from the chain's chip 0, the MISO end: chip 2 counted from MOSI.
+  EXPECT_NE(r.out.find("byte 0: chip 2: byte 3 of 3 of the GetParam(ABS_POS) answer"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  chip 2 state (emulated, as it answered):"), std::string::npos) << r.out;
+}
+
+TEST(TraceCommands, RejectAnUnknownNumberingInOneLineWithStatusTwo) {
+  for (const char* cmd : {"decode", "replay"}) {
+    const RunResult r = l6470emu(std::string(cmd) + " --number-from x " + fixture_path("three_chips.trace"));
+    EXPECT_EQ(r.status, 2) << cmd;
+    EXPECT_EQ(r.out, std::string("l6470emu ") + cmd +
+                         ": --number-from: 'x' is not a chip numbering: write miso (chip 0 drives MISO) or mosi "
+                         "(chip 0 reads the host's MOSI)\n");
+  }
+}
+
 }  // namespace
 }  // namespace l6470emu
