@@ -3,6 +3,8 @@
 
 #include <stdexcept>
 
+#include "spi/import_support.hpp"  // quote(): input in messages, cut short, control characters as \xNN
+
 namespace l6470emu {
 
 std::vector<const Variant*> parse_chain_spec(std::string_view spec) {
@@ -20,23 +22,26 @@ std::vector<const Variant*> parse_chain_spec(std::string_view spec) {
     std::size_t k = 0;
     while (k < item.size() && item[k] >= '0' && item[k] <= '9') ++k;
     if (k > 0) {
-      if (k > 4) throw std::invalid_argument("chain item \"" + std::string(item) + "\": too many chips");
+      if (k > 4) throw std::invalid_argument("chain item " + detail::quote(item) + ": too many chips");
       count = std::stoul(std::string(item.substr(0, k)));
       if (k == item.size()) {
         name = "L6470";
       } else if (item[k] == '*' || item[k] == 'x') {
         name = item.substr(k + 1);
+        if (name.empty())
+          throw std::invalid_argument("chain item " + detail::quote(item) + " has no variant after '" + item[k] +
+                                      "' (N*VARIANT, e.g. 3*L6470)");
       } else {
-        throw std::invalid_argument("chain item \"" + std::string(item) + "\" is not N, VARIANT or N*VARIANT");
+        throw std::invalid_argument("chain item " + detail::quote(item) + " is not N, VARIANT or N*VARIANT");
       }
     }
     const Variant* v = find_variant(name);
     if (v == nullptr) {
       std::string known;
       for (const Variant* a : all_variants()) known += (known.empty() ? "" : ", ") + std::string(a->name);
-      throw std::invalid_argument("unknown chip variant \"" + std::string(name) + "\" (" + known + ")");
+      throw std::invalid_argument("unknown chip variant " + detail::quote(name) + " (" + known + ")");
     }
-    if (count == 0) throw std::invalid_argument("chain item \"" + std::string(item) + "\" has no chips");
+    if (count == 0) throw std::invalid_argument("chain item " + detail::quote(item) + " has no chips");
     if (out.size() + count > Chain::kMaxChips)
       throw std::invalid_argument("a chain has at most " + std::to_string(Chain::kMaxChips) + " chips");
     out.insert(out.end(), count, v);

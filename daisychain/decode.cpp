@@ -2,6 +2,7 @@
 // diagnostics so a host that always sends the wrong frame length does not drown the log.
 #include "daisychain/decode.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <deque>
 #include <iterator>
@@ -78,7 +79,7 @@ class Decoder {
                        : std::string(issue_name(e.issue)) + ": " + e.text);
         return;
     }
-    put(t, std::move(line_));
+    put(t, std::move(line_), e.chip);
   }
 
   bool shown(std::size_t chip) const {
@@ -118,14 +119,14 @@ class Decoder {
       else if (e.fault == TraceFault::ADCIN) what = "ADCIN level: ADC_OUT code " + std::to_string(e.value);
       else what += level ? "on" : "off";
     }
-    put(t, stamp(t) + chip_column(e.chip) + what);
+    put(t, stamp(t) + chip_column(e.chip) + what, e.chip);
   }
 
   /// Writes the lines earlier than `watermark` (the start of the oldest answer still being
   /// shifted out, whose line comes later), so the log stays in time order.
   void flush(double watermark) {
-    while (!pending_.empty() && pending_.front().first < watermark) {
-      out_ << pending_.front().second << '\n';
+    while (!pending_.empty() && pending_.front().t < watermark) {
+      out_ << pending_.front().text << '\n';
       pending_.pop_front();
     }
   }
@@ -155,14 +156,24 @@ class Decoder {
     if (e.repetition) l += " repetition " + std::to_string(e.repetition);
     l += ']';
     if (options_.max_repeats != 0 && count == options_.max_repeats) l += "  (further ones of this kind not shown)";
-    put(t, std::move(l));
+    put(t, std::move(l), e.chip);
   }
 
-  /// Queues a line at time `t`, after the queued lines of the same or earlier times.
-  void put(double t, std::string line) {
+  /// Queues a line at time `t`, after the queued lines of earlier times. Among lines of the
+  /// same time, a chip's line goes after those of chips the user numbers lower or the same
+  /// (the tracker reports chips in chain order, which is the reverse under mosi numbering);
+  /// a line of no chip (kNoChip) stays where it came, and chip lines do not move before it.
+  void put(double t, std::string line, std::size_t chip = ProtocolEvent::kNoChip) {
+    const std::size_t key = chip == ProtocolEvent::kNoChip ? chip : numbering_.number_of(chip);
     auto at = pending_.end();
-    while (at != pending_.begin() && std::prev(at)->first > t) --at;
-    pending_.insert(at, {t, std::move(line)});
+    while (at != pending_.begin()) {
+      const Pending& before = *std::prev(at);
+      const bool later = before.t > t || (before.t == t && key != ProtocolEvent::kNoChip &&
+                                          before.key != ProtocolEvent::kNoChip && before.key > key);
+      if (!later) break;
+      --at;
+    }
+    pending_.insert(at, Pending{t, key, std::move(line)});
   }
 
   std::ostream& out_;
@@ -170,7 +181,12 @@ class Decoder {
   const std::string& name_;
   ChipNumbering numbering_;
   std::string line_;
-  std::deque<std::pair<double, std::string>> pending_;
+  struct Pending {
+    double t;         // display time
+    std::size_t key;  // the chip's number as shown, or kNoChip
+    std::string text;
+  };
+  std::deque<Pending> pending_;
   std::map<std::pair<std::size_t, int>, std::size_t> seen_;
   std::set<std::pair<std::size_t, int>> seen_outputs_;  // (chip, BUSY/FLAG) looked at before
 };
@@ -196,7 +212,9 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       rx.resize(e.mosi.size());
       tracker.begin_frame(e, rx);
       tracker.end_frame();
-      decoder.flush(tracker.pending_answer_seconds());
+      // Lines of this time stay queued: a later event of the same time may add lines of
+      // chips numbered lower, which come first.
+      decoder.flush(std::min(tracker.pending_answer_seconds(), display_seconds(e.tick, e.source_time)));
       continue;
     }
     if (e.chip >= chain.size())
@@ -206,7 +224,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
     decoder.pin(e, t, previous);
     // Outputs looked at together share one bound; an input or fault is an event of its own.
     if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) previous = t;
-    decoder.flush(tracker.pending_answer_seconds());
+    decoder.flush(std::min(tracker.pending_answer_seconds(), t));
   }
   tracker.finish();
   decoder.flush(std::numeric_limits<double>::infinity());

@@ -18,7 +18,9 @@ bool gzip_file_name(std::string_view path);
 std::string_view without_gz(std::string_view path);
 
 /// Reads a file's bytes, gunzipped when the file starts with the gzip magic. Errors are
-/// TraceError naming the file (and, for damaged gzip data, how far the data went).
+/// TraceError naming the file; a read error or damaged gzip data also names the line it
+/// falls in (1-based, of the uncompressed text: every line before it was handed out) and
+/// how many bytes came before it.
 class TraceFileReader {
  public:
   /// Opens `path`. Throws TraceError ("run.trace: cannot open: No such file or directory").
@@ -34,6 +36,8 @@ class TraceFileReader {
   bool gzip() const { return gz_ != nullptr; }
   /// Bytes handed out so far (uncompressed).
   std::uint64_t offset() const { return offset_; }
+  /// Newlines among them (the line being read is lines() + 1).
+  std::uint64_t lines() const { return lines_; }
   /// The size on disk when it is a regular file, else 0 (a hint for buffers and progress).
   std::uint64_t size_on_disk() const { return size_on_disk_; }
   /// Bytes of the file on disk consumed so far (for a progress bar; compressed bytes for gzip).
@@ -44,7 +48,10 @@ class TraceFileReader {
   std::string path_;
   int fd_ = -1;
   void* gz_ = nullptr;  // gzFile
+  void handed_out(const char* data, std::size_t size);
+
   std::uint64_t offset_ = 0;
+  std::uint64_t lines_ = 0;
   std::uint64_t size_on_disk_ = 0;
 };
 

@@ -488,7 +488,15 @@ NativeTraceWriter::NativeTraceWriter(const std::string& path, NativeWriteOptions
 NativeTraceWriter::NativeTraceWriter(std::ostream& out, bool flush_each_event)
     : NativeTraceWriter(out, NativeWriteOptions{flush_each_event, true}) {}
 
-NativeTraceWriter::NativeTraceWriter(std::ostream& out, NativeWriteOptions options) : out_(&out), options_(options) {}
+NativeTraceWriter::NativeTraceWriter(std::ostream& out, NativeWriteOptions options, std::string name)
+    : out_(&out), out_name_(std::move(name)), options_(options) {}
+
+/// Throws when the stream has failed; errno was cleared before the write, so a value now is its reason.
+void NativeTraceWriter::check_stream() const {
+  if (*out_) return;
+  const int e = errno;
+  throw std::runtime_error(out_name_ + ": write failed" + (e != 0 ? std::string(": ") + std::strerror(e) : std::string()));
+}
 
 NativeTraceWriter::~NativeTraceWriter() {
   try {
@@ -504,8 +512,9 @@ void NativeTraceWriter::finish() {
   if (file_) {
     file_->close();
   } else if (out_ != nullptr) {
+    errno = 0;
     out_->flush();
-    if (!*out_) throw std::runtime_error("trace write failed");
+    check_stream();
   }
 }
 
@@ -515,8 +524,9 @@ void NativeTraceWriter::put(const std::string& text) {
   if (file_) {
     file_->write(text);
   } else {
+    errno = 0;
     out_->write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!*out_) throw std::runtime_error("trace write failed");
+    check_stream();
   }
 }
 
@@ -526,8 +536,9 @@ void NativeTraceWriter::end_event() {
   if (file_) {
     file_->flush();
   } else {
+    errno = 0;
     out_->flush();
-    if (!*out_) throw std::runtime_error("trace write failed");
+    check_stream();
   }
 }
 

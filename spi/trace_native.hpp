@@ -104,9 +104,11 @@ class NativeTraceWriter final : public TraceSink {
   /// Creates or truncates `path`. Throws std::runtime_error when it cannot.
   explicit NativeTraceWriter(const std::string& path, bool flush_each_event = true);
   NativeTraceWriter(const std::string& path, NativeWriteOptions options);
-  /// Writes to `out` (flushed after every event when `flush_each_event`).
+  /// Writes to `out` (flushed after every event when `flush_each_event`). A write error is a
+  /// std::runtime_error of one line naming where the trace was going: `name` ("standard
+  /// output", a file's path), and the reason when the system gave one.
   explicit NativeTraceWriter(std::ostream& out, bool flush_each_event = true);
-  NativeTraceWriter(std::ostream& out, NativeWriteOptions options);
+  NativeTraceWriter(std::ostream& out, NativeWriteOptions options, std::string name = "the output stream");
   /// Writes what is pending (a run in progress) and closes; errors here are lost: call finish().
   ~NativeTraceWriter() override;
   NativeTraceWriter(const NativeTraceWriter&) = delete;
@@ -133,6 +135,7 @@ class NativeTraceWriter final : public TraceSink {
     TraceEvent event() const;
   };
   void put(const std::string& text);
+  void check_stream() const;
   void end_event();
   void write_line(const TraceEvent& e);
   void frame(const TraceEvent& e);
@@ -143,6 +146,7 @@ class NativeTraceWriter final : public TraceSink {
 
   std::unique_ptr<TraceFileWriter> file_;
   std::ostream* out_ = nullptr;
+  std::string out_name_;  // what out_ is, for messages
   NativeWriteOptions options_;
   bool header_written_ = false;
   bool finished_ = false;

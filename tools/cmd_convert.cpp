@@ -1,7 +1,12 @@
 // `l6470emu convert TRACE -o OUT`: native text, VCD (with the emulated chain's pins and
 // positions unless --no-emulation) or umockdev .ioctl.
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <exception>
+#include <iostream>
 #include <memory>
 #include <streambuf>
 #include <string_view>
@@ -23,37 +28,97 @@ bool ends_with(std::string_view s, std::string_view suffix) {
   return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
 }
 
-/// An ostream's buffer over a TraceFileWriter (gzip when the name ends in .gz).
+/// An ostream's buffer over a TraceFileWriter (gzip when the name ends in .gz). A stream
+/// swallows what its buffer throws, so a write error is kept here (error()) with its text
+/// ("out.vcd: write failed: No space left on device") and the stream goes bad.
 class FileBuf final : public std::streambuf {
  public:
   explicit FileBuf(const std::string& path) : file_(path) { setp(buf_, buf_ + sizeof buf_); }
+  /// Keeps what was written before an error elsewhere (the file is then finished by file_).
+  ~FileBuf() override { sync_out(); }
+  /// Writes what is buffered and finishes the file; throws the first write error.
   void close() {
+    if (!error_.empty()) throw std::runtime_error(error_);
     sync_out();
+    if (!error_.empty()) throw std::runtime_error(error_);
     file_.close();
   }
+  /// The first write error, or "".
+  const std::string& error() const { return error_; }
 
  protected:
   int_type overflow(int_type c) override {
-    sync_out();
+    if (!sync_out()) return traits_type::eof();
     if (!traits_type::eq_int_type(c, traits_type::eof())) {
       *pptr() = traits_type::to_char_type(c);
       pbump(1);
     }
     return traits_type::not_eof(c);
   }
-  int sync() override {
-    sync_out();
-    return 0;
-  }
+  int sync() override { return sync_out() ? 0 : -1; }
 
  private:
-  void sync_out() {
-    file_.write(std::string_view(pbase(), static_cast<std::size_t>(pptr() - pbase())));
+  bool sync_out() {
+    if (!error_.empty()) return false;
+    try {
+      file_.write(std::string_view(pbase(), static_cast<std::size_t>(pptr() - pbase())));
+    } catch (const std::exception& e) {
+      error_ = e.what();
+      return false;
+    }
     setp(buf_, buf_ + sizeof buf_);
+    return true;
   }
   TraceFileWriter file_;
+  std::string error_;
   char buf_[1 << 16];
 };
+
+/// An ostream's buffer over standard output's descriptor, keeping the first write error with
+/// its reason ("standard output: write failed: Broken pipe"): std::cout loses errno.
+class StdoutBuf final : public std::streambuf {
+ public:
+  StdoutBuf() { setp(buf_, buf_ + sizeof buf_); }
+  /// Keeps what was written before an error elsewhere.
+  ~StdoutBuf() override { sync_out(); }
+  /// Writes what is buffered; throws the first write error.
+  void close() {
+    if (!sync_out() || !error_.empty()) throw std::runtime_error(error_);
+  }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (!sync_out()) return traits_type::eof();
+    if (!traits_type::eq_int_type(c, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(c);
+      pbump(1);
+    }
+    return traits_type::not_eof(c);
+  }
+  int sync() override { return sync_out() ? 0 : -1; }
+
+ private:
+  bool sync_out() {
+    if (!error_.empty()) return false;
+    const char* p = pbase();
+    while (p < pptr()) {
+      const ssize_t n = ::write(STDOUT_FILENO, p, static_cast<std::size_t>(pptr() - p));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error_ = std::string("standard output: write failed: ") + std::strerror(n < 0 ? errno : EIO);
+        return false;
+      }
+      p += n;
+    }
+    setp(buf_, buf_ + sizeof buf_);
+    return true;
+  }
+  std::string error_;
+  char buf_[1 << 16];
+};
+
+/// Where the output goes, for messages: "standard output" or the path as given.
+std::string output_name(const std::string& output) { return output == "-" ? "standard output" : output; }
 
 }  // namespace
 
@@ -65,17 +130,27 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
     const TraceFile file(args.trace.path, input_options(args.trace));
     print_notes(file.header(), err);
 
-    std::unique_ptr<FileBuf> file_buf;
-    std::ostream file_out(nullptr);
-    std::ostream* dst = &out;
-    if (args.output != "-") {
-      file_buf = std::make_unique<FileBuf>(args.output);  // throws "OUT: cannot create: ..."
-      file_out.rdbuf(file_buf.get());
-      dst = &file_out;
+    const std::string where = output_name(args.output);
+    // The program's standard output is written through its descriptor, so that a write error
+    // has its reason; a test's stream as it is.
+    std::unique_ptr<StdoutBuf> stdout_buf;
+    std::ostream stdout_stream(nullptr);
+    std::ostream* to_stdout = &out;
+    if (args.output == "-" && out.rdbuf() == std::cout.rdbuf()) {
+      std::cout.flush();
+      stdout_buf = std::make_unique<StdoutBuf>();
+      stdout_stream.rdbuf(stdout_buf.get());
+      to_stdout = &stdout_stream;
     }
     if (to == "native") {
-      NativeTraceWriter w(*dst, NativeWriteOptions{false, !args.expand});
+      // A file is written by the writer itself (its errors name the file), standard output
+      // through the stream (its errors say "standard output").
       std::unique_ptr<TraceReader> reader = file.read();
+      const NativeWriteOptions wo{false, !args.expand};
+      std::unique_ptr<NativeTraceWriter> writer = args.output == "-"
+                                                      ? std::make_unique<NativeTraceWriter>(*to_stdout, wo, where)
+                                                      : std::make_unique<NativeTraceWriter>(args.output, wo);
+      NativeTraceWriter& w = *writer;
       TraceHeader h = reader->header();
       if (!args.trace.chain.empty()) h.chain = chain_spec_of(parse_chain_spec(args.trace.chain));
       w.write_header(h);
@@ -85,7 +160,18 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
       while (watched.next(e)) w.write(e);
       bar.finish();
       w.finish();
-    } else if (to == "ioctl") {
+      if (stdout_buf) stdout_buf->close();
+      return kTraceOk;
+    }
+    std::unique_ptr<FileBuf> file_buf;
+    std::ostream file_out(nullptr);
+    std::ostream* dst = to_stdout;
+    if (args.output != "-") {
+      file_buf = std::make_unique<FileBuf>(args.output);  // throws "OUT: cannot create: ..."
+      file_out.rdbuf(file_buf.get());
+      dst = &file_out;
+    }
+    if (to == "ioctl") {
       std::unique_ptr<TraceReader> reader = file.read();
       const UmockdevExportStats s = export_umockdev_ioctl(*reader, *dst, args.device);
       if (s.frames_without_miso)
@@ -104,9 +190,16 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
         err << "l6470emu: BUSY, FLAG and ABS_POS from an emulated chain " << chain_spec_of(chain) << " (" << how << ")\n";
       }
     }
+    errno = 0;
     dst->flush();
-    if (!*dst) throw std::runtime_error(args.output + ": write failed");
-    if (file_buf) file_buf->close();
+    if (file_buf) {
+      file_buf->close();  // throws "OUT: write failed: <reason>"
+    } else if (stdout_buf) {
+      stdout_buf->close();  // throws "standard output: write failed: <reason>"
+    } else if (!*dst) {
+      const int e = errno;
+      throw std::runtime_error(where + ": write failed" + (e != 0 ? std::string(": ") + std::strerror(e) : std::string()));
+    }
     return kTraceOk;
   } catch (const std::exception& e) {
     err << "l6470emu convert: " << e.what() << "\n";

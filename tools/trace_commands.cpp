@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -109,7 +110,12 @@ void add_trace_commands(CLI::App& app) {
   c->add_flag("--no-emulation", convert->no_emulation, "VCD: only the trace's own signals, no emulated BUSY/FLAG/ABS_POS");
   c->add_flag("--expand", convert->expand,
               "native: one line per frame (by default frames repeated at a constant period become 'repeat' lines)");
-  c->callback([convert] { finish(run_convert(*convert, std::cout, std::cerr)); });
+  c->callback([convert] {
+    // A reader that goes away (`convert -o - | head`) is a write error with a message and
+    // exit status 2, not a silent death by SIGPIPE.
+    std::signal(SIGPIPE, SIG_IGN);
+    finish(run_convert(*convert, std::cout, std::cerr));
+  });
 }
 
 }  // namespace l6470emu

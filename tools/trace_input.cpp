@@ -36,6 +36,8 @@ bool ends_with(const std::string& s, const std::string& suffix) {
 TraceFormat format_of(const std::string& path, const TraceInputOptions& options) {
   if (options.format != TraceFormat::unknown) return options.format;
   const std::string head = read_trace_file_head(path, 64 * 1024);
+  if (head.empty() && !ends_with(path, ".sr"))
+    throw TraceError(path, 0, "empty file (no trace in it: a capture that was never written, or cut to nothing)");
   const TraceFormat f = detect_trace_format(head, without_gz(path));
   if (f == TraceFormat::unknown)
     throw TraceError(path, 0,

@@ -13,6 +13,7 @@
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/decode.hpp"
 #include "daisychain/replay.hpp"
+#include "spi/trace_file.hpp"
 #include "spi/trace_import.hpp"
 #include "spi/trace_native.hpp"
 #include "tools/trace_input.hpp"
@@ -60,7 +61,22 @@ PyTraceEvent event_of(const TraceEvent& e) {
 struct DecodeResult {
   DecodeSummary summary;
   std::string text;
+  std::string number_from, numbering;  // how the log counts the chips: "miso"/"mosi", and in words
 };
+
+/// replay()'s answer: the replay's, and how its reports count the chips.
+struct PyReplayResult : ReplayResult {
+  std::string number_from, numbering;
+};
+
+/// A number_from= argument: "miso" or "mosi" (ValueError naming the argument otherwise).
+NumberFrom number_from_arg(const std::string& text) {
+  try {
+    return parse_number_from(text);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(std::string("number_from: ") + e.what());
+  }
+}
 
 }  // namespace
 
@@ -129,12 +145,12 @@ text; a Chain made with record=True gives one as Chain.trace.)")
           "Reads a trace from text (any text format; recognised from the content when format is None).")
       .def("save", [](const Trace& t, py::handle path) {
              const std::string p = path_from(path, "path");
-             std::ofstream out(p, std::ios::binary | std::ios::trunc);
-             if (!out) throw std::runtime_error("cannot create " + p);
-             out << to_native_text(t);
-             if (!out.flush()) throw std::runtime_error("cannot write " + p);
+             const std::string text = to_native_text(t);
+             TraceFileWriter out(p);  // errors: "PATH: cannot create: REASON", "PATH: write failed: REASON"
+             out.write(text);
+             out.close();
            },
-           py::arg("path"), "Writes the trace as a native trace file.")
+           py::arg("path"), "Writes the trace as a native trace file (gzip-compressed when the name ends in .gz).")
       .def("to_native", [](const Trace& t) { return to_native_text(t); }, "The trace as native text.")
       .def("__len__", &Trace::size, "Number of events.")
       .def("__getitem__",
@@ -176,7 +192,7 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def("__str__", [](const Divergence& d) { return d.report; })
       .def("__repr__", [](const Divergence& d) { return "Divergence(" + d.summary + ")"; });
 
-  py::class_<ReplayResult>(m, "ReplayResult", "What a replay did; true when every captured byte and pin matched.")
+  py::class_<PyReplayResult>(m, "ReplayResult", "What a replay did; true when every captured byte and pin matched.")
       .def_property_readonly("matched", &ReplayResult::matched, "every captured MISO byte and pin level matched")
       .def("__bool__", &ReplayResult::matched)
       .def_readonly("frames", &ReplayResult::frames, "frames replayed")
@@ -187,7 +203,9 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def_readonly("pin_mismatches", &ReplayResult::pin_mismatches, "BUSY/FLAG observations that differed")
       .def_readonly("stopped_early", &ReplayResult::stopped_early, "stopped at the first divergence")
       .def_readonly("divergences", &ReplayResult::divergences, "the reported divergences")
-      .def("__repr__", [](const ReplayResult& r) {
+      .def_readonly("number_from", &PyReplayResult::number_from, "how the reports count the chips: \"miso\" or \"mosi\"")
+      .def_readonly("numbering", &PyReplayResult::numbering, "what the reports' chip numbers mean, in words")
+      .def("__repr__", [](const PyReplayResult& r) {
         return std::string("ReplayResult(") + (r.matched() ? "matched" : "diverged") + ", " + std::to_string(r.frames) +
                " frames, " + std::to_string(r.bytes_compared) + " bytes compared)";
       });
@@ -205,6 +223,8 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def_property_readonly("answer_mismatches", [](const DecodeResult& d) { return d.summary.answer_mismatches; },
                              "captured answers the emulator would give differently")
       .def_readonly("text", &DecodeResult::text, "the log, one line per command, answer or diagnostic")
+      .def_readonly("number_from", &DecodeResult::number_from, "how the log counts the chips: \"miso\" or \"mosi\"")
+      .def_readonly("numbering", &DecodeResult::numbering, "what the log's chip numbers mean, in words")
       .def("__str__", [](const DecodeResult& d) { return d.text; })
       .def("__repr__", [](const DecodeResult& d) {
         return "DecodeResult(" + std::to_string(d.summary.frames) + " frames, " + std::to_string(d.summary.commands) +
@@ -214,34 +234,45 @@ text; a Chain made with record=True gives one as Chain.trace.)")
   m.def(
       "replay",
       [](py::handle trace, py::handle chain, py::handle format, bool keep_going, std::size_t max_reports,
-         bool compare_pins) {
-        const Source s = source_of(trace, chain, format);
+         bool compare_pins, const std::string& number_from) {
         ReplayOptions o;
+        o.number_from = number_from_arg(number_from);
+        const Source s = source_of(trace, chain, format);
         o.keep_going = keep_going;
         o.max_reports = max_reports;
         o.compare_pins = compare_pins;
+        PyReplayResult result;
+        result.number_from = to_string(o.number_from);
+        result.numbering = describe_numbering(o.number_from);
         py::gil_scoped_release unlocked;
         Chain c = make_chain(s.variants);
         auto reader = s.reader();
-        return replay_trace(*reader, c, o);
+        static_cast<ReplayResult&>(result) = replay_trace(*reader, c, o);
+        return result;
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("keep_going") = false, py::arg("max_reports") = 100, py::arg("compare_pins") = true,
+      py::arg("number_from") = "miso",
       R"(Drives a trace's MOSI into a fresh emulated chain with the captured timing and compares every
 MISO byte (and BUSY/FLAG observation). trace: a Trace or a file path. chain: the chain
-(default: the trace's own; for a file without one, guessed from its frame lengths).)");
+(default: the trace's own; for a file without one, guessed from its frame lengths), chip 0
+at the MISO end as in trace files. number_from: which end the reports call chip 0, "miso"
+(chip 0 drives MISO, the default) or "mosi" (chip 0 reads the host's MOSI).)");
 
   m.def(
       "decode",
       [](py::handle trace, py::handle chain, py::handle format, bool show_nops, std::size_t max_repeats,
-         py::object only_chip) {
-        const Source s = source_of(trace, chain, format);
+         py::object only_chip, const std::string& number_from) {
         DecodeOptions o;
+        o.number_from = number_from_arg(number_from);
+        const Source s = source_of(trace, chain, format);
         o.show_nops = show_nops;
         o.max_repeats = max_repeats;
         if (!only_chip.is_none())
           o.only_chip = static_cast<int>(int_in_range(only_chip, "only_chip", 0, static_cast<long long>(s.variants.size()) - 1));
         DecodeResult result;
+        result.number_from = to_string(o.number_from);
+        result.numbering = describe_numbering(o.number_from);
         {
           py::gil_scoped_release unlocked;
           std::ostringstream text;
@@ -254,7 +285,10 @@ MISO byte (and BUSY/FLAG observation). trace: a Trace or a file path. chain: the
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("show_nops") = false, py::arg("max_repeats") = 10, py::arg("only_chip") = py::none(),
-      "Explains a trace: every command and answer per chip, with protocol diagnostics (as `l6470emu decode`).");
+      py::arg("number_from") = "miso",
+      R"(Explains a trace: every command and answer per chip, with protocol diagnostics (as `l6470emu decode`).
+number_from: which end the log calls chip 0, "miso" (chip 0 drives MISO, the default) or "mosi"
+(chip 0 reads the host's MOSI); only_chip is a number in the same convention.)");
 }
 
 }  // namespace l6470emu::python

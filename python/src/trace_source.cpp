@@ -33,6 +33,14 @@ Source source_of(py::handle trace, py::handle chain, py::handle format, const st
     return s;
   }
   const std::string path = path_from(trace, "trace");
+  if (!spec.empty()) {
+    // Checked here so that the message names the argument (chain_for_trace names "--chain").
+    try {
+      parse_chain_spec(spec);
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(std::string("chain: ") + e.what());
+    }
+  }
   TraceInputOptions options;
   options.format = format_arg(py::reinterpret_borrow<py::object>(format));
   options.import.select = select;

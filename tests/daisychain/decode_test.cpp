@@ -213,3 +213,37 @@ TEST(DecodeOutputs, MarksBusyAndFlagLevelsAsSeenAtNotAsExactEdges) {
 
 }  // namespace
 }  // namespace l6470emu
+
+namespace l6470emu {
+namespace {
+
+/// The chip numbers of the lines of `log` that start with `stamp`, in order.
+std::string chips_at(const std::string& log, const std::string& stamp) {
+  std::string order;
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind(stamp, 0) == 0) order += line.substr(stamp.size() + 7, 1);  // "  chip N"
+  return order;
+}
+
+TEST(DecodeOrder, ListsTheLinesOfOneTimeInTheUsersChipOrder) {
+  // Each chip's BUSY is looked at together, then one frame gives each chip a SoftStop.
+  const std::string text =
+      "l6470emu-trace 1\n"
+      "0.00000000 pin 0 BUSY 1\n"
+      "0.00000000 pin 1 BUSY 1\n"
+      "0.00000000 pin 2 BUSY 1\n"
+      "0.00001500 frame 5.75us B0 B0 B0 | 00 00 00\n";
+  const std::string miso = decode_text(text, "3").log;
+  EXPECT_EQ(chips_at(miso, "t=0.000000 s"), "012") << miso;
+  EXPECT_EQ(chips_at(miso, "t=0.000015 s"), "012") << miso;
+  DecodeOptions o;
+  o.number_from = NumberFrom::mosi;
+  // Counted from the MOSI end, the chain's chip 2 is chip 0: it is listed first all the same.
+  const std::string mosi = decode_text(text, "3", o).log;
+  EXPECT_EQ(chips_at(mosi, "t=0.000000 s"), "012") << mosi;
+  EXPECT_EQ(chips_at(mosi, "t=0.000015 s"), "012") << mosi;
+}
+
+}  // namespace
+}  // namespace l6470emu

@@ -130,3 +130,54 @@ def test_malformed_input_is_a_trace_error_with_file_and_line(tmp_path):
         l6470emu.Trace.load(bad, format="pcap")
     with pytest.raises(RuntimeError, match="record"):
         l6470emu.Chain(record=tmp_path / "no" / "such" / "dir.trace")
+
+
+def test_decode_and_replay_number_chips_from_either_end_and_say_which():
+    miso = l6470emu.decode(FIXTURES / "three_chips.trace")
+    mosi = l6470emu.decode(FIXTURES / "three_chips.trace", number_from="mosi")
+    assert miso.number_from == "miso" and "count from the MISO end" in miso.numbering
+    assert mosi.number_from == "mosi" and "count from the MOSI end" in mosi.numbering
+    # The thermal warning was on the chain's chip 2, nearest the host's MOSI.
+    assert "chip 2   fault THERMAL warning" in miso.text
+    assert "chip 0   fault THERMAL warning" in mosi.text
+    only = l6470emu.decode(FIXTURES / "three_chips.trace", number_from="mosi", only_chip=0).text
+    assert "fault THERMAL warning" in only and "chip 2 " not in only
+    # Lines of one time come in the user's order.
+    at = [line for line in mosi.text.splitlines() if line.startswith("t=0.001047 s")]
+    assert [line.split()[3] for line in at] == ["0", "1", "2"]
+    result = l6470emu.replay(FIXTURES / "ftrace_spi_set_cs.txt", chain="3", number_from="mosi")
+    assert not result.matched and result.number_from == "mosi"
+    assert "byte 0: chip 2: byte 3 of 3 of the GetParam(ABS_POS) answer" in result.divergences[0].report
+
+
+@pytest.mark.parametrize("call", [l6470emu.decode, l6470emu.replay])
+def test_an_unknown_numbering_is_a_value_error_naming_the_argument(call):
+    with pytest.raises(ValueError, match="number_from: 'x' is not a chip numbering"):
+        call(FIXTURES / "three_chips.trace", number_from="x")
+
+
+def test_a_bad_chain_argument_names_the_argument_not_a_command_line_option():
+    with pytest.raises(ValueError, match='^chain: unknown chip variant "L6499"'):
+        l6470emu.replay(FIXTURES / "three_chips.trace", chain="3*L6499")
+
+
+def test_errors_name_the_file_and_line(tmp_path):
+    bad = tmp_path / "bad.trace"
+    bad.write_text("l6470emu-trace 1\n0.001 frame 00 | 00\n0.002 frame 0G | 00\n")
+    with pytest.raises(l6470emu.TraceError) as e:
+        l6470emu.decode(bad)
+    assert e.value.file == str(bad) and e.value.line == 3
+    assert str(e.value) == f'{bad}:3: MOSI "0G" is not a byte (two hex digits)'
+    empty = tmp_path / "empty.trace"
+    empty.write_bytes(b"")
+    with pytest.raises(l6470emu.TraceError, match="empty file"):
+        l6470emu.Trace.load(empty)
+
+
+def test_save_names_the_file_and_the_reason(tmp_path):
+    trace = l6470emu.Trace.load(FIXTURES / "three_chips.trace")
+    with pytest.raises(RuntimeError, match=f"^{tmp_path}/no/such/dir.trace: cannot create: No such file or directory$"):
+        trace.save(tmp_path / "no" / "such" / "dir.trace")
+    trace.save(tmp_path / "t.trace.gz")
+    assert (tmp_path / "t.trace.gz").read_bytes()[:2] == b"\x1f\x8b"
+    assert len(l6470emu.Trace.load(tmp_path / "t.trace.gz")) == len(trace)

@@ -2,6 +2,10 @@
 // cmd_convert.cpp): exit statuses, what is printed, conversions, and one-line errors
 // with the file and line for bad input.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
 
 #include "support/trace_test_support.hpp"
 
@@ -173,6 +177,108 @@ TEST(TraceCommands, RejectAnUnknownNumberingInOneLineWithStatusTwo) {
                          ": --number-from: 'x' is not a chip numbering: write miso (chip 0 drives MISO) or mosi "
                          "(chip 0 reads the host's MOSI)\n");
   }
+}
+
+/// How many lines `text` has.
+std::size_t lines_in(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+
+TEST(ConvertCommand, NamesWhereItWasWritingWhenAWriteFails) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "no /dev/full";
+  const std::string in = fixture_path("polling_host.trace");
+  RunResult r = l6470emu("convert --expand " + in + " -o /dev/full");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: /dev/full: write failed: No space left on device\n");
+  // Standard error to the pipe, standard output to the full disk.
+  r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert --expand " + in + " -o - >/dev/full; }");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: standard output: write failed: No space left on device\n");
+  r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert --to ioctl " + in + " -o - >/dev/full; }");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: standard output: write failed: No space left on device\n");
+}
+
+TEST(ConvertCommand, SaysSoInOneLineWhenItsReaderGoesAway) {
+  test::TempDir dir;
+  // The reader takes 10 bytes of a 100 kB output and closes the pipe.
+  const std::string cmd = "(" + std::string(L6470EMU_BINARY) + " convert --expand " + fixture_path("polling_host.trace") +
+                          " -o - 2>" + dir.file("err") + "; echo $? >" + dir.file("status") + ") | head -c 10 >/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(test::read_text(dir.file("status")), "2\n");
+  EXPECT_EQ(test::read_text(dir.file("err")), "l6470emu convert: standard output: write failed: Broken pipe\n");
+}
+
+TEST(ConvertCommand, KeepsWhatItWroteBeforeABadLine) {
+  test::TempDir dir;
+  const std::string bad = dir.write("bad.trace", "l6470emu-trace 1\n0.001 frame 00 | 00\n0.002 frame ZZ | 00\n");
+  RunResult r = l6470emu("convert " + bad + " -o " + dir.file("out.trace"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: " + bad + ":3: MOSI \"ZZ\" is not a byte (two hex digits)\n");
+  EXPECT_EQ(test::read_text(dir.file("out.trace")), "l6470emu-trace 1\n0.00100000 frame 0.00us 00 | 00\n");
+  r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert " + bad + " -o - 2>/dev/null; }");
+  EXPECT_EQ(r.out, "l6470emu-trace 1\n0.00100000 frame 0.00us 00 | 00\n");
+}
+
+TEST(TraceCommands, NameTheLineWhereGzipDataIsDamaged) {
+  test::TempDir dir;
+  ASSERT_EQ(l6470emu("convert --expand " + fixture_path("polling_host.trace") + " -o " + dir.file("p.trace.gz")).status, 0);
+  std::string data = test::read_text(dir.file("p.trace.gz"));
+  data[data.size() - 8] = static_cast<char>(data[data.size() - 8] ^ 0x5A);  // the CRC-32 of the text: checked at the end
+  const std::string bad = dir.write("bad.trace.gz", data);
+  const RunResult r = l6470emu("replay " + bad);
+  EXPECT_EQ(r.status, 2) << r.out;
+  // The last line of the output is the error: the file, the (uncompressed) line, the bytes before it.
+  const std::string last = r.out.substr(r.out.rfind("l6470emu replay: "));
+  EXPECT_EQ(lines_in(last), 1u) << r.out;
+  EXPECT_EQ(last.find("l6470emu replay: " + bad + ":"), 0u) << last;
+  EXPECT_NE(last.find(": damaged gzip data after "), std::string::npos) << last;
+  EXPECT_EQ(last.find("<fd:"), std::string::npos) << last;  // zlib's name for the descriptor is no help
+  const std::size_t line = std::stoul(last.substr(("l6470emu replay: " + bad + ":").size()));
+  EXPECT_GT(line, 3000u) << last;
+  // A file damaged at its very start: line 1.
+  std::string head = test::read_text(dir.file("p.trace.gz"));
+  for (std::size_t i = 12; i < 40; ++i) head[i] = static_cast<char>(head[i] ^ 0x5A);
+  const RunResult first = l6470emu("decode " + dir.write("head.trace.gz", head));
+  EXPECT_EQ(first.status, 2);
+  EXPECT_EQ(first.out.find("l6470emu decode: " + dir.file("head.trace.gz") + ":1: "), 0u) << first.out;
+}
+
+TEST(TraceCommands, GiveOneLineForEmptyBinaryAndNonTraceFiles) {
+  test::TempDir dir;
+  std::string binary;
+  for (int i = 0; i < 4096; ++i) binary += static_cast<char>((i * 7919) & 0xFF);
+  const std::string sr = dir.write("capture.sr", "PK\x03\x04" + binary);
+  struct Case {
+    std::string path, says;
+  } cases[] = {
+      {dir.write("empty.trace", ""), ": empty file"},
+      {dir.write("noise.bin", binary), ": unknown trace format"},
+      {sr, "capture.sr: "},
+      {dir.file("."), ": cannot read: it is a directory"},
+  };
+  for (const Case& c : cases) {
+    const RunResult r = l6470emu("decode " + c.path);
+    EXPECT_EQ(r.status, 2) << c.path << "\n" << r.out;
+    EXPECT_EQ(lines_in(r.out), 1u) << r.out;
+    EXPECT_EQ(r.out.find("l6470emu decode: " + c.path), 0u) << r.out;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << r.out;
+  }
+}
+
+TEST(TraceCommands, NameTheChainItemThatIsWrong) {
+  const RunResult r = l6470emu("decode --chain 2,3* " + fixture_path("three_chips.trace"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu decode: --chain: chain item \"3*\" has no variant after '*' (N*VARIANT, e.g. 3*L6470)\n");
+}
+
+TEST(DecodeCommand, ListsTheChipsOfOneTimeInTheOrderTheyAreNumbered) {
+  const RunResult r = l6470emu("decode --number-from mosi " + fixture_path("three_chips.trace"));
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto c0 = r.out.find("t=0.001047 s  chip 0   SetParam(ACC");
+  const auto c1 = r.out.find("t=0.001047 s  chip 1   SetParam(MAX_SPEED");
+  const auto c2 = r.out.find("t=0.001047 s  chip 2   SetParam(CONFIG");
+  ASSERT_NE(c0, std::string::npos) << r.out;
+  EXPECT_LT(c0, c1) << r.out;
+  EXPECT_LT(c1, c2) << r.out;
 }
 
 }  // namespace
