@@ -26,6 +26,7 @@ Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host) : l
     std::vector<Chip> chips;
     chips.reserve(cc.chips.size());
     for (const Variant* v : cc.chips) chips.emplace_back(*v);
+    for (const auto& [k, spec] : cc.axes) chips.at(k).attach_axis(spec);
     auto cd = std::make_unique<ChainDev>(cc, std::move(chips));
     cd->name = cc.path.substr(cc.path.rfind('/') + 1);
     cd->spi.mode = cc.mode;
