@@ -161,7 +161,8 @@ bool Axis::settle(const MotionState& s, const Profile& p, Tick now) {
     }
   }
   bool changed = synced_ != was_synced || (synced_ ? offset_ : stall_pos_) != was_at;
-  observe(s, p);
+  cmd_ = cmd;
+  true_pos_ = synced_ ? clamp(cmd_ + offset_) : stall_pos_;
 
   bool level = true;
   for (std::size_t i = 0; i < switches_.size(); ++i) {

@@ -27,7 +27,7 @@ class Axis {
 
   const AxisSpec& spec() const { return spec_; }
 
-  // ---- observations (as of the last observe()/settle()) ------------------------------
+  // ---- observations (as of the last observe(); Chip::axis() calls it) ------------------
 
   /// The rotor's true position, 1/128 step.
   std::int64_t true_position() const { return true_pos_; }

@@ -696,6 +696,11 @@ void Chip::axis_settle(Tick at) {
   }
 }
 
+bool Chip::axis_quiet_through_now() const {
+  if (motion_active(motion_)) return run_.known && axis_event_known_ && now_ < axis_event_at_;
+  return axis_->next_time_event() > now_;
+}
+
 void Chip::sync_with_axis() {
   Tick t = motion_now_;
   Tick left = now_ - t;
@@ -703,7 +708,7 @@ void Chip::sync_with_axis() {
   while (left > 0) {
     if (!motion_active(motion_)) {
       // Standing still: only switch bounce edges happen on their own.
-      const Tick e = axis_->next_time_event();
+      const Tick e = std::max(axis_->next_time_event(), t + 1);
       if (e == kNever || e > t + left) break;
       left -= e - t;
       t = e;

@@ -218,8 +218,11 @@ class Chip {
   void sync() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
   bool status_known_without_sync() const {
-    return !axis_ && live_bits_known_ && (!motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left));
+    if (!live_bits_known_ || (axis_ && !axis_quiet_through_now())) return false;
+    return !motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left);
   }
+  /// With an axis: whether no mechanical event can have happened between the last sync and now().
+  bool axis_quiet_through_now() const;
   /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
   void touched() const {
     run_.known = false;
