@@ -309,5 +309,42 @@ TEST(AxisPhysics, ANormallyClosedSwitchWithBounceChattersThenSettles) {
   EXPECT_TRUE(level) << "settled open";
 }
 
+TEST(AxisPhysics, NextEventTickIncludesAPendingBounceEdgeWhileTheMotorStands) {
+  AxisSpec spec;
+  SwitchSpec sw;
+  sw.position = 0;
+  sw.bounce_count = 1;
+  sw.bounce_ticks = 1000;
+  spec.switches.push_back(sw);
+  spec.start_position = 2 * kStep;
+  Rig r(spec);
+  r.host.hard_hiz(0);
+  r.host.set_param(0, Reg::CONFIG, 0x2E88 | 0x10);
+  r.host.run(0, false, test::spd_from_steps_per_s(50));
+  while (r.chip().sw_pin()) r.chain.advance_to(r.chain.now() + 1);
+  const Tick closed = r.chain.now();
+  r.host.hard_stop(0);
+  EXPECT_EQ(r.chip().next_event_tick(), closed + 1000) << "the contact reverts once, 1000 ticks later";
+  r.chain.advance_to(closed + 1000);
+  EXPECT_TRUE(r.chip().sw_pin());
+  EXPECT_EQ(r.chip().next_event_tick(), closed + 2000);
+  r.chain.advance_to(closed + 2000);
+  EXPECT_FALSE(r.chip().sw_pin());
+  EXPECT_EQ(r.chip().next_event_tick(), kNever);
+}
+
+TEST(AxisPhysics, CopyingAChipCopiesItsAxisAndTheCopiesGoTheirOwnWays) {
+  Chip a;
+  a.attach_axis(AxisSpec{});
+  a.on_byte(0xD0);  // GetStatus: clear the power-up flag
+  Chip b = a;
+  for (std::uint8_t x : {0x51, 0x00, 0x10, 0x00}) b.on_byte(x);  // Run forward
+  a.advance_to(ticks_from_ms(100));
+  b.advance_to(ticks_from_ms(100));
+  EXPECT_EQ(a.axis()->true_position(), 0);
+  EXPECT_GT(b.axis()->true_position(), 0);
+  EXPECT_EQ(b.axis()->true_position(), b.position());
+}
+
 }  // namespace
 }  // namespace l6470emu
