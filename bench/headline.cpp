@@ -210,6 +210,16 @@ int main(int argc, char** argv) {
       std::printf("  warning: %llu polls showed NOTPERF_CMD/WRONG_CMD\n", static_cast<unsigned long long>(r.stats.cmd_errors));
   }
   std::printf("  fast engine / reference engine: %.0fx\n", ratios[1] / ratios[0]);
+  {
+    // The same with a mechanical axis behind every chip (bench_axis(): motor, load, stops, switch).
+    MotionWorkload axes(kMotionChips, Engine::fast, 0x6470, /*axes=*/true);
+    const MotionResult r = measure_motion(axes, Engine::fast, seconds);
+    std::size_t lost = 0;
+    for (std::size_t k = 0; k < axes.chips(); ++k) lost += axes.chain().chip(k).axis()->lost_steps() != 0;
+    std::printf("  %-10s  %13.0fx  %9.3f  %9.3f  %6llu  %5llu  (%zu of %zu axes lost steps; costs %.2fx the time without axes)\n",
+                "fast+axes", r.ratio(), r.sim_seconds, r.wall_seconds, static_cast<unsigned long long>(r.stats.moves_done),
+                static_cast<unsigned long long>(r.stats.runs_done), lost, axes.chips(), ratios[1] / r.ratio());
+  }
   // The fast row only counts if the fast engine did the same work: replay the reference run's
   // simulated time with the fast engine and compare every chip's motion state and STATUS.
   {

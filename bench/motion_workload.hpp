@@ -35,6 +35,23 @@ Chain make_chain(std::size_t n, Engine engine) {
   return chain;
 }
 
+/// The mechanics each chip gets when a workload runs with axes: a default NEMA-17 with a light
+/// load, hard stops and a switch far out (so every jump also looks for position events) and
+/// the chip's reset KVAL/BEMF registers, so fast profiles lose steps and stall as they would.
+inline AxisSpec bench_axis() {
+  AxisSpec spec;
+  spec.load.friction_uNm = 10'000;
+  spec.load.inertia_g_mm2 = 5'000;
+  spec.has_lower_stop = spec.has_upper_stop = true;
+  spec.lower_stop = -(std::int64_t{1} << 30);
+  spec.upper_stop = std::int64_t{1} << 30;
+  SwitchSpec home;
+  home.position = -(std::int64_t{1} << 29);
+  home.hysteresis = 16;
+  spec.switches.push_back(home);
+  return spec;
+}
+
 /// Host-side view of one axis: what the host last told it to do.
 struct Axis {
   enum class Phase : std::uint8_t { idle, moving, running, stopping } phase = Phase::idle;
@@ -60,7 +77,8 @@ class MotionWorkload {
   static constexpr Tick kPollPeriod = ticks_from_ms(1);
   static constexpr std::uint32_t kSckHz = 5'000'000;
 
-  MotionWorkload(std::size_t chips, Engine engine, std::uint64_t seed = 0x6470)
+  /// With `axes`, every chip has bench_axis() behind it.
+  MotionWorkload(std::size_t chips, Engine engine, std::uint64_t seed = 0x6470, bool axes = false)
       : chain_(make_chain(chips, engine)),
         rng_(seed),
         axes_(chips),
@@ -71,6 +89,8 @@ class MotionWorkload {
         nops_(chips, 0x00),
         frame_ticks_(transfer_ticks(static_cast<std::uint32_t>(chips), kSckHz) + BusTiming{}.cs_high_ticks) {
     for (auto& f : cmd_) f.assign(chips, 0x00);
+    if (axes)
+      for (std::size_t k = 0; k < chips; ++k) chain_.chip(k).attach_axis(bench_axis());
     const StatusLayout& layout = chain_.chip(0).variant().status;
     busy_bit_ = 1u << layout.busy;
     mot_shift_ = static_cast<unsigned>(layout.mot_status);

@@ -36,7 +36,9 @@ void Chip::reset_logic() {
   touched();
   table_ = variant_;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
+  const std::int64_t travel = motion_.travel;  // the shaft does not move with a reset
   motion_ = MotionState{};
+  motion_.travel = travel;
   refresh_profile();
   collecting_ = false;
   args_seen_ = 0;
@@ -76,6 +78,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
     if (++args_seen_ == pending_.arg_bytes) {
       collecting_ = false;
       execute(pending_, arg_);
+      if (axis_) axis_after_change();
     }
     return next_response_byte();
   }
@@ -103,6 +106,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
         arg_ = 0;
       } else {
         execute(op, 0);
+        if (axis_) axis_after_change();
       }
       break;
   }
@@ -358,6 +362,12 @@ void Chip::not_performable(const char* what) {
 
 void Chip::sync() const {
   if (motion_now_ >= now_) return;
+  if (axis_) {
+    // Axis events change the chip's inputs (SW, stall, overcurrent): not a const affair, but
+    // a Chip is never const-constructed where an axis can be attached.
+    const_cast<Chip*>(this)->sync_with_axis();
+    return;
+  }
   Tick left = now_ - motion_now_;
   motion_now_ = now_;
   if (!motion_active(motion_)) return;
@@ -369,7 +379,10 @@ void Chip::sync() const {
   if (fast_advance(motion_, profile_, left, run_)) live_bits_known_ = false;
 }
 
-Tick Chip::next_event_tick() const { return motion_active(motion()) ? now_ + 1 : kNever; }
+Tick Chip::next_event_tick() const {
+  if (motion_active(motion())) return now_ + 1;
+  return axis_ ? axis_->next_time_event() : kNever;
+}
 
 // ---------------------------------------------------------------- pins
 
@@ -385,6 +398,7 @@ bool Chip::busy_sync_pin() const {
 }
 
 bool Chip::flag_pin() const {
+  if (axis_) sync();  // a mechanical event may have latched a flag since
   const std::uint32_t enabled = reg(Reg::ALARM_EN);
   const AlarmFlags& a = latched_;
   for (unsigned bit = 0; bit < 8; ++bit) {
@@ -454,6 +468,7 @@ void Chip::set_stck_pin(bool level) {
   const bool rising = level && !stck_level_;
   stck_level_ = level;
   if (rising && stby_level_ && motion_.activity == Activity::step_clock) take_microstep(motion_, profile_);
+  if (axis_) axis_after_change();
 }
 
 void Chip::set_stby_rst_pin(bool level) {
@@ -463,6 +478,7 @@ void Chip::set_stby_rst_pin(bool level) {
   stby_level_ = level;
   reset_logic();
   if (level) come_out_of_reset();
+  if (axis_) axis_after_change();
 }
 
 void Chip::set_adc_input(std::uint8_t code) { adc_code_ = std::min<std::uint8_t>(code, 31); }
@@ -486,6 +502,7 @@ void Chip::set_undervoltage(bool active) {
   if (active) latched_.uvlo = true;
   latched_changed();
   apply_forced_hiz();
+  if (axis_) axis_after_change();
 }
 
 void Chip::set_adc_undervoltage(bool active) {
@@ -506,6 +523,7 @@ void Chip::set_thermal(Thermal t) {
   latched_.thermal = std::max(latched_.thermal, t);
   latched_changed();
   apply_forced_hiz();
+  if (axis_) axis_after_change();
 }
 
 void Chip::set_overcurrent(bool active) {
@@ -557,6 +575,188 @@ std::string Chip::dump() const {
     out += '\n';
   }
   return out;
+}
+
+// ---------------------------------------------------------------- the mechanical axis
+
+namespace {
+// Longest stretch searched for an axis event at once (about 4.8 h of chip time): keeps the
+// closed-form positions far from overflow; a longer quiet run is searched again after it.
+constexpr Tick kAxisHorizon = Tick{1} << 36;
+}  // namespace
+
+void Chip::attach_axis(const AxisSpec& spec) {
+  sync();
+  touched();
+  axis_ = ValuePtr<Axis>(std::make_unique<Axis>(spec, motion_.travel));
+  axis_sw_ = sw_level_;
+  axis_stall_ = false;
+  axis_ocd_ = false;
+  axis_event_known_ = false;
+  axis_after_change();
+}
+
+void Chip::detach_axis() {
+  sync();
+  touched();
+  axis_.reset();
+}
+
+const Axis* Chip::axis() const {
+  if (!axis_) return nullptr;
+  sync();
+  axis_->observe(motion_, profile_);
+  return axis_.get();
+}
+
+void Chip::set_axis_load(const LoadSpec& load) {
+  if (!axis_) return;
+  sync();
+  touched();
+  axis_->set_load(load);
+  axis_event_known_ = false;
+  axis_settle(now_);
+}
+
+DriveInputs Chip::drive_inputs() const {
+  auto value = [&](Reg id) -> std::uint32_t {
+    const RegisterInfo* r = table_->find(id);
+    return r ? regs_[r->address] & r->mask() : 0;
+  };
+  const bool gate_driver = variant_->has(Reg::GATECFG1);
+  DriveInputs d;
+  if (table_->has(Reg::TVAL_RUN)) {
+    d.mode = gate_driver ? DriveMode::current_sense : DriveMode::current_ma;
+    d.level = {static_cast<std::uint8_t>(value(Reg::TVAL_HOLD)), static_cast<std::uint8_t>(value(Reg::TVAL_RUN)),
+               static_cast<std::uint8_t>(value(Reg::TVAL_ACC)), static_cast<std::uint8_t>(value(Reg::TVAL_DEC))};
+  } else {
+    d.mode = DriveMode::voltage;
+    d.level = {static_cast<std::uint8_t>(value(Reg::KVAL_HOLD)), static_cast<std::uint8_t>(value(Reg::KVAL_RUN)),
+               static_cast<std::uint8_t>(value(Reg::KVAL_ACC)), static_cast<std::uint8_t>(value(Reg::KVAL_DEC))};
+    d.st_slp = static_cast<std::uint8_t>(value(Reg::ST_SLP));
+    d.fn_slp_acc = static_cast<std::uint8_t>(value(Reg::FN_SLP_ACC));
+    d.fn_slp_dec = static_cast<std::uint8_t>(value(Reg::FN_SLP_DEC));
+    d.int_speed = static_cast<std::uint16_t>(value(Reg::INT_SPEED));
+    d.k_therm = static_cast<std::uint8_t>(value(Reg::K_THERM));
+  }
+  if (table_->has(Reg::STALL_TH)) {
+    d.stall_kind = gate_driver ? Comparator::vds_31mV : Comparator::current_31mA;
+    d.stall_th = static_cast<std::uint8_t>(value(Reg::STALL_TH));
+  }
+  if (table_->has(Reg::OCD_TH)) {
+    d.ocd_kind = gate_driver ? Comparator::vds_31mV : Comparator::current_375mA;
+    d.ocd_th = static_cast<std::uint8_t>(value(Reg::OCD_TH));
+  }
+  d.acc = profile_.acc;
+  d.dec = profile_.dec;
+  d.infinite = profile_.infinite;
+  return d;
+}
+
+void Chip::axis_after_change() {
+  axis_->set_drive(drive_inputs());
+  axis_event_known_ = false;
+  axis_settle(now_);
+}
+
+void Chip::axis_settle(Tick at) {
+  // The axis's outputs are the chip's SW pin, stall and overcurrent inputs; a change of them can
+  // change the motion (a switch stops a GoUntil, OC_SD disables the bridges), so settle again.
+  for (int round = 0; round < 8; ++round) {
+    if (axis_->settle(motion_, profile_, at)) axis_event_known_ = false;
+    bool drove = false;
+    if (axis_->sw_level() != axis_sw_) {
+      axis_sw_ = axis_->sw_level();
+      if (axis_sw_ != sw_level_) {
+        touched();
+        sw_level_ = axis_sw_;
+        if (stby_level_) {
+          if (!sw_level_)
+            switch_turn_on_event();
+          else
+            switch_release_event();
+        }
+        drove = true;
+      }
+    }
+    if (axis_->stall_condition() != axis_stall_) {
+      axis_stall_ = axis_->stall_condition();
+      set_stall(Bridge::A, axis_stall_);
+      set_stall(Bridge::B, axis_stall_);
+      touched();
+      drove = true;
+    }
+    if (axis_->overcurrent_condition() != axis_ocd_) {
+      axis_ocd_ = axis_->overcurrent_condition();
+      set_overcurrent(axis_ocd_);
+      drove = true;
+    }
+    if (!drove) return;
+    axis_event_known_ = false;
+  }
+}
+
+bool Chip::axis_quiet_through_now() const {
+  if (motion_active(motion_)) return run_.known && axis_event_known_ && now_ < axis_event_at_;
+  return axis_->next_time_event() > now_;
+}
+
+void Chip::sync_with_axis() {
+  Tick t = motion_now_;
+  Tick left = now_ - t;
+  motion_now_ = now_;
+  while (left > 0) {
+    if (!motion_active(motion_)) {
+      // Standing still: only switch bounce edges happen on their own.
+      const Tick e = std::max(axis_->next_time_event(), t + 1);
+      if (e == kNever || e > t + left) break;
+      left -= e - t;
+      t = e;
+      live_bits_known_ = false;
+      axis_settle(t);
+      continue;
+    }
+    if (engine_ == MotionEngine::reference) {
+      reference_tick(motion_, profile_);
+      ++t;
+      --left;
+      live_bits_known_ = false;
+      axis_settle(t);
+      continue;
+    }
+    if (!run_.known) {
+      run_.left = uniform_ticks(motion_, profile_, kNever - 1);
+      run_.known = true;
+      axis_event_known_ = false;
+    }
+    if (!axis_event_known_) {
+      axis_event_at_ = t + axis_->first_event(motion_, profile_, std::min(run_.left, kAxisHorizon), t);
+      axis_event_known_ = true;
+    }
+    const Tick to_event = axis_event_at_ - t;
+    const Tick n = std::min(run_.left, left);
+    if (to_event <= n) {
+      apply_uniform_ticks(motion_, profile_, to_event);
+      run_.left -= to_event;
+      left -= to_event;
+      t += to_event;
+      live_bits_known_ = false;
+      axis_event_known_ = false;
+      axis_settle(t);
+      continue;
+    }
+    apply_uniform_ticks(motion_, profile_, n);
+    run_.left -= n;
+    left -= n;
+    t += n;
+    if (left == 0) break;
+    reference_tick(motion_, profile_);
+    --left;
+    ++t;
+    run_.known = false;
+    live_bits_known_ = false;
+    axis_settle(t);
+  }
 }
 
 }  // namespace l6470emu

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/axis.hpp"
 #include "core/commands.hpp"
 #include "core/diagnostics.hpp"
 #include "core/fast_motion.hpp"
@@ -15,6 +16,7 @@
 #include "core/registers.hpp"
 #include "core/status.hpp"
 #include "core/tick.hpp"
+#include "core/value_ptr.hpp"
 #include "core/variant.hpp"
 
 namespace l6470emu {
@@ -76,7 +78,10 @@ class Chip {
   bool flag_pin() const;
   /// SW input level; false = switch closed (pin pulled to ground). Edges act at now().
   void set_sw_pin(bool level);
-  bool sw_pin() const { return sw_level_; }
+  bool sw_pin() const {
+    if (axis_) sync();  // the axis's switches drive it
+    return sw_level_;
+  }
   /// STCK input level; a rising edge in step-clock mode makes one microstep.
   void set_stck_pin(bool level);
   /// STBY\RST input; low holds the logic in reset with SPI silent, rising edge = power-up state.
@@ -97,6 +102,19 @@ class Chip {
   void set_overcurrent(bool active);
   /// Stall (step loss) detected on a bridge.
   void set_stall(Bridge bridge, bool active);
+
+  // ---- the mechanical world (optional) ----------------------------------------
+
+  /// Puts a motor, its load, hard stops and switches behind the chip (replacing any earlier
+  /// axis). From now on the axis drives SW, the stall and the overcurrent conditions; the rotor
+  /// starts at `spec.start_position`, synchronised. Without an axis nothing of this exists.
+  void attach_axis(const AxisSpec& spec);
+  /// Removes the axis; the chip's inputs stay as the axis last left them.
+  void detach_axis();
+  /// The axis brought up to now() (true position, lost steps, switches), or nullptr.
+  const Axis* axis() const;
+  /// Changes the axis's load at runtime (no effect without an axis).
+  void set_axis_load(const LoadSpec& load);
 
   // ---- inspection without side effects --------------------------------------
 
@@ -200,8 +218,11 @@ class Chip {
   void sync() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
   bool status_known_without_sync() const {
-    return live_bits_known_ && (!motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left));
+    if (!live_bits_known_ || (axis_ && !axis_quiet_through_now())) return false;
+    return !motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left);
   }
+  /// With an axis: whether no mechanical event can have happened between the last sync and now().
+  bool axis_quiet_through_now() const;
   /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
   void touched() const {
     run_.known = false;
@@ -220,6 +241,19 @@ class Chip {
   std::uint8_t adc_code_ = 0;
 
   DiagnosticSink sink_;
+
+  // The axis, when attached. Its events are found inside the runs of uniform ticks.
+  ValuePtr<Axis> axis_;
+  mutable Tick axis_event_at_ = 0;       // absolute tick of the axis's next event in the cached run
+  mutable bool axis_event_known_ = false;
+  bool axis_sw_ = true, axis_stall_ = false, axis_ocd_ = false;  // what the axis last drove
+  /// sync() with an axis: the same engines, stopping at every mechanical event.
+  void sync_with_axis();
+  /// Lets the axis apply its rules at tick `at` and passes its outputs to the chip's inputs.
+  void axis_settle(Tick at);
+  /// After a command, a pin or a fault: new drive registers, then the rules at now().
+  void axis_after_change();
+  DriveInputs drive_inputs() const;
 };
 
 }  // namespace l6470emu

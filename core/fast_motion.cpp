@@ -175,6 +175,8 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
   s.abs_pos = sign_extend(pos & 0x3FFFFF, 22);
   const std::uint32_t el = mod512 * p.el_increment();
   s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? el : 512u * 128u - el)) & 0x1FF);
+  const std::int64_t moved = static_cast<std::int64_t>(steps) * p.el_increment();
+  s.travel += s.dir ? moved : -moved;
   if (s.activity == Activity::position && !s.reversing) s.steps_left -= static_cast<std::uint32_t>(steps);
 }
 

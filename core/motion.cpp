@@ -214,6 +214,7 @@ void take_microstep(MotionState& s, const Profile& p) {
   const int delta = s.dir ? 1 : -1;
   s.abs_pos = wrap22(static_cast<std::int64_t>(s.abs_pos) + delta);
   s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? p.el_increment() : 512 - p.el_increment())) & 0x1FF);
+  s.travel += s.dir ? p.el_increment() : -static_cast<std::int64_t>(p.el_increment());
 }
 
 std::uint32_t directed_distance(std::int32_t from, std::int32_t to, bool forward) {

@@ -75,6 +75,9 @@ struct MotionState {
   std::int32_t target_pos = 0; ///< positioning target, used when a reversal completes
   std::int32_t abs_pos = 0;    ///< ABS_POS, sign-extended 22-bit
   std::uint16_t el_pos = 0;    ///< EL_POS, 9 bits
+  /// Commanded travel since the chip was made, 1/128 step, never wrapped or reset (the
+  /// mechanical axis follows it; ResetPos, ABS_POS writes and resets leave it alone).
+  std::int64_t travel = 0;
 
   friend bool operator==(const MotionState&, const MotionState&) = default;
 };

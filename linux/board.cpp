@@ -27,6 +27,9 @@ Board::Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host)
     std::vector<Chip> chips;
     chips.reserve(cc.chips.size());
     for (const Variant* v : cc.chips) chips.emplace_back(*v);
+    // axis.K counts chips as the board's numbering= does.
+    const ChipNumbering axis_numbers(numbering_, chips.size());
+    for (const auto& [k, spec] : cc.axes) chips.at(axis_numbers.index_of(k)).attach_axis(spec);
     auto cd = std::make_unique<ChainDev>(cc, std::move(chips));
     cd->name = cc.path.substr(cc.path.rfind('/') + 1);
     cd->spi.mode = cc.mode;

@@ -2,6 +2,8 @@
 // checked against its range, one error line that says where, what and how to write it instead.
 #include "linux/config.hpp"
 
+#include "linux/axis_config.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -420,8 +422,23 @@ struct Parser {
     return fail("expected key=value, got " + q);
   }
 
+  // axis.K=ITEMS: the mechanics behind chip K of this clause's chain.
+  bool parse_axis_word(std::string_view key, std::string_view value, std::vector<std::pair<std::size_t, AxisSpec>>& axes) {
+    std::size_t k = 0;
+    if (!parse_uint(key.substr(5), k, 0, kMaxChipsPerChain - 1))
+      return fail("axis key " + quoted_text(key) + " needs a chip number: axis.K= with K from 0 to 255 (e.g. axis.0=stops=0..256000)");
+    for (const auto& [other, spec] : axes)
+      if (other == k) return fail(std::string(key) + "= is given twice in this clause");
+    if (value.empty()) return fail(std::string(key) + "= has no value (e.g. axis.0=default or axis.0=stops=0..256000)");
+    AxisSpec spec;
+    if (const std::string e = parse_axis_spec(value, spec); !e.empty()) return fail(std::string(key) + ": " + e);
+    axes.emplace_back(k, std::move(spec));
+    return true;
+  }
+
   bool parse_clause(std::string_view clause, BoardConfig& cfg) {
     const auto words = split_words(clause);
+    std::vector<std::pair<std::size_t, AxisSpec>> axes;
     std::vector<std::pair<const KeySpec*, std::string_view>> settings;
     std::map<std::string_view, std::string_view> in_clause;
     const KeySpec* first_chain_key = nullptr;
@@ -433,6 +450,10 @@ struct Parser {
       const std::size_t eq = w.find('=');
       if (eq == std::string_view::npos || eq == 0) return fail_bare_word(w);
       const std::string_view key = w.substr(0, eq), value = w.substr(eq + 1);
+      if (key.substr(0, 5) == "axis.") {
+        if (!parse_axis_word(key, value, axes)) return false;
+        continue;
+      }
       const KeySpec* spec = find_key(key);
       if (spec == nullptr) {
         const std::string near = key_suggestion(key);
@@ -451,12 +472,22 @@ struct Parser {
     if (first_chain_key && !is_chain)
       return fail(std::string(first_chain_key->name) +
                   "= describes a chain: add chips= to this clause (e.g. 'bus=0 cs=0 chips=L6470')");
+    if (!axes.empty() && !is_chain)
+      return fail("axis." + std::to_string(axes.front().first) +
+                  "= describes a chip of a chain: add chips= to this clause (e.g. 'chips=L6470 axis.0=default')");
     ChainConfig chain;
     for (const auto& [spec, value] : settings) {
       const bool ok = spec->scope == Scope::board ? set_board_key(*spec, value, cfg) : set_chain_key(*spec, value, chain);
       if (!ok) return false;
     }
     if (!is_chain) return true;
+    for (const auto& [k, spec] : axes)
+      if (k >= chain.chips.size())
+        return fail("axis." + std::to_string(k) + "= names chip " + std::to_string(k) + " but the chain has " +
+                    std::to_string(chain.chips.size()) + " chip" + (chain.chips.size() == 1 ? "" : "s") + " (0 to " +
+                    std::to_string(chain.chips.size() - 1) + ")");
+    std::sort(axes.begin(), axes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    chain.axes = std::move(axes);
     if (cfg.chains.size() >= kMaxChains) return fail("a board holds at most 256 chains");
     if (chain.path.empty()) chain.path = "/dev/spidev" + std::to_string(chain.bus) + "." + std::to_string(chain.cs);
     for (std::size_t i = 0; i < cfg.chains.size(); ++i) {
@@ -616,7 +647,12 @@ std::string describe_board_config(const BoardConfig& config) {
       i += run;
     }
     o << " gpiochip=" << (c.gpiochip ? std::to_string(*c.gpiochip) : std::string("none")) << " speed=" << c.max_speed_hz
-      << " mode=" << unsigned{c.mode} << " bufsiz=" << c.bufsiz << "\n";
+      << " mode=" << unsigned{c.mode} << " bufsiz=" << c.bufsiz;
+    for (const auto& [k, spec] : c.axes) {
+      const std::string items = describe_axis_spec(spec);
+      o << " axis." << k << "=" << (items.empty() ? "default" : items);
+    }
+    o << "\n";
   }
   // scale= only means something on the wall clock, idle= only in virtual time.
   if (config.time.virtual_time) {

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/axis_spec.hpp"
 #include "core/variant.hpp"
 #include "daisychain/chip_numbering.hpp"
 
@@ -34,6 +35,8 @@ struct ChainConfig {
   std::uint32_t max_speed_hz = 5'000'000;  ///< the device's spi-max-frequency (RD_MAX_SPEED_HZ at open)
   std::uint8_t mode = 0;                   ///< SPI mode the device starts in (as a device tree sets it)
   std::uint32_t bufsiz = 4096;             ///< spidev's bufsiz module parameter
+  /// axis.K=...: the mechanics behind chip K (linux/axis_config.hpp), ascending K.
+  std::vector<std::pair<std::size_t, AxisSpec>> axes;
 };
 
 /// The whole emulated board.
@@ -55,7 +58,7 @@ struct ConfigError {
 /// of the line, ';' separates clauses within a line, words are separated by blanks. Each word is
 /// key=value, each key at most once per clause. A clause with chips= is a chain:
 ///   chips=L6470,2xL6480 [bus=0..32767] [cs=0..255] [path=/dev/NAME] [gpiochip=0..1023|none]
-///   [speed=HZ] [mode=0..3] [bufsiz=N]
+///   [speed=HZ] [mode=0..3] [bufsiz=N] [axis.K=ITEM,... (a motor, load, stops and switches behind chip K)]
 /// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
 /// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual
 /// time), log=stderr|off|FILE, socket=PATH, trace=FILE, numbering=miso|mosi (which end chip 0

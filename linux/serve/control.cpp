@@ -1,4 +1,4 @@
-// `ctl` commands: status, get, sw, pin, fault, adc, dump, chains, time, advance, trace.
+// `ctl` commands: status, get, sw, pin, fault, adc, axis, dump, chains, time, advance, trace.
 #include "linux/serve/control.hpp"
 
 #include <cstdio>
@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/status.hpp"
+#include "linux/axis_config.hpp"
 
 namespace l6470emu {
 namespace {
@@ -74,6 +75,8 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  fault uvlo|uvlo-adc|ocd|stall-a|stall-b on|off --chip K\n"
          "  fault thermal normal|warning|bridge-shutdown|device-shutdown --chip K\n"
          "  adc CODE --chip K                   ADCIN conversion result, 0..31\n"
+         "  axis [--chip K]                     the mechanics: true position next to ABS_POS, lost steps, switches\n"
+         "  axis load ITEM,... --chip K         change the load at runtime: load=G_CM2,friction=NM,force=NM\n"
          "  time                                virtual time of each chain\n"
          "  advance MS                          virtual-time daemons: let MS milliseconds pass\n"
          "  trace start FILE                    record the chain's SPI frames, pins and faults (native trace)\n"
@@ -148,7 +151,10 @@ int run_control(Board& board, const std::string& command, std::string& out) {
       for_chips([&](std::size_t k) {
         const Chip& chip = c.chip(k);
         o << label(k) << " (" << chip.variant().name << "): STATUS " << hex(chip.status(), 4) << "  "
-          << describe_status(chip.variant().status, chip.status()) << "\n";
+          << describe_status(chip.variant().status, chip.status());
+        if (const Axis* axis = chip.axis())
+          o << "  ABS_POS " << chip.position() << " true " << axis->true_position();
+        o << "\n";
       });
     });
   } else if (cmd == "get") {
@@ -263,6 +269,58 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     }
     board.inject_fault(ci, k, TraceFault::ADCIN, static_cast<std::uint8_t>(code));
     o << label(k) << ": ADC_OUT " << code << "\n";
+  } else if (cmd == "axis") {
+    if (!a.words.empty() && a.words[0] == "load") {
+      std::size_t k = 0;
+      if (!target_chip(k)) return 2;
+      if (a.words.size() != 2) {
+        out = "ctl: usage: axis load ITEM,... --chip K (load=G_CM2, friction=NM, force=NM)\n";
+        return 2;
+      }
+      std::string error;
+      bool has_axis = true;
+      board.with_chain(ci, [&](Chain& c) {
+        Chip& chip = c.chip(k);
+        if (!chip.axis()) {
+          has_axis = false;
+          return;
+        }
+        LoadSpec load = chip.axis()->spec().load;
+        error = parse_axis_load(a.words[1], load);
+        if (error.empty()) chip.set_axis_load(load);
+      });
+      if (!has_axis) {
+        out = "ctl: " + label(k) + " has no axis (axis.K= in the board description)\n";
+        return 1;
+      }
+      if (!error.empty()) {
+        out = "ctl: axis load: " + error + "\n";
+        return 2;
+      }
+      o << label(k) << ": load " << a.words[1] << "\n";
+    } else if (!a.words.empty()) {
+      out = "ctl: usage: axis [--chip K] | axis load ITEM,... --chip K\n";
+      return 2;
+    } else {
+      board.with_chain(ci, [&](Chain& c) {
+        for_chips([&](std::size_t k) {
+          const Chip& chip = c.chip(k);
+          const Axis* axis = chip.axis();
+          o << label(k) << ": ";
+          if (!axis) {
+            o << "no axis\n";
+            return;
+          }
+          o << "ABS_POS " << chip.position() << "  true " << axis->true_position() << " (1/128 step)  lost "
+            << axis->lost_steps() << "  " << (axis->synchronised() ? "synchronised" : "stalled")
+            << (axis->at_stop() ? " at a hard stop" : "") << "  " << axis->phase_current_mA() << " mA  torque "
+            << axis->available_torque_uNm() << "/" << axis->required_torque_uNm() << " uNm";
+          for (std::size_t i = 0; i < axis->spec().switches.size(); ++i)
+            o << "  " << axis->spec().switches[i].name << " " << (axis->switch_closed(i) ? "closed" : "open");
+          o << "  SW " << (chip.sw_pin() ? "high" : "low") << "\n";
+        });
+      });
+    }
   } else if (cmd == "time") {
     for (std::size_t i = 0; i < board.chain_count(); ++i) {
       const Tick t = board.now(i);

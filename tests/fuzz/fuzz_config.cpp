@@ -30,7 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (std::size_t i = 0; i < a.chains.size(); ++i) {
     const ChainConfig &x = a.chains[i], &y = b.chains[i];
     FUZZ_CHECK(x.bus == y.bus && x.cs == y.cs && x.path == y.path && x.chips == y.chips && x.gpiochip == y.gpiochip &&
-                   x.max_speed_hz == y.max_speed_hz && x.mode == y.mode && x.bufsiz == y.bufsiz,
+                   x.max_speed_hz == y.max_speed_hz && x.mode == y.mode && x.bufsiz == y.bufsiz &&
+                   x.axes == y.axes,
                "chain %zu reads back differently from its description:\n%.300s", i, description.c_str());
   }
   FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace,

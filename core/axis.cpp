@@ -1,0 +1,279 @@
+// The axis rules (docs/chip-model.md, "The mechanical world") and the search for the tick of
+// the next mechanical event inside a run of uniform ticks, which keeps the event-driven engine
+// identical to the tick-by-tick one: every decision of settle() depends on the speed band, the
+// true position or the time, and each of those moves monotonically through a uniform run.
+#include "core/axis.hpp"
+
+#include <algorithm>
+
+#include "core/fast_motion.hpp"
+
+namespace l6470emu {
+namespace {
+
+constexpr std::int64_t kHalfCycle = 256;  // two full steps, 1/128 step
+constexpr std::int64_t kCycle = 512;      // one electrical cycle
+
+std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  std::int64_t q = a / b;
+  if ((a % b != 0) && ((a < 0) != (b < 0))) --q;
+  return q;
+}
+
+MotionState after(const MotionState& s, const Profile& p, Tick i) {
+  MotionState c = s;
+  apply_uniform_ticks(c, p, i);
+  return c;
+}
+
+/// Smallest i in [lo, hi] with pred(i) true (pred monotone false...true), or hi + 1.
+template <class Pred>
+Tick first_true(Tick lo, Tick hi, Pred pred) {
+  if (lo > hi || !pred(hi)) return hi + 1;
+  while (lo < hi) {
+    const Tick mid = lo + (hi - lo) / 2;
+    if (pred(mid))
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
+bool moving(const MotionState& s) { return motion_active(s) && !s.hiz; }
+
+}  // namespace
+
+DrivePhase drive_phase(const MotionState& s, const Profile& p) {
+  switch (mot_status(s, p)) {
+    case MotStatus::stopped: return DrivePhase::hold;
+    case MotStatus::acceleration: return DrivePhase::acc;
+    case MotStatus::deceleration: return DrivePhase::dec;
+    case MotStatus::constant_speed: return DrivePhase::run;
+  }
+  return DrivePhase::hold;
+}
+
+Axis::Axis(AxisSpec spec, std::int64_t travel)
+    : spec_(std::move(spec)), cmd0_(travel), cmd_(travel) {
+  offset_ = spec_.start_position - travel;
+  true_pos_ = clamp(travel + offset_);
+  switches_.resize(spec_.switches.size());
+  for (std::size_t i = 0; i < switches_.size(); ++i) {
+    const SwitchSpec& sw = spec_.switches[i];
+    switches_[i].actuated = sw.above ? true_pos_ >= sw.position : true_pos_ <= sw.position;
+    switches_[i].shown_closed = switches_[i].actuated != sw.normally_closed;
+    if (switches_[i].shown_closed) sw_level_ = false;
+  }
+}
+
+void Axis::set_load(const LoadSpec& load) {
+  if (spec_.load == load) return;
+  spec_.load = load;
+  table_.clear();
+}
+
+void Axis::set_drive(const DriveInputs& drive) {
+  if (drive_ == drive) return;
+  drive_ = drive;
+  table_.clear();
+}
+
+std::int64_t Axis::clamp(std::int64_t u) const {
+  if (spec_.has_upper_stop && u > spec_.upper_stop) return spec_.upper_stop;
+  if (spec_.has_lower_stop && u < spec_.lower_stop) return spec_.lower_stop;
+  return u;
+}
+
+std::uint8_t Axis::entry(DrivePhase phase, bool forward, std::uint32_t band) const {
+  if (table_.empty()) table_.assign(std::size_t{8} * kSpeedBands, 0xFF);
+  std::uint8_t& e = table_[(static_cast<std::size_t>(phase) * 2 + (forward ? 1 : 0)) * kSpeedBands + band];
+  if (e != 0xFF) return e;
+  const DrivePoint d = drive_point(spec_, drive_, phase, band);
+  const std::uint64_t need = l6470emu::required_torque_uNm(spec_, drive_, phase, forward);
+  const std::uint32_t rds = spec_.supply.rds_on_mohm;
+  std::uint8_t v = 0;
+  if (d.torque_uNm < need) v |= kLost;
+  if (comparator_trips(drive_.stall_kind, drive_.stall_th, d.sync_mA, rds)) v |= kStallSync;
+  if (comparator_trips(drive_.ocd_kind, drive_.ocd_th, d.sync_mA, rds)) v |= kOcdSync;
+  if (comparator_trips(drive_.stall_kind, drive_.stall_th, d.blocked_mA, rds)) v |= kStallBlocked;
+  if (comparator_trips(drive_.ocd_kind, drive_.ocd_th, d.blocked_mA, rds)) v |= kOcdBlocked;
+  // band speed b·15625/1024 step/s at or below the pull-in speed
+  if (std::uint64_t{band} * 15625 <= std::uint64_t{spec_.pull_in_speed_steps_per_s} * 1024) v |= kPullIn;
+  e = v;
+  return e;
+}
+
+// The bits settle() acts on in the present state (synchronised or not, driven to move or not).
+std::uint8_t Axis::signature(std::uint8_t e, bool is_moving) const {
+  if (synced_) return static_cast<std::uint8_t>(e & ((is_moving ? kLost | kStallSync : 0) | kOcdSync));
+  const bool pull_in = (e & kPullIn) && !(e & kLost);
+  return static_cast<std::uint8_t>((pull_in ? kPullIn : 0) | (e & (kStallBlocked | kOcdBlocked)));
+}
+
+bool Axis::shown(const SwitchSpec& sw, const SwitchState& st, Tick now) const {
+  bool closed = st.actuated != sw.normally_closed;
+  if (sw.bounce_count > 0 && sw.bounce_ticks > 0 && st.ever_changed && now >= st.changed_at) {
+    const Tick j = (now - st.changed_at) / sw.bounce_ticks;
+    if (j < Tick{2} * sw.bounce_count && (j & 1)) closed = !closed;
+  }
+  return closed;
+}
+
+void Axis::observe(const MotionState& s, const Profile& p) {
+  cmd_ = s.travel;
+  true_pos_ = synced_ ? clamp(cmd_ + offset_) : stall_pos_;
+  const DrivePhase phase = drive_phase(s, p);
+  const DrivePoint d = drive_point(spec_, drive_, phase, speed_band(s.speed));
+  current_mA_ = s.hiz ? 0 : (synced_ ? d.sync_mA : d.blocked_mA);
+  torque_avail_ = s.hiz ? 0 : d.torque_uNm;
+  torque_req_ = moving(s) ? l6470emu::required_torque_uNm(spec_, drive_, phase, s.dir) : 0;
+}
+
+bool Axis::settle(const MotionState& s, const Profile& p, Tick now) {
+  const bool was_synced = synced_;
+  const std::int64_t was_at = synced_ ? offset_ : stall_pos_;
+  const bool is_moving = moving(s);
+  const DrivePhase phase = drive_phase(s, p);
+  const std::uint8_t e = entry(phase, s.dir, speed_band(s.speed));
+  const std::int64_t cmd = s.travel;
+  settled_at_ = now;
+
+  if (!synced_ && (!is_moving || ((e & kPullIn) && !(e & kLost)))) {
+    // Pull in: the nearest rotor position with the commanded electrical phase.
+    const std::int64_t phase0 = spec_.start_position - cmd0_;  // true − commanded when attached
+    offset_ = phase0 + kCycle * floor_div(stall_pos_ - cmd - phase0 + kHalfCycle, kCycle);
+    synced_ = true;
+  }
+  if (synced_) {
+    const std::int64_t u = cmd + offset_;
+    if (is_moving && (e & kLost)) {
+      synced_ = false;
+      stall_pos_ = clamp(u);
+    } else if (spec_.has_upper_stop && u > spec_.upper_stop &&
+               ((is_moving && s.dir) || u > spec_.upper_stop + kHalfCycle)) {
+      synced_ = false;
+      stall_pos_ = spec_.upper_stop;
+    } else if (spec_.has_lower_stop && u < spec_.lower_stop &&
+               ((is_moving && !s.dir) || u < spec_.lower_stop - kHalfCycle)) {
+      synced_ = false;
+      stall_pos_ = spec_.lower_stop;
+    }
+  }
+  bool changed = synced_ != was_synced || (synced_ ? offset_ : stall_pos_) != was_at;
+  cmd_ = cmd;
+  true_pos_ = synced_ ? clamp(cmd_ + offset_) : stall_pos_;
+
+  bool level = true;
+  for (std::size_t i = 0; i < switches_.size(); ++i) {
+    const SwitchSpec& sw = spec_.switches[i];
+    SwitchState& st = switches_[i];
+    bool act = st.actuated;
+    if (!sw.above) {
+      if (!act && true_pos_ <= sw.position) act = true;
+      else if (act && true_pos_ > sw.position + sw.hysteresis) act = false;
+    } else {
+      if (!act && true_pos_ >= sw.position) act = true;
+      else if (act && true_pos_ < sw.position - sw.hysteresis) act = false;
+    }
+    if (act != st.actuated) {
+      st.actuated = act;
+      st.ever_changed = true;
+      st.changed_at = now;
+      changed = true;
+    }
+    const bool closed = shown(sw, st, now);
+    if (closed != st.shown_closed) {
+      st.shown_closed = closed;
+      changed = true;
+    }
+    if (closed) level = false;
+  }
+  const bool stall = is_moving && (e & (synced_ ? kStallSync : kStallBlocked)) != 0;
+  const bool ocd = !s.hiz && (e & (synced_ ? kOcdSync : kOcdBlocked)) != 0;
+  changed = changed || level != sw_level_ || stall != stall_ || ocd != ocd_;
+  sw_level_ = level;
+  stall_ = stall;
+  ocd_ = ocd;
+  return changed;
+}
+
+Tick Axis::next_time_event() const {
+  Tick next = kNever;
+  for (std::size_t i = 0; i < switches_.size(); ++i) {
+    const SwitchSpec& sw = spec_.switches[i];
+    const SwitchState& st = switches_[i];
+    if (sw.bounce_count == 0 || sw.bounce_ticks == 0 || !st.ever_changed) continue;
+    // Edges at changed_at + j·T for j = 1 .. 2·bounce_count; the next one after the last settle.
+    const Tick last_edge = st.changed_at + Tick{2} * sw.bounce_count * sw.bounce_ticks;
+    if (last_edge <= settled_at_) continue;
+    const Tick j = (settled_at_ - st.changed_at) / sw.bounce_ticks + 1;
+    next = std::min(next, st.changed_at + j * sw.bounce_ticks);
+  }
+  return next;
+}
+
+Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now) const {
+  Tick best = n + 1;
+  const Tick timed = next_time_event();
+  if (timed != kNever && timed > now && timed - now <= n) best = timed - now;
+  if (!moving(s) || best == 1) return best;
+  const Tick m = best - 1;  // only ticks before the best event so far matter
+
+  // A change of speed band that changes what settle() would decide.
+  const DrivePhase phase = drive_phase(s, p);
+  const std::uint32_t b0 = speed_band(s.speed);
+  const std::uint32_t bn = speed_band(after(s, p, m).speed);
+  if (bn != b0) {
+    const std::uint8_t sig0 = signature(entry(phase, s.dir, b0), true);
+    const bool up = bn > b0;
+    for (std::uint32_t b = up ? b0 + 1 : b0 - 1;; b = up ? b + 1 : b - 1) {
+      if (signature(entry(phase, s.dir, b), true) != sig0) {
+        const Tick k = first_true(1, m, [&](Tick i) {
+          const std::uint32_t bi = speed_band(after(s, p, i).speed);
+          return up ? bi >= b : bi <= b;
+        });
+        best = std::min(best, k);
+        break;
+      }
+      if (b == bn) break;
+    }
+  }
+
+  // The true position reaching a hard stop or a switch's actuation or release point.
+  if (synced_ && best > 1) {
+    const std::int64_t u = s.travel + offset_;
+    const bool fwd = s.dir;
+    bool have = false;
+    std::int64_t target = 0;  // the value of u at which something happens
+    auto consider = [&](std::int64_t t) {
+      if (fwd ? t <= u : t >= u) return;
+      if (!have || (fwd ? t < target : t > target)) target = t;
+      have = true;
+    };
+    if (fwd && spec_.has_upper_stop) consider(spec_.upper_stop + 1);
+    if (!fwd && spec_.has_lower_stop) consider(spec_.lower_stop - 1);
+    for (std::size_t i = 0; i < switches_.size(); ++i) {
+      const SwitchSpec& sw = spec_.switches[i];
+      const bool act = switches_[i].actuated;
+      if (!sw.above) {
+        if (fwd && act) consider(sw.position + sw.hysteresis + 1);
+        if (!fwd && !act) consider(sw.position);
+      } else {
+        if (fwd && !act) consider(sw.position);
+        if (!fwd && act) consider(sw.position - sw.hysteresis - 1);
+      }
+    }
+    if (have) {
+      const std::int64_t goal = target - offset_;  // commanded travel at which it happens
+      const Tick k = first_true(1, best - 1, [&](Tick i) {
+        const std::int64_t t = after(s, p, i).travel;
+        return fwd ? t >= goal : t <= goal;
+      });
+      best = std::min(best, k);
+    }
+  }
+  return best;
+}
+
+}  // namespace l6470emu
