@@ -173,5 +173,20 @@ TEST(AxisCtl, StatusShowsTheTruePositionNextToAbsPosAndAxisChangesTheLoad) {
   EXPECT_NE(out.find("chip 0 has no axis"), std::string::npos) << out;
 }
 
+TEST(AxisCtl, AnAxisChipNumberCountsAsTheBoardsNumberingSays) {
+  ParseResult p = parse_board_config("bus=0 cs=0 chips=3xL6470 axis.0=start=640; numbering=mosi", "test");
+  ASSERT_TRUE(p.config) << p.error.message;
+  DiagnosticLog log("off");
+  Board board(*p.config, log);
+  board.with_chain(0, [](Chain& c) {
+    EXPECT_EQ(c.chip(0).axis(), nullptr) << "chip 0 from the MOSI end is the chain's last chip";
+    ASSERT_NE(c.chip(2).axis(), nullptr);
+    EXPECT_EQ(c.chip(2).axis()->true_position(), 640);
+  });
+  std::string out;
+  ASSERT_EQ(run_control(board, "axis --chip 0", out), 0) << out;
+  EXPECT_NE(out.find("chip 0: ABS_POS 0  true 640"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace l6470emu
