@@ -20,7 +20,7 @@ namespace l6470emu {
 
 /// Bytes of the request area and of the reply area each. A packet that does not fit goes by the
 /// socket instead (kShmOnSocket), so this bounds only what travels without a system call.
-inline constexpr std::size_t kShmAreaBytes = 64 * 1024 - 64;
+inline constexpr std::size_t kShmAreaBytes = 64 * 1024 - 16;
 
 /// Request flag: "my packet is on the socket" (it carries what the region cannot: a descriptor,
 /// more than kShmAreaBytes). Reply flag: "your reply is on the socket".
