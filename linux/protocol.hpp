@@ -73,7 +73,8 @@ struct Packet {
 /// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error.
 bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t spin_ns = 0);
 
-/// How long the preload waits for a reply, and the daemon for a client's next request, before sleeping.
+/// How long the preload polls for a reply, and the daemon for a client's next request, before
+/// sleeping (in recvmsg on the socket, or on the shared region's futex).
 inline constexpr std::int64_t kReplySpinNs = 30'000;
 inline constexpr std::int64_t kRequestSpinNs = 20'000;
 
