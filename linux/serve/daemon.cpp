@@ -166,11 +166,15 @@ void serve_connection(Board& board, const ControlHandler& control, Connection& c
   }
 }
 
-/// `ctl clients`: who is connected and how each is served.
+/// `ctl clients`: who is connected and how each is served (a connection that ended but is not
+/// reaped yet is left out). The caller holds the connections' lock.
 std::string describe_clients(const std::list<Connection>& connections) {
   std::ostringstream o;
-  o << connections.size() << (connections.size() == 1 ? " client\n" : " clients\n");
+  std::size_t n = 0;
+  for (const Connection& c : connections) n += c.done ? 0 : 1;
+  o << n << (n == 1 ? " client\n" : " clients\n");
   for (const Connection& c : connections) {
+    if (c.done) continue;
     o << "pid " << c.pid << ": ";
     if (c.shared)
       o << "shared memory, " << c.shared_requests << " requests through it, " << c.socket_requests
