@@ -2,6 +2,7 @@
 #include "linux/protocol.hpp"
 
 #include "linux/clock.hpp"
+#include "linux/shm_channel.hpp"
 
 #include <sys/socket.h>
 #include <unistd.h>
@@ -175,8 +176,30 @@ void serve_request(Board& board, const ControlHandler& control, std::span<const 
       out.assign(text.begin(), text.end());
       return;
     }
+    case Op::attach_shm:  // a matter of the connection (serve/daemon.cpp), not of the board
+      break;
   }
   reply.result = -EPROTO;
+}
+
+SharedOutcome serve_shared_request(Board& board, const ControlHandler& control, SharedChannel& channel,
+                                   std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& out,
+                                   int& pass_fd) {
+  std::uint32_t flags = 0;
+  const std::size_t n = channel.take_request(scratch, flags);
+  pass_fd = -1;
+  if (flags & kShmOnSocket) return SharedOutcome::request_on_socket;
+  try {
+    serve_request(board, control, {scratch, n}, reply, out, pass_fd);
+  } catch (const std::exception&) {
+    reply = {};
+    reply.result = -ENOMEM;
+    out.clear();
+  }
+  reply.payload = static_cast<std::uint32_t>(out.size());
+  if (pass_fd >= 0 || !SharedChannel::reply_fits(sizeof reply + out.size())) return SharedOutcome::reply_on_socket;
+  channel.post_reply({reinterpret_cast<const std::uint8_t*>(&reply), sizeof reply}, out, 0);
+  return SharedOutcome::replied;
 }
 
 }  // namespace l6470emu

@@ -1,7 +1,10 @@
 // The wire protocol between the preload library and `l6470emu serve`: one SOCK_SEQPACKET
 // connection per host process, strictly request/reply. A request is a RequestHeader and a
 // payload; a reply is a ReplyHeader, a payload and, for new files, one descriptor passed
-// with SCM_RIGHTS. Both ends are built from this one header (same machine, same build).
+// with SCM_RIGHTS. After Op::attach_shm the same packets travel through a region of shared
+// memory (shm_channel.hpp) instead, and the socket carries only what the region cannot:
+// descriptors and packets larger than its areas. Both ends are built from this one header
+// (same machine, same build).
 #pragma once
 
 #include <cstdint>
@@ -13,6 +16,8 @@
 #include "linux/board.hpp"
 
 namespace l6470emu {
+
+class SharedChannel;
 
 /// Protocol version; the daemon refuses a hello of another version.
 inline constexpr std::uint32_t kProtocolVersion = 1;
@@ -27,6 +32,7 @@ enum class Op : std::uint32_t {
   spi_read = 6,     ///< handle, arg = count; reply payload = rx data
   spi_write = 7,    ///< handle, payload = tx data
   control = 8,      ///< payload = a ctl command line; reply: exit status and text
+  attach_shm = 9,   ///< reply: result = region bytes, the region's memfd (see shm_channel.hpp)
 };
 
 inline constexpr std::uint64_t kOpenCloexec = std::uint64_t{1} << 63;
@@ -67,7 +73,8 @@ struct Packet {
 /// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error.
 bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t spin_ns = 0);
 
-/// How long the preload waits for a reply, and the daemon for a client's next request, before sleeping.
+/// How long the preload polls for a reply, and the daemon for a client's next request, before
+/// sleeping (in recvmsg on the socket, or on the shared region's futex).
 inline constexpr std::int64_t kReplySpinNs = 30'000;
 inline constexpr std::int64_t kRequestSpinNs = 20'000;
 
@@ -78,5 +85,20 @@ using ControlHandler = std::function<int(const std::string& command, std::string
 /// `pass_fd` gets a descriptor to send along (the caller closes its copy after sending).
 void serve_request(Board& board, const ControlHandler& control, std::span<const std::uint8_t> packet,
                    ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload, int& pass_fd);
+
+/// What serve_shared_request did with the request posted in a shared channel.
+enum class SharedOutcome {
+  replied,            ///< the reply is in the region
+  reply_on_socket,    ///< the reply carries a descriptor or does not fit: the caller sends `reply`,
+                      ///< `reply_payload` and `pass_fd` on the socket, then posts kShmOnSocket
+  request_on_socket,  ///< the client sent its packet on the socket: the caller receives and serves it
+};
+
+/// Serves the request posted in `channel` (the daemon side) exactly as serve_request serves it
+/// from the socket. The region is the client's to scribble on, so the request is first copied
+/// into `scratch` (kShmAreaBytes), its size checked against the area.
+SharedOutcome serve_shared_request(Board& board, const ControlHandler& control, SharedChannel& channel,
+                                   std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload,
+                                   int& pass_fd);
 
 }  // namespace l6470emu

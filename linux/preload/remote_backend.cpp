@@ -1,17 +1,22 @@
 // Backend forwarding to `l6470emu serve` over its Unix socket (L6470EMU_SOCKET): one
-// connection per process, re-opened after fork(); new files arrive with SCM_RIGHTS.
+// connection per process, re-opened after fork(); new files arrive with SCM_RIGHTS. Requests
+// go through the connection's shared region (shm_channel.hpp) when they fit and the daemon gave
+// one (L6470EMU_SHM=off keeps everything on the socket).
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 
 #include "linux/preload/backend.hpp"
+#include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/protocol.hpp"
+#include "linux/shm_channel.hpp"
 
 namespace l6470emu::preload {
 namespace {
@@ -19,6 +24,7 @@ namespace {
 class RemoteBackend final : public Backend {
  public:
   RemoteBackend(std::string path, const std::string& log) : path_(std::move(path)), log_(log) {
+    if (const char* shm = std::getenv("L6470EMU_SHM"); shm && std::strcmp(shm, "off") == 0) use_shared_ = false;
     std::lock_guard lock(m_);
     if (!connect_locked()) {
       log_.line("cannot reach the daemon at " + path_ + " (" + std::strerror(errno) +
@@ -37,9 +43,7 @@ class RemoteBackend final : public Backend {
     nodes_ = decode_catalogue(std::string(payload.begin(), payload.end()));
   }
 
-  ~RemoteBackend() override {
-    if (sock_ >= 0) real_close_protected(sock_);
-  }
+  ~RemoteBackend() override { disconnect_locked(); }
 
   const std::vector<DeviceNode>& nodes() override { return nodes_; }
 
@@ -118,9 +122,9 @@ class RemoteBackend final : public Backend {
   void before_fork() override { m_.lock(); }
   void after_fork_parent() override { m_.unlock(); }
   void after_fork_child() override {
-    // The connection is shared with the parent now: leave it to the parent, open our own on demand.
-    if (sock_ >= 0) real_close_protected(sock_);
-    sock_ = -1;
+    // The connection and its region are shared with the parent now: leave them to the parent,
+    // open our own on demand.
+    disconnect_locked();
     m_.unlock();
   }
 
@@ -145,7 +149,28 @@ class RemoteBackend final : public Backend {
       return false;
     }
     protect_fd(sock_);
+    if (use_shared_) attach_shared_locked();
     return true;
+  }
+
+  // Asks the daemon for a shared region; without one (an older daemon, no memfd) every request
+  // stays on the socket.
+  void attach_shared_locked() {
+    const RequestHeader req{static_cast<std::uint32_t>(Op::attach_shm), 0, 0, 0};
+    int fd = -1;
+    if (!send_packet(sock_, &req, sizeof req, {}, -1) || !recv_packet(sock_, reply_, fd, true)) return;
+    ReplyHeader rep;
+    if (reply_.size >= sizeof rep) std::memcpy(&rep, reply_.data.get(), sizeof rep);
+    if (fd >= 0) {
+      if (reply_.size >= sizeof rep && rep.result > 0) shared_ = SharedChannel::attach(fd);
+      real::close(fd);  // the mapping stays; nothing of it in the host's descriptor table
+    }
+  }
+
+  void disconnect_locked() {
+    shared_.reset();
+    if (sock_ >= 0) real_close_protected(sock_);
+    sock_ = -1;
   }
 
   // One request, one reply; reconnects once if the connection was lost (fork, host closed it).
@@ -155,24 +180,62 @@ class RemoteBackend final : public Backend {
       if (sock_ < 0 && !connect_locked()) return false;
       if (!protected_fd_is(sock_)) {  // the host closed our socket behind our back
         sock_ = -1;
+        shared_.reset();
         continue;
       }
-      packet_.resize(sizeof req + a.size() + b.size());
-      std::memcpy(packet_.data(), &req, sizeof req);
-      if (!a.empty()) std::memcpy(packet_.data() + sizeof req, a.data(), a.size());
-      if (!b.empty()) std::memcpy(packet_.data() + sizeof req + a.size(), b.data(), b.size());
-      if (!send_packet(sock_, packet_.data(), packet_.size(), {}, -1) || !recv_packet(sock_, reply_, fd, cloexec, kReplySpinNs) ||
-          reply_.size < sizeof rep) {
-        real_close_protected(sock_);
-        sock_ = -1;
+      if (!exchange_locked(req, a, b, fd, cloexec)) {
+        disconnect_locked();
         if (req.op != static_cast<std::uint32_t>(Op::hello) && attempt == 0 && errno != EINTR) continue;
         return false;
       }
-      std::memcpy(&rep, reply_.data.get(), sizeof rep);
-      payload.assign(reply_.data.get() + sizeof rep, reply_.data.get() + reply_.size);
+      std::span<const std::uint8_t> got = reply_.bytes();
+      if (from_region_) got = shared_->reply();
+      if (got.size() < sizeof rep) {
+        disconnect_locked();
+        return false;
+      }
+      std::memcpy(&rep, got.data(), sizeof rep);
+      payload.assign(got.begin() + sizeof rep, got.end());
       return true;
     }
     return false;
+  }
+
+  // Sends the request and waits for the reply: through the shared region when the request fits
+  // (the reply is then in the region, or on the socket when it carries a descriptor or is too
+  // large), else on the socket. Sets from_region_. False when the connection is lost.
+  bool exchange_locked(const RequestHeader& req, std::span<const std::uint8_t> a, std::span<const std::uint8_t> b,
+                       int& fd, bool cloexec) {
+    fd = -1;
+    from_region_ = false;
+    const std::size_t size = sizeof req + a.size() + b.size();
+    const bool whole = shared_ && req.op != static_cast<std::uint32_t>(Op::hello) &&
+                       req.op != static_cast<std::uint32_t>(Op::open) && size <= kShmAreaBytes;
+    const std::function<bool()> alive = [this] { return peer_alive(sock_); };
+    if (whole) {
+      std::uint8_t* p = shared_->request_area();
+      std::memcpy(p, &req, sizeof req);
+      if (!a.empty()) std::memcpy(p + sizeof req, a.data(), a.size());
+      if (!b.empty()) std::memcpy(p + sizeof req + a.size(), b.data(), b.size());
+      shared_->post_request(static_cast<std::uint32_t>(size), 0);
+      if (!shared_->wait_reply(kReplySpinNs, alive)) {
+        errno = EPIPE;
+        return false;
+      }
+      if (!(shared_->reply_flags() & kShmOnSocket)) {
+        from_region_ = true;
+        return true;
+      }
+      return recv_packet(sock_, reply_, fd, cloexec);
+    }
+    packet_.resize(size);
+    std::memcpy(packet_.data(), &req, sizeof req);
+    if (!a.empty()) std::memcpy(packet_.data() + sizeof req, a.data(), a.size());
+    if (!b.empty()) std::memcpy(packet_.data() + sizeof req + a.size(), b.data(), b.size());
+    if (!send_packet(sock_, packet_.data(), packet_.size(), {}, -1)) return false;
+    // With a region, the daemon's thread listens to the region: tell it to read the socket.
+    if (shared_) shared_->post_request(0, kShmOnSocket);
+    return recv_packet(sock_, reply_, fd, cloexec, kReplySpinNs);
   }
 
   std::string path_;
@@ -182,6 +245,9 @@ class RemoteBackend final : public Backend {
   std::vector<DeviceNode> nodes_;
   std::vector<std::uint8_t> packet_, scratch_;
   Packet reply_;
+  bool use_shared_ = true;
+  std::unique_ptr<SharedChannel> shared_;
+  bool from_region_ = false;  // the last reply is in shared_'s reply area, not in reply_
 };
 
 }  // namespace

@@ -70,6 +70,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  status [--chip K]                   STATUS of each chip, read without clearing anything\n"
          "  get REGISTER [--chip K]             a register as GetParam would return it, without side effects\n"
          "  dump                                every register of every chip, STATUS decoded, open files\n"
+         "  clients                             the connected programs (pid), each through shared memory or the socket\n"
          "  sw open|closed --chip K             the limit switch on the SW pin (closed = pulled low)\n"
          "  pin SW|STCK|STBY_RST 0|1 --chip K   drive an input pin of a chip\n"
          "  fault uvlo|uvlo-adc|ocd|stall-a|stall-b on|off --chip K\n"

@@ -1,4 +1,5 @@
-// The serve daemon: socket set-up, accept loop, one thread per connection, clean shutdown.
+// The serve daemon: socket set-up, accept loop, one thread per connection (its requests from the
+// socket or from a shared region), clean shutdown.
 #include "linux/serve/daemon.hpp"
 
 #include <poll.h>
@@ -10,6 +11,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -17,11 +19,13 @@
 #include <list>
 #include <memory>
 #include <mutex>
+#include <sstream>
 #include <thread>
 
 #include "linux/board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/serve/control.hpp"
+#include "linux/shm_channel.hpp"
 
 namespace l6470emu {
 namespace {
@@ -60,6 +64,10 @@ struct Connection {
   int fd = -1;
   pthread_t thread{};
   bool done = false;
+  pid_t pid = 0;
+  std::atomic<bool> shared{false};                // requests come through a shared region
+  std::atomic<std::uint64_t> shared_requests{0};  // served from the region
+  std::atomic<std::uint64_t> socket_requests{0};  // received on the socket
 };
 
 /// Starts `body` on a thread with a small stack. Returns false (errno set) when it cannot.
@@ -85,15 +93,67 @@ bool start_thread(pthread_t& thread, std::function<void()> body) {
   return true;
 }
 
+/// Sends a reply on the socket (closing `pass_fd` after); false when the client is gone.
+bool send_reply(int sock, const ReplyHeader& reply, const std::vector<std::uint8_t>& payload, int pass_fd) {
+  const bool sent = send_packet(sock, &reply, sizeof reply, payload, pass_fd);
+  if (pass_fd >= 0) close(pass_fd);  // the client has its copy now (or is gone)
+  return sent;
+}
+
+/// Op::attach_shm: a shared region for this connection (one only), its memfd in the reply.
+bool attach_shared(Connection& c, std::unique_ptr<SharedChannel>& shared) {
+  ReplyHeader reply{};
+  int fd = -1;
+  if (shared) {
+    reply.result = -EALREADY;
+  } else if (auto made = SharedChannel::create(fd)) {
+    shared = std::move(made);
+    reply.result = static_cast<std::int64_t>(SharedChannel::region_bytes());
+  } else {
+    reply.result = -errno;
+  }
+  if (!send_reply(c.fd, reply, {}, fd)) return false;
+  if (shared) c.shared = true;
+  return true;
+}
+
+/// Serves one connection until the client leaves (or the daemon shuts the socket down). On the
+/// socket until the client attaches a shared region, then from the region: the thread spins
+/// briefly for the next request and then sleeps on the region's futex, looking every
+/// kShmAliveCheckMs whether the client is still there, so a client killed at any moment (even
+/// while the thread sleeps on its futex) ends only its own connection.
 void serve_connection(Board& board, const ControlHandler& control, Connection& c) {
   Packet packet;
   std::vector<std::uint8_t> payload;
   ReplyHeader reply;
+  std::unique_ptr<SharedChannel> shared;
+  std::unique_ptr<std::uint8_t[]> scratch(new std::uint8_t[kShmAreaBytes]);
+  const std::function<bool()> alive = [&c] { return peer_alive(c.fd); };
   for (;;) {
-    int passed = -1;
-    if (!recv_packet(c.fd, packet, passed, true, kRequestSpinNs)) break;
-    if (passed >= 0) close(passed);  // clients never send descriptors
     int pass_fd = -1;
+    if (shared) {
+      if (!shared->wait_request(kRequestSpinNs, alive)) break;
+      const SharedOutcome done = serve_shared_request(board, control, *shared, scratch.get(), reply, payload, pass_fd);
+      if (done != SharedOutcome::request_on_socket) {
+        ++c.shared_requests;
+        if (done == SharedOutcome::reply_on_socket) {
+          if (!send_reply(c.fd, reply, payload, pass_fd)) break;
+          shared->post_reply({}, {}, kShmOnSocket);
+        }
+        continue;
+      }
+    }
+    int passed = -1;
+    if (!recv_packet(c.fd, packet, passed, true, shared ? 0 : kRequestSpinNs)) break;
+    if (passed >= 0) close(passed);  // clients never send descriptors
+    ++c.socket_requests;
+    if (RequestHeader req; packet.size == sizeof req) {
+      std::memcpy(&req, packet.data.get(), sizeof req);
+      if (req.op == static_cast<std::uint32_t>(Op::attach_shm) && req.payload == 0) {
+        if (!attach_shared(c, shared)) break;
+        continue;
+      }
+    }
     try {
       serve_request(board, control, packet.bytes(), reply, payload, pass_fd);
     } catch (const std::exception&) {
@@ -102,10 +162,27 @@ void serve_connection(Board& board, const ControlHandler& control, Connection& c
       payload.clear();
     }
     reply.payload = static_cast<std::uint32_t>(payload.size());
-    const bool sent = send_packet(c.fd, &reply, sizeof reply, payload, pass_fd);
-    if (pass_fd >= 0) close(pass_fd);  // the client has its copy now (or is gone)
-    if (!sent) break;                  // client killed mid-request: drop it, keep serving others
+    if (!send_reply(c.fd, reply, payload, pass_fd)) break;  // client killed mid-request: drop it, keep serving others
   }
+}
+
+/// `ctl clients`: who is connected and how each is served (a connection that ended but is not
+/// reaped yet is left out). The caller holds the connections' lock.
+std::string describe_clients(const std::list<Connection>& connections) {
+  std::ostringstream o;
+  std::size_t n = 0;
+  for (const Connection& c : connections) n += c.done ? 0 : 1;
+  o << n << (n == 1 ? " client\n" : " clients\n");
+  for (const Connection& c : connections) {
+    if (c.done) continue;
+    o << "pid " << c.pid << ": ";
+    if (c.shared)
+      o << "shared memory, " << c.shared_requests << " requests through it, " << c.socket_requests
+        << " through the socket\n";
+    else
+      o << "socket, " << c.socket_requests << (c.socket_requests == 1 ? " request\n" : " requests\n");
+  }
+  return o.str();
 }
 
 }  // namespace
@@ -190,9 +267,18 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
       return 1;
     }
   }
+  std::list<Connection> connections;
+  std::mutex connections_mutex;
   std::mutex control_mutex;  // ctl commands one at a time
   const ControlHandler control = [&](const std::string& command, std::string& text) {
     std::lock_guard lock(control_mutex);
+    std::istringstream words(command);
+    std::string first, more;
+    if (words >> first && first == "clients" && !(words >> more)) {
+      std::lock_guard l(connections_mutex);
+      text = describe_clients(connections);
+      return 0;
+    }
     return run_control(board, command, text);
   };
 
@@ -206,8 +292,6 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   out << "run programs with: LD_PRELOAD=<path>/libl6470emu-preload.so L6470EMU_SOCKET=" << socket_path << " <program>\n";
   out.flush();
 
-  std::list<Connection> connections;
-  std::mutex connections_mutex;
   bool warned_descriptors = false, warned_clients = false;
   for (;;) {
     pollfd fds[2] = {{listener, POLLIN, 0}, {sfd, POLLIN, 0}};
@@ -258,6 +342,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     warned_clients = false;
     Connection& conn = connections.emplace_back();
     conn.fd = c;
+    conn.pid = peer.pid;
     if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex] {
           serve_connection(board, control, conn);
           std::lock_guard l(connections_mutex);

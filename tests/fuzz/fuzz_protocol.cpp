@@ -1,8 +1,11 @@
 // libFuzzer harness of the daemon's request dispatcher (linux/protocol.hpp serve_request) on
 // a virtual-time Board: every Op, well-formed and not (truncated headers, payloads longer or
 // shorter than announced, oversized counts), spidev and gpio ioctls with argument buffers of
-// any size, spi_message with any transfers. Checked: nothing crashes, replies stay bounded,
-// a passed descriptor comes only with a handle. `ctl trace` is not run (it writes files).
+// any size, spi_message with any transfers. About half the packets arrive through a shared
+// region (serve_shared_request, linux/shm_channel.hpp) as a hostile client could leave them:
+// any size word (past the area too), any flags. Checked: nothing crashes, replies stay bounded,
+// a passed descriptor comes only with a handle, a reply the region got fits it. `ctl trace` is
+// not run (it writes files).
 #include <fuzzer/FuzzedDataProvider.h>
 #include <linux/gpio.h>
 #include <linux/spi/spidev.h>
@@ -17,6 +20,7 @@
 #include "linux/board.hpp"
 #include "linux/log.hpp"
 #include "linux/protocol.hpp"
+#include "linux/shm_channel.hpp"
 #include "linux/serve/control.hpp"
 
 using namespace l6470emu;
@@ -67,6 +71,7 @@ class Harness {
   ~Harness() {
     board_.reset();
     for (int fd : fds_) ::close(fd);
+    if (region_fd_ >= 0) ::close(region_fd_);
   }
 
   void run() {
@@ -210,7 +215,11 @@ class Harness {
     ReplyHeader reply;
     std::vector<std::uint8_t> out;
     int pass_fd = -1;
-    serve_request(*board_, control_, packet, reply, out, pass_fd);
+    if (in_.ConsumeBool() && through_region(packet, reply, out, pass_fd)) {
+      // served from the shared region (checked there)
+    } else {
+      serve_request(*board_, control_, packet, reply, out, pass_fd);
+    }
     FUZZ_CHECK(out.size() <= kMaxMessage + 65536, "reply payload of %zu bytes", out.size());
     if (pass_fd >= 0) {
       FUZZ_CHECK(reply.result >= 0 && reply.handle != 0, "a descriptor passed with result %lld, handle %llu",
@@ -225,7 +234,52 @@ class Harness {
     }
   }
 
+  /// Posts `packet` in the shared region as a client would (or with a size word and flags that
+  /// lie) and serves it. False when the packet is for the socket (too large for the region, or
+  /// the region could not be made), which the caller then serves as the socket's.
+  bool through_region(const std::vector<std::uint8_t>& packet, ReplyHeader& reply, std::vector<std::uint8_t>& out,
+                      int& pass_fd) {
+    if (packet.size() > kShmAreaBytes) return false;
+    if (!daemon_side_) {
+      daemon_side_ = SharedChannel::create(region_fd_);
+      if (!daemon_side_) return false;
+      client_side_ = SharedChannel::attach(region_fd_);
+      if (!client_side_) return false;
+      scratch_.resize(kShmAreaBytes);
+    }
+    if (!packet.empty()) std::memcpy(client_side_->request_area(), packet.data(), packet.size());
+    std::uint32_t size = static_cast<std::uint32_t>(packet.size());
+    std::uint32_t flags = 0;
+    switch (in_.ConsumeIntegralInRange<int>(0, 15)) {
+      case 0: size = in_.ConsumeIntegral<std::uint32_t>(); break;
+      case 1: size = static_cast<std::uint32_t>(kShmAreaBytes) + in_.ConsumeIntegralInRange<std::uint32_t>(0, 4096); break;
+      case 2: flags = in_.ConsumeIntegral<std::uint32_t>(); break;
+      default: break;
+    }
+    client_side_->post_request(size, flags);
+    FUZZ_CHECK(daemon_side_->wait_request(0, {}), "a posted request was not seen");
+    const SharedOutcome done = serve_shared_request(*board_, control_, *daemon_side_, scratch_.data(), reply, out, pass_fd);
+    if (done == SharedOutcome::request_on_socket) {
+      FUZZ_CHECK(flags & kShmOnSocket, "a request taken for the socket's without the flag");
+      return false;
+    }
+    if (done == SharedOutcome::replied) {
+      FUZZ_CHECK(pass_fd < 0, "a descriptor left behind by a reply in the region");
+      FUZZ_CHECK(client_side_->wait_reply(0, {}), "a reply in the region was not seen");
+      const auto r = client_side_->reply();
+      FUZZ_CHECK(r.size() == sizeof(ReplyHeader) + out.size() && r.size() <= kShmAreaBytes,
+                 "region reply of %zu bytes for a payload of %zu", r.size(), out.size());
+    } else {
+      FUZZ_CHECK(pass_fd >= 0 || sizeof(ReplyHeader) + out.size() > kShmAreaBytes,
+                 "a reply that fits the region was sent to the socket");
+    }
+    return true;
+  }
+
   FuzzedDataProvider& in_;
+  int region_fd_ = -1;
+  std::unique_ptr<SharedChannel> daemon_side_, client_side_;
+  std::vector<std::uint8_t> scratch_;
   DiagnosticLog log_{"off"};
   std::unique_ptr<Board> board_;
   std::vector<int> fds_;
