@@ -22,6 +22,7 @@
 #include <sstream>
 #include <thread>
 
+#include "daisychain/chip_numbering.hpp"
 #include "linux/board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/serve/control.hpp"
@@ -273,8 +274,13 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   const ControlHandler control = [&](const std::string& command, std::string& text) {
     std::lock_guard lock(control_mutex);
     std::istringstream words(command);
-    std::string first, more;
-    if (words >> first && first == "clients" && !(words >> more)) {
+    std::string first, more, from;
+    // `clients` names no chip, so ctl's --number-from (passed after the command word) changes nothing.
+    const auto only_numbering = [&] {
+      if (!(words >> more)) return true;
+      return more == "--number-from" && words >> from && number_from_named(from) && !(words >> more);
+    };
+    if (words >> first && first == "clients" && only_numbering()) {
       std::lock_guard l(connections_mutex);
       text = describe_clients(connections);
       return 0;

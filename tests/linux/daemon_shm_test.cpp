@@ -55,6 +55,9 @@ TEST_F(DaemonSharedMemory, APreloadClientIsServedThroughTheSharedRegion) {
   EXPECT_NE(c.out.find("pid " + std::to_string(holder.pid()) + ": shared memory"), std::string::npos) << c.out;
   // ctl's own connection stays on the socket.
   EXPECT_NE(c.out.find(": socket, 1 request\n"), std::string::npos) << c.out;
+  // clients names no chip: a chip numbering changes nothing, a bad one is refused.
+  EXPECT_EQ(d.ctl({"--number-from", "mosi", "clients"}).status, 0);
+  EXPECT_EQ(d.ctl({"--number-from", "sideways", "clients"}).status, 2);
 }
 
 TEST_F(DaemonSharedMemory, TheRegionAndTheSocketGiveTheSameBytesErrorsAndBusTime) {
