@@ -85,6 +85,43 @@ std::vector<MotionSample> thin(const std::vector<MotionSample>& in, Tick from, T
   return out;
 }
 
+/// Tells a PassProgress how far a reader has come: at the start, every kEventsPerReport
+/// events and at the end (done == total), never going back.
+class PassReporter {
+ public:
+  static constexpr std::uint32_t kEventsPerReport = 4096;
+  PassReporter(const TraceReader& in, const PassProgress& progress) : in_(in), progress_(progress) { report(); }
+  void event() {
+    if (progress_ && ++count_ == kEventsPerReport) {
+      count_ = 0;
+      report();
+    }
+  }
+  void end() {
+    if (!progress_) return;
+    ReadProgress p = in_.progress();
+    p.done = std::max(p.done, done_);
+    if (p.total == 0 || p.done > p.total) p.total = p.done;
+    p.done = p.total;
+    progress_(p);
+  }
+
+ private:
+  void report() {
+    if (!progress_) return;
+    ReadProgress p = in_.progress();
+    p.done = std::max(p.done, done_);  // a reader's count may stall; it never goes back here
+    if (p.total != 0) p.done = std::min(p.done, p.total);
+    done_ = p.done;
+    progress_(p);
+  }
+
+  const TraceReader& in_;
+  const PassProgress& progress_;
+  std::uint32_t count_ = 0;
+  std::uint64_t done_ = 0;
+};
+
 class Sampler {
  public:
   Sampler(Chain& chain, const MotionOptions& o, Tick from, Tick to, Tick step)
@@ -209,10 +246,15 @@ class Sampler {
 
 }  // namespace
 
-Tick trace_end_tick(TraceReader& in) {
+Tick trace_end_tick(TraceReader& in, const PassProgress& progress) {
+  PassReporter reporter(in, progress);
   Tick end = 0;
   TraceEvent e;
-  while (in.next(e)) end = std::max(end, e.kind == TraceEventKind::frame ? e.end() : e.tick);
+  while (in.next(e)) {
+    end = std::max(end, e.kind == TraceEventKind::frame ? e.end() : e.tick);
+    reporter.event();
+  }
+  reporter.end();
   return end;
 }
 
@@ -245,10 +287,12 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
   });
 
   if (chain.now() == from) sampler.sample_all(from);  // a window from the start: the power-up state
+  PassReporter reporter(in, options.progress);
   std::vector<std::uint8_t> rx;
   TraceEvent e;
   bool ended = true;
   while (in.next(e)) {
+    reporter.event();
     const Tick at = e.kind == TraceEventKind::frame ? e.end() : e.tick;
     if (at > last) {
       ended = false;
@@ -297,6 +341,7 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
   // The last samples close the window (the sampler only looks at moving chips).
   sampler.sample_all(std::min(chain.now(), to));
   out.chips = sampler.finish(to);
+  reporter.end();
   return out;
 }
 

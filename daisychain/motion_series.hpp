@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,13 @@ struct ChipMotion {
   std::uint64_t commands_dropped = 0; ///< commands in the window beyond max_commands
 };
 
+/// How far a pass over a trace has come, for a progress bar: called with the reader's
+/// progress() (bytes of the file, or events) when the pass begins, every few thousand events,
+/// and once when it ends, then with done == total (total = done when the reader cannot say).
+/// `done` never goes back within a pass. The pass's own work; the caller limits the rate it
+/// draws at.
+using PassProgress = std::function<void(const ReadProgress&)>;
+
 /// Choices for sample_motion.
 struct MotionOptions {
   std::vector<std::size_t> chips;  ///< chips to sample, numbered as number_from says (empty = all)
@@ -61,6 +69,7 @@ struct MotionOptions {
   /// SPEED and the first change of each pin), so the picture keeps its shape. At least 64.
   std::size_t max_points = 4000;
   std::size_t max_commands = 2000;  ///< most command marks per chip
+  PassProgress progress;            ///< told how far the replay has come (empty: nobody asks)
 };
 
 /// The series of a trace's window.
@@ -70,8 +79,9 @@ struct MotionSeries {
   std::vector<ChipMotion> chips;  ///< in the order asked for
 };
 
-/// The last tick of a trace: the latest event's tick (a frame's CS rising edge).
-Tick trace_end_tick(TraceReader& in);
+/// The last tick of a trace: the latest event's tick (a frame's CS rising edge). `progress`
+/// (if any) is told how far the reading has come.
+Tick trace_end_tick(TraceReader& in, const PassProgress& progress = {});
 
 /// Replays `in` through `chain` (fresh, as the capture began) and samples the chosen chips.
 /// Samples are taken at the window's edges, after every trace event inside the window that

@@ -547,6 +547,7 @@ void NativeTraceWriter::write_header(const TraceHeader& header) {
   header_written_ = true;
   std::string text = std::string(kNativeTraceMagic) + " " + std::to_string(kNativeTraceVersion) + "\n";
   if (!header.chain.empty()) text += "chain " + header.chain + "\n";
+  text += "# " + std::string(kNativeTraceNumbering) + "\n";
   if (!header.name.empty() && header.format != "native")
     text += "# converted from " + header.name + (header.format.empty() ? "" : " (" + header.format + ")") + "\n";
   for (const std::string& note : header.notes) text += "# note: " + note + "\n";

@@ -19,6 +19,11 @@ namespace l6470emu {
 inline constexpr std::string_view kNativeTraceMagic = "l6470emu-trace";
 /// The format version this code writes and reads.
 inline constexpr int kNativeTraceVersion = 1;
+/// The comment the writer puts under the header (after `chain`), so a reader of the file
+/// knows which end chip 0 is: the chain's own order, whatever a tool shows.
+inline constexpr std::string_view kNativeTraceNumbering =
+    "chip numbers count from the MISO end: chip 0 drives MISO, byte k of a frame goes to chip k";
+
 /// The most frames a `repeat` line can repeat as one group.
 inline constexpr std::size_t kMaxRepeatGroup = 16;
 /// The most repetitions one `repeat` line can stand for.

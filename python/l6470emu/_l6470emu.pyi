@@ -2,7 +2,7 @@
 # checks that every name here exists in the module and the other way round.
 import enum
 import os
-from typing import Iterator, List, Optional, Sequence, Union, overload
+from typing import Callable, Iterator, List, Optional, Sequence, Union, overload
 
 from ._status import Status
 
@@ -370,4 +370,6 @@ class Motion:
 def motion(trace: Union[Trace, _Path], chain: Optional[_Chips] = None, *, format: Optional[str] = None,
            select: str = "", chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, max_points: int = 4000, max_commands: int = 2000,
-           number_from: str = "miso") -> Motion: ...
+           number_from: str = "miso",
+           progress: Optional[Callable[[str, int, int, str], object]] = None) -> Motion: ...
+def format_progress(label: str, done: int, total: int, unit: str, width: int = 80) -> str: ...

@@ -50,7 +50,46 @@ def parse_chips(text: str) -> List[int]:
     return sorted(set(chips))
 
 
-def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from):
+class TerminalProgress:
+    """A progress bar on a terminal (standard error by default), as the l6470emu program draws
+    it while replaying or converting: one line redrawn in place, cleared when done; nothing at
+    all when the stream is not a terminal (a pipe, a file, a test). Pass it as progress= to
+    figure(), plot() or l6470emu.motion(); stage() shows a step without a bar ("drawing").
+    """
+
+    def __init__(self, name: str, stream=None):
+        self.name = name
+        self.stream = stream if stream is not None else sys.stderr
+        try:
+            self.enabled = self.stream.isatty()
+        except (AttributeError, ValueError):
+            self.enabled = False
+        self._drawn = False
+
+    def __call__(self, stage: str, done: int, total: int, unit: str) -> None:
+        label = f"{stage} {self.name}"
+        self._draw(label if done == 0 and total == 0 else _l6470emu.format_progress(label, done, total, unit))
+
+    def stage(self, what: str) -> None:
+        """A step without a measure of its own: its name alone."""
+        self._draw(what)
+
+    def clear(self) -> None:
+        """Takes the bar off the line (before other output, and at the end)."""
+        if self.enabled and self._drawn:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
+        self._drawn = False
+
+    def _draw(self, line: str) -> None:
+        if not self.enabled:
+            return
+        self.stream.write("\r" + line + "\x1b[K")
+        self.stream.flush()
+        self._drawn = True
+
+
+def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress=None):
     """l6470emu.motion() of a Motion (as is), a Chain recording into memory, a Trace or a path."""
     if isinstance(source, _l6470emu.Motion):
         return source
@@ -61,7 +100,7 @@ def _motion_of(source, chain, chips, start, end, format, select, max_points, num
             end = source.now_seconds  # a live chain: up to its present
         source = source.trace if source.trace is not None else source.record_path
     return _l6470emu.motion(source, chain, format=format, select=select, chips=chips, start=start, end=end,
-                            max_points=max_points, number_from=number_from)
+                            max_points=max_points, number_from=number_from, progress=progress)
 
 
 def _time_scale(motion) -> tuple:
@@ -76,19 +115,20 @@ def _time_scale(motion) -> tuple:
 def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
            title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None,
-           number_from: str = "miso"):
+           number_from: str = "miso", progress=None):
     """The picture as a matplotlib Figure (not shown, not saved; pyplot is not used).
 
     source: a trace file (any format the l6470emu program reads), a Trace, a Chain made with
     record=True, or a Motion from l6470emu.motion() (which brings its own numbering). The other
     arguments are motion()'s (number_from: chip 0 at the "miso" or the "mosi" end), and
     position_unit = (name, microsteps per unit), e.g. ("rev", 25600), to draw positions in
-    another unit than ABS_POS's microsteps.
+    another unit than ABS_POS's microsteps. progress: motion()'s progress(stage, done, total,
+    unit), e.g. a TerminalProgress, told how far reading and replaying the trace have come.
     """
     import numpy as np
     from matplotlib.figure import Figure
 
-    motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from)
+    motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress)
     scale, unit = _time_scale(motion)
     pos_unit, per_unit = position_unit if position_unit is not None else ("microsteps", 1.0)
     if not per_unit > 0:
@@ -151,12 +191,16 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
 
 
 def plot(source, output: Union[str, Path], **options) -> Path:
-    """Draws the picture of `source` (see figure()) into `output`, a .png or .svg file."""
+    """Draws the picture of `source` (see figure()) into `output`, a .png or .svg file. A
+    progress with a stage() method (TerminalProgress) is also told when the drawing begins."""
     output = Path(output)
     if output.suffix.lower() not in FORMATS:
         raise PlotError(f"{output}: the picture is written as .png or .svg (the file name says which)")
     dpi = options.pop("dpi", 100)
     fig = figure(source, **options)
+    progress = options.get("progress")
+    if hasattr(progress, "stage"):
+        progress.stage(f"drawing {output.name}")
     fig.savefig(output, dpi=dpi)
     return output
 
@@ -222,9 +266,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             raise PlotError(f"drawing needs matplotlib: {MATPLOTLIB_MISSING}")
         import matplotlib
         matplotlib.use("Agg")
-        out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
-                   format=args.format, select=args.select, max_points=args.max_points, title=args.title,
-                   size=(width, height), dpi=args.dpi, number_from=args.number_from)
+        # A bar on a terminal while a long trace is read, replayed and drawn; quiet otherwise.
+        # The file's name alone: a long path cut to fit would cut the stage's name too.
+        bar = TerminalProgress(Path(args.trace).name)
+        try:
+            out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
+                       format=args.format, select=args.select, max_points=args.max_points, title=args.title,
+                       size=(width, height), dpi=args.dpi, number_from=args.number_from, progress=bar)
+        finally:
+            bar.clear()
     except (ValueError, TypeError, OSError, RuntimeError) as e:  # TraceError is a ValueError
         print(f"l6470emu plot: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -4,6 +4,7 @@
 // Values stay in the datasheet's integer units; l6470emu.plot converts and draws them.
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <cmath>
 #include <memory>
 
@@ -13,6 +14,7 @@
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/motion_series.hpp"
 #include "spi/trace_import.hpp"
+#include "tools/progress.hpp"
 #include "tools/trace_input.hpp"
 
 namespace l6470emu::python {
@@ -72,6 +74,32 @@ Tick tick_from_seconds(py::handle seconds, const char* what, Tick none) {
   return static_cast<Tick>(std::llround(s * static_cast<double>(kTicksPerSecond)));
 }
 
+/// A Python progress(stage, done, total, unit) told how far motion()'s passes have come, from
+/// the thread running them without the GIL: at most every 100 ms (taking the GIL only then),
+/// and always when a pass begins and ends. An exception it raises (KeyboardInterrupt) ends
+/// motion() with it.
+class PyProgress {
+ public:
+  explicit PyProgress(py::handle callback) : callback_(callback) {}
+  /// The daisychain callback for one pass ("reading", "replaying"); empty without a callback.
+  PassProgress pass(const char* stage) {
+    if (callback_.is_none()) return {};
+    return [this, stage, first = true](const ReadProgress& p) mutable {
+      const auto now = std::chrono::steady_clock::now();
+      const bool last = p.total != 0 && p.done == p.total;
+      if (!first && !last && now - drawn_ < std::chrono::milliseconds(100)) return;
+      first = false;
+      drawn_ = now;
+      py::gil_scoped_acquire locked;
+      callback_(stage, p.done, p.total, p.bytes ? "bytes" : "events");
+    };
+  }
+
+ private:
+  py::handle callback_;  // motion()'s argument: alive (and referenced) for the whole call
+  std::chrono::steady_clock::time_point drawn_{};
+};
+
 }  // namespace
 
 void bind_motion(py::module_& m) {
@@ -124,7 +152,11 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
   m.def(
       "motion",
       [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
-         py::handle end, std::size_t max_points, std::size_t max_commands, const std::string& number_from) {
+         py::handle end, std::size_t max_points, std::size_t max_commands, const std::string& number_from,
+         py::handle progress) {
+        if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+          throw py::type_error("progress: a function progress(stage, done, total, unit), or None");
+        PyProgress told(progress);
         MotionOptions o;
         try {
           o.number_from = parse_number_from(number_from);
@@ -153,8 +185,9 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
           Tick trace_end = 0;
           {
             auto pass = source.reader();
-            trace_end = trace_end_tick(*pass);
+            trace_end = trace_end_tick(*pass, told.pass("reading"));
           }
+          o.progress = told.pass("replaying");
           auto pass = source.reader();
           MotionSeries s = sample_motion(*pass, c, trace_end, o);
           result.start = s.from;
@@ -167,6 +200,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("select") = "", py::arg("chips") = py::none(), py::arg("start") = py::none(), py::arg("end") = py::none(),
       py::arg("max_points") = 4000, py::arg("max_commands") = 2000, py::arg("number_from") = "miso",
+      py::arg("progress") = py::none(),
       R"(Replays a trace through a fresh emulated chain and samples what each chip did.
 
 trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
@@ -178,8 +212,18 @@ still going). Samples are the chips' exact states at their ticks: at the window'
 after every event that touches a chip, at every change of the motion rule (the ends of
 acceleration, constant speed and deceleration: MOT_STATUS and BUSY edges to the tick) and
 on a grid of about max_points / 4 steps; long runs are thinned to at most max_points per
-chip. Raises ValueError for chips outside the chain or an empty window, TraceError for
+chip. progress, if given, is called as progress(stage, done, total, unit) while the trace is
+read ("reading": finding its end) and replayed ("replaying"): done and total count "bytes" of
+the file or "events" (total 0: not known), done never goes back within a stage, and each
+stage ends with done == total; at most about 10 calls a second (format_progress() draws a
+bar of them). Raises ValueError for chips outside the chain or an empty window, TraceError for
 malformed traces.)");
+
+  m.def("format_progress", &format_progress, py::arg("label"), py::arg("done"), py::arg("total"), py::arg("unit"),
+        py::arg("width") = 80,
+        R"(One line of progress, width characters at most, as the l6470emu program draws it on a
+terminal: "replaying run.trace [#####-----]  50% 12.0 of 24.0 MB". unit "bytes" is shown in
+kB/MB/GB, anything else as numbers; total 0: what was done, no bar.)");
 }
 
 }  // namespace l6470emu::python

@@ -183,6 +183,78 @@ TEST(MotionSeries, BadChipsAndEmptyWindowsAreRefused) {
   EXPECT_THROW(sample(s.trace, late), std::invalid_argument);
 }
 
+/// Every report a PassProgress got.
+struct Reports {
+  std::vector<ReadProgress> seen;
+  PassProgress callback() {
+    return [this](const ReadProgress& p) { seen.push_back(p); };
+  }
+  /// done never goes back, never passes total, and the last report is done == total.
+  void expect_rising_to_the_end(const char* pass, std::size_t at_least) const {
+    ASSERT_GE(seen.size(), at_least) << pass;
+    for (std::size_t i = 1; i < seen.size(); ++i) {
+      EXPECT_GE(seen[i].done, seen[i - 1].done) << pass << ", report " << i;
+      EXPECT_LE(seen[i].done, seen[i].total) << pass << ", report " << i;
+    }
+    EXPECT_EQ(seen.back().done, seen.back().total) << pass;
+    EXPECT_GT(seen.back().total, 0u) << pass;
+  }
+};
+
+/// One chip moving while the host polls 6000 times: more events than one report's worth.
+void polled_run(MovedChain& s) {
+  s.host.move(0, true, 3200);
+  for (int i = 0; i < 6000; ++i) s.host.get_status(0);
+}
+
+TEST(MotionSeries, BothPassesOverAFileReportBytesRisingToDoneEqualsTotal) {
+  MovedChain s(2);
+  polled_run(s);
+  test::TempDir dir;
+  const std::string path = dir.write("long.trace", to_native_text(s.trace));
+  const auto size = static_cast<std::uint64_t>(test::read_text(path).size());
+
+  Reports reading, replaying;
+  NativeTraceReader pass(path);
+  const Tick end = trace_end_tick(pass, reading.callback());
+  MotionOptions o;
+  o.progress = replaying.callback();
+  NativeTraceReader again(path);
+  Chain fresh(2);
+  sample_motion(again, fresh, end, o);
+
+  reading.expect_rising_to_the_end("reading", 3);  // the start, every 4096 events, the end
+  replaying.expect_rising_to_the_end("replaying", 3);
+  EXPECT_TRUE(replaying.seen.back().bytes);
+  EXPECT_EQ(reading.seen.back().total, size);
+  EXPECT_EQ(replaying.seen.back().total, size);
+}
+
+TEST(MotionSeries, ATraceInMemoryReportsEventsAlongTheWay) {
+  MovedChain s(1);
+  polled_run(s);
+  Reports replaying;
+  MotionOptions o;
+  o.progress = replaying.callback();
+  sample(s.trace, o);
+  replaying.expect_rising_to_the_end("replaying", 3);
+  EXPECT_FALSE(replaying.seen.back().bytes);
+  EXPECT_EQ(replaying.seen.back().total, s.trace.size());
+  EXPECT_EQ(replaying.seen[1].done, 4096u);  // every 4096 events
+}
+
+TEST(MotionSeries, AWindowEndingBeforeTheTraceStillReportsDoneEqualsTotal) {
+  MovedChain s(1);
+  polled_run(s);
+  Reports replaying;
+  MotionOptions o;
+  o.to = 1000;  // long before the trace ends: the pass stops early
+  o.progress = replaying.callback();
+  sample(s.trace, o);
+  replaying.expect_rising_to_the_end("replaying", 2);
+  EXPECT_EQ(replaying.seen.back().total, s.trace.size());
+}
+
 TEST(MotionSeries, TheThreeChipFixtureShowsItsSwitchAndItsMoves) {
   const Trace t = read_native_trace(test::fixture("three_chips.trace"), "three_chips.trace");
   const MotionSeries m = sample(t);

@@ -3,6 +3,8 @@ with something in it (read back as pixels), PNG and SVG, chosen chips and window
 recordings, and every bad input is one line on standard error with exit status 2.
 Run by ctest's `plot` test, which is skipped (with the reason) when matplotlib is missing."""
 import os
+import shlex
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -127,3 +129,28 @@ def test_chips_numbered_from_the_mosi_end_are_labelled_so_and_the_picture_says_w
     assert any("count from the MOSI end" in t.get_text() for t in fig.texts)
     labels = [line.get_label() for line in fig.axes[0].get_lines() if not line.get_label().startswith("_")]
     assert labels == ["chip 0 L6470 (1/128)"]
+
+
+def test_the_cli_is_quiet_but_for_its_result_when_standard_error_is_not_a_terminal(tmp_path):
+    out = tmp_path / "quiet.png"
+    r = run_plot(FIXTURES / "three_chips.trace", "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == f"l6470emu plot: wrote {out}\n"  # no bar, no carriage return, no escape
+    assert r.stdout == ""
+
+
+@pytest.mark.skipif(shutil.which("script") is None, reason="needs util-linux script (a terminal to draw on)")
+def test_on_a_terminal_the_cli_draws_reading_replaying_and_drawing_then_clears_the_line(tmp_path):
+    out = tmp_path / "tty.png"
+    command = shlex.join([l6470emu.program(), "plot", str(FIXTURES / "three_chips.trace"), "-o", str(out)])
+    # script runs the command on a pseudo-terminal and copies what it printed to its output.
+    r = subprocess.run(["script", "-qec", command, "/dev/null"], capture_output=True, timeout=120,
+                       stdin=subprocess.DEVNULL)
+    seen = r.stdout.decode()  # as bytes first: text mode would turn every '\r' into a newline
+    assert r.returncode == 0, seen
+    assert "\rreading three_chips.trace [" in seen, seen
+    assert "\rreplaying three_chips.trace [" in seen and "% 1896 B of 1896 B" in seen, seen  # a bar with a total
+    assert "\rdrawing tty.png" in seen, seen
+    # The bar is taken off the line before the result is printed.
+    assert f"\r\x1b[Kl6470emu plot: wrote {out}" in seen, seen
+    assert out.stat().st_size > 20_000

@@ -67,3 +67,64 @@ def test_mistakes_are_value_or_type_errors_naming_them(kwargs, error, says):
 def test_a_missing_file_is_a_trace_error():
     with pytest.raises(l6470emu.TraceError):
         l6470emu.motion("/nonexistent.trace")
+
+
+def progress_calls(trace, **kwargs):
+    calls = []
+    l6470emu.motion(trace, progress=lambda *call: calls.append(call), **kwargs)
+    return calls
+
+
+def test_progress_is_told_of_reading_then_replaying_each_rising_to_done_equals_total():
+    for trace in (FIXTURES / "three_chips.trace", polled_recording().trace):
+        calls = progress_calls(trace)
+        stages = [stage for stage, *_ in calls]
+        assert stages[0] == "reading" and stages[-1] == "replaying"
+        assert stages == sorted(stages)  # all of reading before any of replaying
+        for stage in ("reading", "replaying"):
+            mine = [(done, total, unit) for s, done, total, unit in calls if s == stage]
+            assert len(mine) >= 2, (stage, calls)  # when the pass begins and when it ends
+            dones = [done for done, _, _ in mine]
+            assert dones == sorted(dones), (stage, mine)
+            done, total, unit = mine[-1]
+            assert done == total > 0, (stage, mine)
+            assert unit == ("bytes" if isinstance(trace, Path) else "events")
+
+
+def polled_recording():
+    chain = l6470emu.Chain("L6470", record=True)
+    chain.move(0, forward=True, n_step=3200)
+    for _ in range(5000):
+        chain.get_status(0)
+    return chain
+
+
+def test_a_window_ending_early_still_ends_its_progress_with_done_equals_total():
+    calls = progress_calls(polled_recording().trace, end=0.001)
+    assert calls[-1][0] == "replaying" and calls[-1][1] == calls[-1][2] == len(polled_recording().trace)
+
+
+def test_progress_calls_are_few_even_for_a_long_trace():
+    calls = progress_calls(polled_recording().trace)
+    assert len(calls) <= 10  # at most every 100 ms, plus each pass's start and end
+
+
+def test_an_exception_raised_by_progress_ends_motion_with_it():
+    class Stop(Exception):
+        pass
+
+    def stop(*_):
+        raise Stop("enough")
+
+    with pytest.raises(Stop, match="enough"):
+        l6470emu.motion(FIXTURES / "three_chips.trace", progress=stop)
+
+
+def test_progress_must_be_callable():
+    with pytest.raises(TypeError, match="progress"):
+        l6470emu.motion(FIXTURES / "three_chips.trace", progress=3)
+
+
+def test_format_progress_draws_the_programs_bar():
+    assert l6470emu._l6470emu.format_progress("replaying run.trace", 50, 100, "events", 60) == \
+        "replaying run.trace [########--------]  50% 50 of 100 events"

@@ -55,6 +55,7 @@ TEST(TraceCompaction, CollapsesAPollingLoopIntoOneRepeatLine) {
   EXPECT_EQ(text,
             "l6470emu-trace 1\n"
             "chain 1\n"
+            "# chip numbers count from the MISO end: chip 0 drives MISO, byte k of a frame goes to chip k\n"
             "0.00010000 frame 1.75us D0 | 00\n"
             "0.00010300 frame 1.75us 00 | 7C\n"
             "0.00010600 frame 1.75us 00 | 03\n"
@@ -69,7 +70,7 @@ TEST(TraceCompaction, ReadsBackExactlyTheFramesThatWereCollapsed) {
   const Trace back = read_native_trace(to_native_text(original, true), "c.trace");
   expect_same_events(original, back);
   // Each repeated frame says which repetition of which line it came from.
-  EXPECT_EQ(back[6].line, 9u);
+  EXPECT_EQ(back[6].line, 10u);  // the repeat line, after the header, chain, numbering comment and 6 frames
   EXPECT_EQ(back[6].repetition, 1u);
   EXPECT_EQ(back[back.size() - 1].repetition, 998u);
   EXPECT_EQ(back[5].repetition, 0u);

@@ -82,7 +82,7 @@ TEST(NativeTrace, RoundTripsEveryKindOfEventExactly) {
   EXPECT_TRUE(back[1].miso_byte_known(0));
   EXPECT_FALSE(back[1].miso_byte_known(1));
   EXPECT_TRUE(back[2].miso.empty());
-  EXPECT_EQ(back[0].line, 3u);  // header, chain line, then the first event
+  EXPECT_EQ(back[0].line, 4u);  // header, chain line, the numbering comment, then the first event
 }
 
 TEST(NativeTrace, RoundsHandWrittenTimesToTheNearestTick) {
@@ -162,7 +162,8 @@ TEST(NativeTrace, WriterHandsEveryEventToTheFileBeforeReturning) {
   const Bytes mosi{0xD0}, miso{0x00};
   w.write(frame_at(0, 7, mosi, miso));
   // Still open, nothing closed: the file already holds the header and the frame.
-  EXPECT_EQ(test::read_text(path), "l6470emu-trace 1\n0.00000000 frame 1.75us D0 | 00\n");
+  EXPECT_EQ(test::read_text(path), "l6470emu-trace 1\n# " + std::string(kNativeTraceNumbering) +
+                                        "\n0.00000000 frame 1.75us D0 | 00\n");
 }
 
 TEST(NativeTrace, AKilledRecorderLeavesACompleteFile) {
