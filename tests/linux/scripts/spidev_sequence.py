@@ -13,7 +13,12 @@ s.max_speed_hz = 4000000
 print(f"settings=mode{s.mode} bits{s.bits_per_word} {s.max_speed_hz}Hz")
 
 
+frames = 0
+
+
 def frame(b):
+    global frames
+    frames += 1
     return s.xfer2([b])[0]
 
 
@@ -49,4 +54,5 @@ while time.monotonic() < deadline and not get_status() & 0x0002:
     time.sleep(0.01)
 print(f"abs_pos={get_param(0x01, 3)}")
 print(f"status_end=0x{get_status():04X}")
+print(f"frames={frames}")
 s.close()
