@@ -7,6 +7,7 @@
 #include <algorithm>
 
 #include "core/fast_motion.hpp"
+#include "core/first_true.hpp"
 
 namespace l6470emu {
 namespace {
@@ -24,20 +25,6 @@ MotionState after(const MotionState& s, const Profile& p, Tick i) {
   MotionState c = s;
   apply_uniform_ticks(c, p, i);
   return c;
-}
-
-/// Smallest i in [lo, hi] with pred(i) true (pred monotone false...true), or hi + 1.
-template <class Pred>
-Tick first_true(Tick lo, Tick hi, Pred pred) {
-  if (lo > hi || !pred(hi)) return hi + 1;
-  while (lo < hi) {
-    const Tick mid = lo + (hi - lo) / 2;
-    if (pred(mid))
-      hi = mid;
-    else
-      lo = mid + 1;
-  }
-  return lo;
 }
 
 bool moving(const MotionState& s) { return motion_active(s) && !s.hiz; }

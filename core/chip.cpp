@@ -424,6 +424,10 @@ bool Chip::flag_pin() const {
 
 void Chip::set_sw_pin(bool level) {
   sync();
+  drive_sw(level);
+}
+
+void Chip::drive_sw(bool level) {
   touched();
   if (level == sw_level_) return;
   sw_level_ = level;
@@ -668,14 +672,7 @@ void Chip::axis_settle(Tick at) {
     if (axis_->sw_level() != axis_sw_) {
       axis_sw_ = axis_->sw_level();
       if (axis_sw_ != sw_level_) {
-        touched();
-        sw_level_ = axis_sw_;
-        if (stby_level_) {
-          if (!sw_level_)
-            switch_turn_on_event();
-          else
-            switch_release_event();
-        }
+        drive_sw(axis_sw_);
         drove = true;
       }
     }

@@ -169,6 +169,8 @@ class Chip {
   void clear_latches();
   bool hiz_forced() const;
   void apply_forced_hiz();
+  /// The SW level changes to `level` at the chip's current time (the motion already synced).
+  void drive_sw(bool level);
   void switch_turn_on_event();
   void switch_release_event();
   void wrong_command(std::uint8_t byte, const char* why);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 
+#include "core/first_true.hpp"
 #include "core/registers.hpp"
 
 namespace l6470emu {
@@ -58,21 +59,6 @@ u128 distance_after(std::uint64_t v, const Rule& r, Tick i) {
   const u128 base = static_cast<u128>(v) * i;
   const u128 tri = static_cast<u128>(r.delta) * i * (static_cast<u128>(i) + 1) / 2;
   return r.sign >= 0 ? base + tri : base - tri;
-}
-
-/// Smallest i in [lo, hi] with pred(i) true (pred monotone: false...true), or hi+1.
-template <class Pred>
-Tick first_true(Tick lo, Tick hi, Pred pred) {
-  if (lo > hi) return hi + 1;
-  if (!pred(hi)) return hi + 1;
-  while (lo < hi) {
-    const Tick mid = lo + (hi - lo) / 2;
-    if (pred(mid))
-      hi = mid;
-    else
-      lo = mid + 1;
-  }
-  return lo;
 }
 
 /// Uniform ticks of a ramp that ends at the cap tick, bounded by `limit`.

@@ -28,25 +28,26 @@ bool ends_with(std::string_view s, std::string_view suffix) {
   return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
 }
 
-/// An ostream's buffer over a TraceFileWriter (gzip when the name ends in .gz). A stream
-/// swallows what its buffer throws, so a write error is kept here (error()) with its text
-/// ("out.vcd: write failed: No space left on device") and the stream goes bad.
-class FileBuf final : public std::streambuf {
+/// An ostream's buffer that hands each buffer-full to write_out() and keeps the first write
+/// error with its text ("out.vcd: write failed: No space left on device"): a stream swallows
+/// what its buffer throws, and std::cout loses errno. After an error the stream goes bad.
+class ErrorKeepingBuf : public std::streambuf {
  public:
-  explicit FileBuf(const std::string& path) : file_(path) { setp(buf_, buf_ + sizeof buf_); }
-  /// Keeps what was written before an error elsewhere (the file is then finished by file_).
-  ~FileBuf() override { sync_out(); }
-  /// Writes what is buffered and finishes the file; throws the first write error.
-  void close() {
-    if (!error_.empty()) throw std::runtime_error(error_);
-    sync_out();
-    if (!error_.empty()) throw std::runtime_error(error_);
-    file_.close();
-  }
+  ErrorKeepingBuf() { setp(buf_, buf_ + sizeof buf_); }
   /// The first write error, or "".
   const std::string& error() const { return error_; }
 
  protected:
+  /// Writes `bytes` out; returns "" or the error's text.
+  virtual std::string write_out(std::string_view bytes) = 0;
+  /// Writes what is buffered (nothing after an error); false once an error happened.
+  bool sync_out() {
+    if (!error_.empty()) return false;
+    error_ = write_out(std::string_view(pbase(), static_cast<std::size_t>(pptr() - pbase())));
+    if (!error_.empty()) return false;
+    setp(buf_, buf_ + sizeof buf_);
+    return true;
+  }
   int_type overflow(int_type c) override {
     if (!sync_out()) return traits_type::eof();
     if (!traits_type::eq_int_type(c, traits_type::eof())) {
@@ -58,63 +59,57 @@ class FileBuf final : public std::streambuf {
   int sync() override { return sync_out() ? 0 : -1; }
 
  private:
-  bool sync_out() {
-    if (!error_.empty()) return false;
-    try {
-      file_.write(std::string_view(pbase(), static_cast<std::size_t>(pptr() - pbase())));
-    } catch (const std::exception& e) {
-      error_ = e.what();
-      return false;
-    }
-    setp(buf_, buf_ + sizeof buf_);
-    return true;
-  }
-  TraceFileWriter file_;
   std::string error_;
   char buf_[1 << 16];
 };
 
-/// An ostream's buffer over standard output's descriptor, keeping the first write error with
-/// its reason ("standard output: write failed: Broken pipe"): std::cout loses errno.
-class StdoutBuf final : public std::streambuf {
+/// Over a TraceFileWriter (gzip when the name ends in .gz).
+class FileBuf final : public ErrorKeepingBuf {
  public:
-  StdoutBuf() { setp(buf_, buf_ + sizeof buf_); }
+  explicit FileBuf(const std::string& path) : file_(path) {}
+  /// Keeps what was written before an error elsewhere (the file is then finished by file_).
+  ~FileBuf() override { sync_out(); }
+  /// Writes what is buffered and finishes the file; throws the first write error.
+  void close() {
+    if (!sync_out()) throw std::runtime_error(error());
+    file_.close();
+  }
+
+ private:
+  std::string write_out(std::string_view bytes) override {
+    try {
+      file_.write(bytes);
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return {};
+  }
+  TraceFileWriter file_;
+};
+
+/// Over standard output's descriptor, so that a write error keeps its reason
+/// ("standard output: write failed: Broken pipe").
+class StdoutBuf final : public ErrorKeepingBuf {
+ public:
   /// Keeps what was written before an error elsewhere.
   ~StdoutBuf() override { sync_out(); }
   /// Writes what is buffered; throws the first write error.
   void close() {
-    if (!sync_out() || !error_.empty()) throw std::runtime_error(error_);
+    if (!sync_out()) throw std::runtime_error(error());
   }
-
- protected:
-  int_type overflow(int_type c) override {
-    if (!sync_out()) return traits_type::eof();
-    if (!traits_type::eq_int_type(c, traits_type::eof())) {
-      *pptr() = traits_type::to_char_type(c);
-      pbump(1);
-    }
-    return traits_type::not_eof(c);
-  }
-  int sync() override { return sync_out() ? 0 : -1; }
 
  private:
-  bool sync_out() {
-    if (!error_.empty()) return false;
-    const char* p = pbase();
-    while (p < pptr()) {
-      const ssize_t n = ::write(STDOUT_FILENO, p, static_cast<std::size_t>(pptr() - p));
+  std::string write_out(std::string_view bytes) override {
+    const char* p = bytes.data();
+    const char* const end = p + bytes.size();
+    while (p < end) {
+      const ssize_t n = ::write(STDOUT_FILENO, p, static_cast<std::size_t>(end - p));
       if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) {
-        error_ = std::string("standard output: write failed: ") + std::strerror(n < 0 ? errno : EIO);
-        return false;
-      }
+      if (n <= 0) return std::string("standard output: write failed: ") + std::strerror(n < 0 ? errno : EIO);
       p += n;
     }
-    setp(buf_, buf_ + sizeof buf_);
-    return true;
+    return {};
   }
-  std::string error_;
-  char buf_[1 << 16];
 };
 
 /// Where the output goes, for messages: "standard output" or the path as given.

@@ -10,47 +10,16 @@
 #include <string>
 
 #include "core/chip.hpp"
+#include "support/engine_pair.hpp"
 
 namespace l6470emu {
 namespace {
 
-struct Pair {
-  Chip fast;
-  Chip ref;
-  Pair() {
-    fast.set_motion_engine(MotionEngine::fast);
-    ref.set_motion_engine(MotionEngine::reference);
-  }
-  void attach(const AxisSpec& spec) {
-    fast.attach_axis(spec);
-    ref.attach_axis(spec);
-  }
-  void bytes(std::initializer_list<std::uint8_t> b) {
-    for (auto x : b) {
-      fast.on_byte(x);
-      ref.on_byte(x);
-    }
-  }
-  void cmd3(std::uint8_t op, std::uint32_t v) {
-    bytes({op, static_cast<std::uint8_t>(v >> 16), static_cast<std::uint8_t>(v >> 8), static_cast<std::uint8_t>(v)});
-  }
-  void set2(std::uint8_t addr, std::uint32_t v) { bytes({addr, static_cast<std::uint8_t>(v >> 8), static_cast<std::uint8_t>(v)}); }
-  void set1(std::uint8_t addr, std::uint32_t v) { bytes({addr, static_cast<std::uint8_t>(v)}); }
-  void advance_to(Tick t) {
-    fast.advance_to(t);
-    ref.advance_to(t);
-  }
-};
+using test::EnginePair;
 
 ::testing::AssertionResult same(const Chip& f, const Chip& r) {
-  for (Reg id : {Reg::ABS_POS, Reg::EL_POS, Reg::SPEED, Reg::MARK, Reg::STATUS})
-    if (f.peek(id) != r.peek(id))
-      return ::testing::AssertionFailure() << "register " << static_cast<int>(id) << " fast=" << f.peek(id)
-                                           << " reference=" << r.peek(id) << " at tick " << r.now();
-  if (f.busy_sync_pin() != r.busy_sync_pin()) return ::testing::AssertionFailure() << "BUSY pin differs";
-  if (f.flag_pin() != r.flag_pin()) return ::testing::AssertionFailure() << "FLAG pin differs at tick " << r.now();
+  if (auto motion = test::same_motion(f, r); !motion) return motion;
   if (f.sw_pin() != r.sw_pin()) return ::testing::AssertionFailure() << "SW pin differs at tick " << r.now();
-  if (!(f.motion() == r.motion())) return ::testing::AssertionFailure() << "motion state differs at tick " << r.now();
   const Axis& a = *f.axis();
   const Axis& b = *r.axis();
   if (a.true_position() != b.true_position() || a.synchronised() != b.synchronised() ||
@@ -107,7 +76,7 @@ AxisSpec random_axis(Gen& g) {
   return s;
 }
 
-void configure(Pair& p, Gen& g) {
+void configure(EnginePair& p, Gen& g) {
   p.bytes({0xA8});  // HardHiZ: every register writable
   auto acc = [&] { return static_cast<std::uint32_t>(g.below(5) == 0 ? 0xFFF : 1 + g.below(0x400)); };
   p.set2(0x05, acc());
@@ -123,7 +92,7 @@ void configure(Pair& p, Gen& g) {
   p.set2(0x18, (g.coin() ? 0x2E88u : 0x2E08u) | (g.coin() ? 0x10u : 0u));  // OC_SD and SW_MODE either way
 }
 
-void random_command(Pair& p, Gen& g) {
+void random_command(EnginePair& p, Gen& g) {
   const bool dir = g.coin();
   const auto spd = [&] { return static_cast<std::uint32_t>(g.below(0x10000)); };
   switch (g.below(12)) {
@@ -146,7 +115,7 @@ TEST(AxisEngines, AgreeOnRandomAxesProfilesAndCommandSequences) {
   for (std::uint64_t seed = 1; seed <= 250; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     Gen g(seed);
-    Pair p;
+    EnginePair p;
     configure(p, g);
     p.attach(random_axis(g));
     ASSERT_TRUE(same(p.fast, p.ref));
@@ -180,7 +149,7 @@ TEST(AxisEngines, AgreeWhenSampledEvery997TicksOverWholeSessions) {
   for (std::uint64_t seed = 1; seed <= 40; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     Gen g(seed * 7919);
-    Pair p;
+    EnginePair p;
     configure(p, g);
     p.attach(random_axis(g));
     Tick t = 0;

@@ -7,55 +7,12 @@
 #include <vector>
 
 #include "core/chip.hpp"
+#include "support/engine_pair.hpp"
 
 namespace l6470emu {
 namespace {
 
-struct Pair {
-  Chip fast;
-  Chip ref;
-  Pair() {
-    fast.set_motion_engine(MotionEngine::fast);
-    ref.set_motion_engine(MotionEngine::reference);
-  }
-  void bytes(std::initializer_list<std::uint8_t> b) {
-    for (auto x : b) {
-      fast.on_byte(x);
-      ref.on_byte(x);
-    }
-  }
-  void cmd3(std::uint8_t op, std::uint32_t v) {
-    bytes({op, static_cast<std::uint8_t>(v >> 16), static_cast<std::uint8_t>(v >> 8), static_cast<std::uint8_t>(v)});
-  }
-  void set2(std::uint8_t addr, std::uint32_t v) { bytes({addr, static_cast<std::uint8_t>(v >> 8), static_cast<std::uint8_t>(v)}); }
-  void set1(std::uint8_t addr, std::uint32_t v) { bytes({addr, static_cast<std::uint8_t>(v)}); }
-  void advance_to(Tick t) {
-    fast.advance_to(t);
-    ref.advance_to(t);
-  }
-  void sw(bool level) {
-    fast.set_sw_pin(level);
-    ref.set_sw_pin(level);
-  }
-  void stck(bool level) {
-    fast.set_stck_pin(level);
-    ref.set_stck_pin(level);
-  }
-};
-
-::testing::AssertionResult same(const Chip& f, const Chip& r) {
-  for (Reg id : {Reg::ABS_POS, Reg::EL_POS, Reg::SPEED, Reg::MARK, Reg::STATUS})
-    if (f.peek(id) != r.peek(id))
-      return ::testing::AssertionFailure() << "register " << static_cast<int>(id) << " fast=" << f.peek(id)
-                                           << " reference=" << r.peek(id) << " at tick " << r.now();
-  if (f.busy_sync_pin() != r.busy_sync_pin()) return ::testing::AssertionFailure() << "BUSY pin differs";
-  if (f.flag_pin() != r.flag_pin()) return ::testing::AssertionFailure() << "FLAG pin differs";
-  if (!(f.motion() == r.motion()))
-    return ::testing::AssertionFailure() << "motion state differs at tick " << r.now() << ": speed " << f.motion().speed
-                                         << " vs " << r.motion().speed << ", frac " << f.motion().frac << " vs "
-                                         << r.motion().frac;
-  return ::testing::AssertionSuccess();
-}
+using test::EnginePair;
 
 /// Picks register values that cover ordinary settings and the extremes.
 struct Gen {
@@ -104,7 +61,7 @@ struct Gen {
   }
 };
 
-void configure(Pair& p, Gen& g) {
+void configure(EnginePair& p, Gen& g) {
   p.bytes({0xA8});  // HardHiZ so every register is writable
   p.set2(0x05, g.acc());
   p.set2(0x06, g.acc());
@@ -115,7 +72,7 @@ void configure(Pair& p, Gen& g) {
   if (g.below(3) == 0) p.cmd3(0x01 /*ABS_POS*/, static_cast<std::uint32_t>(0x1FFF00 + g.below(0x200)));  // near +2^21
 }
 
-void random_command(Pair& p, Gen& g) {
+void random_command(EnginePair& p, Gen& g) {
   const bool dir = g.coin();
   switch (g.below(14)) {
     case 0: case 1: p.cmd3(static_cast<std::uint8_t>(0x50 | dir), g.speed()); break;      // Run
@@ -137,7 +94,7 @@ TEST(FastEngine, AgreesWithTheReferenceOnRandomProfilesAndCommandSequences) {
   for (std::uint64_t seed = 1; seed <= 2000; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     Gen g(seed);
-    Pair p;
+    EnginePair p;
     configure(p, g);
     Tick t = 0;
     const int commands = 1 + static_cast<int>(g.below(8));
@@ -155,29 +112,29 @@ TEST(FastEngine, AgreesWithTheReferenceOnRandomProfilesAndCommandSequences) {
           ASSERT_EQ(p.fast.on_byte(0x00), p.ref.on_byte(0x00));
           continue;
         }
-        ASSERT_TRUE(same(p.fast, p.ref));
+        ASSERT_TRUE(test::same_motion(p.fast, p.ref));
       }
     }
   }
 }
 
 TEST(FastEngine, AgreesOnAFullLengthMoveOf2To22Minus1MicrostepsWithWrap) {
-  Pair p;
+  EnginePair p;
   p.bytes({0xA8});
   p.set2(0x05, 0xFFF);  // infinite acceleration
   p.set2(0x07, 0x3FF);
   p.cmd3(0x41, 0x3FFFFF);
   for (Tick t = 1'000'003; t < 12'000'000; t += 1'000'003) {
     p.advance_to(t);
-    ASSERT_TRUE(same(p.fast, p.ref));
+    ASSERT_TRUE(test::same_motion(p.fast, p.ref));
   }
   p.advance_to(12'000'000);
-  EXPECT_TRUE(same(p.fast, p.ref));
+  EXPECT_TRUE(test::same_motion(p.fast, p.ref));
   EXPECT_EQ(p.fast.position(), -1);  // 2^22 - 1 steps forward from 0 wraps to -1
 }
 
 TEST(FastEngine, AgreesWithAcc1AndDec1OverALongRamp) {
-  Pair p;
+  EnginePair p;
   p.bytes({0xA8});
   p.set2(0x05, 1);
   p.set2(0x06, 1);
@@ -185,12 +142,12 @@ TEST(FastEngine, AgreesWithAcc1AndDec1OverALongRamp) {
   p.cmd3(0x51, 0xFFFFF);
   for (Tick t = 777'777; t < 8'000'000; t += 777'777) {
     p.advance_to(t);
-    ASSERT_TRUE(same(p.fast, p.ref));
+    ASSERT_TRUE(test::same_motion(p.fast, p.ref));
   }
   p.bytes({0xB0});  // SoftStop at DEC = 1
   for (Tick t = 8'000'000; t < 16'000'000; t += 999'999) {
     p.advance_to(t);
-    ASSERT_TRUE(same(p.fast, p.ref));
+    ASSERT_TRUE(test::same_motion(p.fast, p.ref));
   }
 }
 
@@ -201,7 +158,7 @@ namespace l6470emu {
 namespace {
 
 TEST(FastEngine, StopsExactlyWhenTheLastMicrostepEndsOnATickBoundary) {
-  Pair p;
+  EnginePair p;
   p.bytes({0xA8});
   p.set2(0x05, 0xFFF);  // infinite acceleration: constant 2^31 per tick
   p.set2(0x07, 0x200);
@@ -209,7 +166,7 @@ TEST(FastEngine, StopsExactlyWhenTheLastMicrostepEndsOnATickBoundary) {
   p.cmd3(0x41, 3);
   for (Tick t : {511u, 512u, 1535u, 1536u, 1537u, 5000u}) {
     p.advance_to(t);
-    ASSERT_TRUE(same(p.fast, p.ref)) << "tick " << t;
+    ASSERT_TRUE(test::same_motion(p.fast, p.ref)) << "tick " << t;
   }
   EXPECT_EQ(p.fast.position(), 3);
   EXPECT_EQ(p.fast.motion().activity, Activity::idle);
