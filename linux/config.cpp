@@ -6,6 +6,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -203,6 +204,32 @@ std::string system_node_reason(std::string_view name) {
   return "";
 }
 
+// What already exists at a chain's path= and is not a spidev node, or "" (nothing there, or a
+// spidev node: the kernel's, major 153, or one a kernel-node daemon made, named spidev*). The
+// emulator takes the path over in host programs, so another driver's node (/dev/kvm, /dev/loop0,
+// /dev/hwrng), a file or a directory there would be hidden from them.
+std::string existing_non_spidev(const std::string& path) {
+  constexpr unsigned kSpidevDriverMajor = 153;  // SPIDEV_MAJOR, drivers/spi/spidev.c
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0)
+    return errno == ENOENT ? "" : std::string("a path that cannot be looked at (") + std::strerror(errno) + ")";
+  const std::string dev = std::to_string(major(st.st_rdev)) + ":" + std::to_string(minor(st.st_rdev));
+  if (S_ISCHR(st.st_mode)) {
+    if (major(st.st_rdev) == kSpidevDriverMajor) return "";
+    // The kernel's name of the device: the last part of /sys/dev/char/MAJ:MIN's target.
+    char target[512];
+    const ssize_t n = ::readlink(("/sys/dev/char/" + dev).c_str(), target, sizeof target - 1);
+    std::string name = n > 0 ? std::string(target, static_cast<std::size_t>(n)) : "";
+    name = name.substr(name.rfind('/') + 1);
+    if (name.rfind("spidev", 0) == 0) return "";
+    return "an existing character device (" + dev + (name.empty() ? "" : ", " + quoted_text(name)) + ") of another driver";
+  }
+  if (S_ISBLK(st.st_mode)) return "an existing block device (" + dev + ")";
+  if (S_ISDIR(st.st_mode)) return "an existing directory";
+  if (S_ISREG(st.st_mode)) return "an existing regular file";
+  return "an existing file that is not a device node";
+}
+
 // The shortest text that reads back as exactly `v`.
 std::string shortest(double v) {
   std::array<char, 32> buf{};
@@ -313,6 +340,9 @@ struct Parser {
     if (const std::string why = system_node_reason(name); !why.empty())
       return fail("path " + q + " is " + why + ", not a spidev node: the emulator would take it over in the host program "
                   "(write e.g. path=/dev/spidev0.0, or leave path= out)");
+    if (const std::string why = existing_non_spidev(std::string(value)); !why.empty())
+      return fail("path " + q + " is " + why + ", not a spidev node: the emulator would take it over in the host program "
+                  "(write a path that does not exist, e.g. path=/dev/spidev9.0, or leave path= out)");
     return true;
   }
 

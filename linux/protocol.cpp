@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <algorithm>
 #include <cstring>
 #include <sstream>
 
@@ -32,6 +33,37 @@ std::vector<DeviceNode> decode_catalogue(const std::string& text) {
     nodes.push_back(std::move(n));
   }
   return nodes;
+}
+
+std::vector<std::uint8_t> encode_refusal(const std::string& why) {
+  ReplyHeader h{};
+  h.result = -ECONNREFUSED;
+  h.kind = kRefusalKind;
+  h.payload = static_cast<std::uint32_t>(why.size());
+  std::vector<std::uint8_t> p(sizeof h + why.size());
+  std::memcpy(p.data(), &h, sizeof h);
+  std::memcpy(p.data() + sizeof h, why.data(), why.size());
+  return p;
+}
+
+std::optional<std::string> decode_refusal(std::span<const std::uint8_t> packet) {
+  ReplyHeader h;
+  if (packet.size() < sizeof h) return std::nullopt;
+  std::memcpy(&h, packet.data(), sizeof h);
+  if (h.kind != kRefusalKind || h.result != -ECONNREFUSED) return std::nullopt;
+  const std::size_t n = std::min<std::size_t>(packet.size() - sizeof h, 512);
+  return std::string(reinterpret_cast<const char*>(packet.data()) + sizeof h, n);
+}
+
+std::string check_server_owner(int sock, const std::string& path) {
+  ucred peer{};
+  socklen_t len = sizeof peer;
+  if (getsockopt(sock, SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0)
+    return "cannot tell who serves " + path + " (" + std::strerror(errno) + "): not talking to it";
+  const uid_t me = geteuid();
+  if (peer.uid == me || peer.uid == 0) return "";
+  return "the socket " + path + " is served by user " + std::to_string(peer.uid) + " (pid " + std::to_string(peer.pid) +
+         "), not by you (user " + std::to_string(me) + ") or root: not talking to it";
 }
 
 bool send_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload, int fd) {
@@ -61,6 +93,7 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
   fd = -1;
   packet.size = 0;
   const std::int64_t spin_until = spin_ns > 0 ? monotonic_ns() + spin_ns : 0;
+  bool reset_seen = false, spin_once = false;
   // One receive, no peek: the buffer is as large as the largest packet can be (kMaxPacket).
   for (;;) {
     iovec iov{packet.data.get(), kMaxPacket};
@@ -72,9 +105,17 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
     msg.msg_controllen = sizeof control;
     // Spinning a few microseconds before sleeping saves two scheduler wake-ups per round trip
     // when the other side answers quickly (it usually does: one SPI message is microseconds).
-    const bool spin = spin_until != 0 && monotonic_ns() < spin_until;
+    const bool spin = spin_once || (spin_until != 0 && monotonic_ns() < spin_until);
+    spin_once = false;
     const ssize_t n = recvmsg(sock, &msg, (cloexec ? MSG_CMSG_CLOEXEC : 0) | (spin ? MSG_DONTWAIT : 0));
     if (n < 0 && (errno == EINTR || (spin && (errno == EAGAIN || errno == EWOULDBLOCK)))) continue;
+    // A peer that closed with our last packet unread reports the reset once, before the packets
+    // it sent are received (a refusal): look once more, without waiting.
+    if (n < 0 && errno == ECONNRESET && !reset_seen) {
+      reset_seen = true;
+      spin_once = true;
+      continue;
+    }
     if (n <= 0) return false;
     for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c))
       if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_RIGHTS) std::memcpy(&fd, CMSG_DATA(c), sizeof fd);

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +52,12 @@ struct ReplyHeader {
   std::uint64_t handle = 0;   ///< handle of a new file (its descriptor rides along with SCM_RIGHTS)
 };
 
+/// ReplyHeader::kind of a refusal: the daemon's first and only packet on a connection it will not
+/// serve (another user, too many clients), sent at once and followed by the connection's end.
+/// result is -ECONNREFUSED and the payload one line saying why (text of the daemon's choosing:
+/// clients escape it before printing it).
+inline constexpr std::uint32_t kRefusalKind = 0x52454655;  // "REFU"
+
 /// Largest data of a message: bufsiz is at most 4 MiB (config), tx and rx each.
 inline constexpr std::size_t kMaxMessage = std::size_t{4} << 20;
 /// Largest packet: a header, 511 transfers (_IOC_SIZE is 14 bits) and the tx data.
@@ -69,8 +76,20 @@ struct Packet {
   std::span<const std::uint8_t> bytes() const { return {data.get(), size}; }
 };
 
+/// The packet that refuses a connection (kRefusalKind), saying `why`.
+std::vector<std::uint8_t> encode_refusal(const std::string& why);
+/// When `packet` is a refusal: its reason, at most 512 bytes of it (else nullopt).
+std::optional<std::string> decode_refusal(std::span<const std::uint8_t> packet);
+
+/// Whether the server at the other end of the connected socket `sock` may be trusted: it runs as
+/// this process's effective user or as root (SO_PEERCRED, as the kernel recorded it when the
+/// server listened). "" when it may, else one line saying whose it is.
+std::string check_server_owner(int sock, const std::string& path);
+
 /// Receives one packet; `fd` gets a passed descriptor or -1 (`cloexec` sets close-on-exec on it).
-/// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error.
+/// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error. A packet the
+/// peer sent before it closed the connection is still received (a refusal), even when the kernel
+/// reports the reset first.
 bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t spin_ns = 0);
 
 /// How long the preload polls for a reply, and the daemon for a client's next request, before

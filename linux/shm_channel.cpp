@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <linux/futex.h>
+#include <poll.h>
 #include <sched.h>
 #include <sys/mman.h>
 #include <sys/socket.h>
@@ -210,11 +211,18 @@ void SharedChannel::post_reply(std::span<const std::uint8_t> head, std::span<con
 }
 
 bool peer_alive(int sock) {
-  // A peek, not poll(): inside the preload library poll() is the library's own replacement.
-  char byte;
-  const ssize_t n = recv(sock, &byte, 1, MSG_PEEK | MSG_DONTWAIT);
-  if (n != 0) return n > 0 || errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
-  return false;  // end of file: the peer closed its end (or was killed)
+  // The socket's hang-up, not its data: a peer that wrote a packet and died leaves the packet
+  // unread, and a peek would find it and answer "alive" for ever. When the peer's end closes (or
+  // this end is shut down), the kernel marks the socket hung up whatever is still queued. A raw
+  // ppoll: inside the preload library poll() is the library's own replacement.
+  pollfd p{sock, static_cast<short>(POLLIN | POLLRDHUP), 0};
+  const timespec zero{0, 0};
+  for (;;) {
+    const long n = syscall(SYS_ppoll, &p, 1, &zero, nullptr, 0);
+    if (n >= 0) break;
+    if (errno != EINTR) return false;
+  }
+  return (p.revents & (POLLHUP | POLLRDHUP | POLLERR | POLLNVAL)) == 0;
 }
 
 }  // namespace l6470emu

@@ -79,7 +79,9 @@ class SharedChannel {
   std::uint32_t sequence_ = 0;  // client: the last posted request; daemon: the last one taken
 };
 
-/// Whether the other end of `sock` is still there (no hang-up, no error), without waiting.
+/// Whether the other end of `sock` is still there (no hang-up, no error), without waiting: false
+/// once the peer closed its end (died), even with its last packets still unread, and once this
+/// end was shut down.
 bool peer_alive(int sock);
 
 }  // namespace l6470emu

@@ -150,6 +150,11 @@ IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi
     const unsigned bits = x.bits_per_word ? x.bits_per_word : s.bits_per_word;
     if (!controller_supports_bits(bits)) return -EINVAL;
     if (x.len % word_bytes(bits)) return -EINVAL;
+    // spidev: a transfer without speed_hz gets the file's speed; __spi_validate: still none, the
+    // device's; faster than the controller is clamped, slower than it can go is refused.
+    std::uint32_t hz = x.speed_hz ? x.speed_hz : s.speed_hz ? s.speed_hz : s.max_speed_hz;
+    if (hz > kControllerMaxSpeedHz) hz = kControllerMaxSpeedHz;
+    if (hz != 0 && hz < kControllerMinSpeedHz) return -EINVAL;
     if (x.tx_buf && x.tx_nbits != 0 && x.tx_nbits != 1) return -EINVAL;  // dual/quad need SPI_TX_DUAL/QUAD
     if (x.rx_buf && x.rx_nbits != 0 && x.rx_nbits != 1) return -EINVAL;
   }

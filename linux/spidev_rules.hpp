@@ -30,6 +30,15 @@ inline constexpr std::uint32_t kControllerModeBits = SPI_CPHA | SPI_CPOL | SPI_C
 /// Fastest SCK of the emulated controller; faster requests are clamped to it, as spi.c does.
 inline constexpr std::uint32_t kControllerMaxSpeedHz = 125'000'000;
 
+/// Slowest SCK of the emulated controller. A controller whose fastest clock is 125 MHz (a 250 MHz
+/// clock halved, the BCM2835's) divides that clock by at most 65536, so it cannot go below
+/// 250 MHz / 65536 = 3814.7 Hz. spi.c's __spi_validate refuses a transfer slower than the
+/// controller's min_speed_hz with -EINVAL (Linux 6.1; drivers that declare one, e.g.
+/// spi-sun4i/spi-sun6i at 3 kHz, spi-omap2-mcspi at its reference clock / 32768), and so does
+/// the emulator, whatever the setting's source: SPI_IOC_WR_MAX_SPEED_HZ (which spidev accepts),
+/// a transfer's speed_hz or the description's speed=.
+inline constexpr std::uint32_t kControllerMinSpeedHz = 3815;
+
 /// Fastest SCK the L6470 family accepts (datasheet: 5 MHz).
 inline constexpr std::uint32_t kChipMaxSpeedHz = 5'000'000;
 
@@ -67,8 +76,9 @@ bool is_spi_message_ioctl(unsigned long cmd, std::size_t& n);
 IoctlResult spidev_message_sizes(std::uint32_t bufsiz, std::span<const spi_ioc_transfer> xfers);
 
 /// spidev_message's and __spi_validate's checks on a message, before anything is clocked:
-/// -EMSGSIZE past bufsiz (or past INT_MAX in total), -EINVAL for word sizes, lengths and
-/// nbits the controller cannot do. Returns the total length in bytes or -errno.
+/// -EMSGSIZE past bufsiz (or past INT_MAX in total), -EINVAL for word sizes, lengths, nbits
+/// and speeds (below kControllerMinSpeedHz) the controller cannot do. Returns the total length
+/// in bytes or -errno.
 IoctlResult validate_spidev_message(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers);
 
 /// Bytes of tx data the transport must copy for `xfers` (sum of len over transfers with a tx_buf).

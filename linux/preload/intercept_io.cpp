@@ -89,6 +89,7 @@ long generic_ioctl(FdEntry& e, unsigned long cmd, void* argp) {
     ne->handle = created.handle;
     ne->kind = created.kind;
     ne->node = e.node;
+    ne->access = O_RDONLY;  // the kernel's line files are anonymous O_RDONLY files
     ne->record.store(created.kind == HandleKind::line_event_v1     ? sizeof(gpioevent_data)
                      : created.kind == HandleKind::line_request_v2 ? sizeof(gpio_v2_line_event)
                                                                    : 0);
@@ -167,7 +168,12 @@ ssize_t read_records(int fd, FdEntry& e, void* buf, std::size_t count) {
   return static_cast<ssize_t>(done);
 }
 
+// The VFS checks the file's access mode before the driver sees a read or a write.
+bool readable(const FdEntry& e) { return e.access == O_RDONLY || e.access == O_RDWR; }
+bool writable(const FdEntry& e) { return e.access == O_WRONLY || e.access == O_RDWR; }
+
 ssize_t emulated_read(int fd, FdEntry& e, void* buf, std::size_t count) {
+  if (!readable(e)) return fail(-EBADF);
   switch (e.kind) {
     case HandleKind::spidev: {
       if (count > nodes()[e.node].bufsiz) return fail(-EMSGSIZE);
@@ -185,6 +191,7 @@ ssize_t emulated_read(int fd, FdEntry& e, void* buf, std::size_t count) {
 }
 
 ssize_t emulated_write(FdEntry& e, const void* buf, std::size_t count) {
+  if (!writable(e)) return fail(-EBADF);
   if (e.kind != HandleKind::spidev) return fail(-EINVAL);
   if (count > nodes()[e.node].bufsiz) return fail(-EMSGSIZE);
   t_tx.resize(count);

@@ -11,8 +11,10 @@
 #include <linux/close_range.h>
 
 #include <cstring>
+#include <string>
 
 #include "linux/log.hpp"
+#include "linux/preload/node_path.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
@@ -38,14 +40,30 @@ int open_virtual_file(const VirtualPath& v, int flags) {
   return fd;
 }
 
-// Returns true when `path` is ours (result in `fd`, errno set on failure).
-bool try_open(const char* path, int flags, int& fd) {
-  if (inside() || !path || (path[0] != '/') || !active()) return false;
-  if (std::strncmp(path, "/dev/", 5) != 0 && std::strncmp(path, "/sys/", 5) != 0) return false;
+// Returns true when `path` (relative paths from `dirfd`) is ours (result in `fd`, errno set on
+// failure). The kernel's walk decides: any spelling of a node's path opens it, a path that goes
+// on past a node is ENOTDIR.
+bool try_open(int dirfd, const char* path, int flags, int& fd) {
+  if (inside() || !path || !active()) return false;
+  std::string absolute;
+  if (path[0] != '/') {
+    // Relative: one getcwd (or readlink of the directory's descriptor) for what may be under /dev.
+    Guard guard;
+    absolute = absolute_path(dirfd, path);
+    if (absolute.empty()) return false;
+    path = absolute.c_str();
+  }
+  if (!may_be_device_path(path)) return false;
   Guard guard;
   try {
-    const int node = node_index(path);
-    if (node < 0) {
+    int node = -1;
+    const NodeWalk walk = walk_to_node(path, node);
+    if (walk == NodeWalk::through_node) {
+      fd = set_errno(-ENOTDIR);
+      return true;
+    }
+    if (walk == NodeWalk::not_ours) {
+      if (std::strncmp(path, "/sys/", 5) != 0) return false;
       const VirtualPath v = lookup_virtual(path, true);
       if (v.type == VirtualPath::Type::file) {
         fd = open_virtual_file(v, flags);
@@ -72,6 +90,7 @@ bool try_open(const char* path, int flags, int& fd) {
     e->handle = f.handle;
     e->kind = f.kind;
     e->node = static_cast<std::uint32_t>(node);
+    e->access = static_cast<std::uint32_t>(flags & O_ACCMODE);
     fd_store(f.fd, e);
     fd = f.fd;
     return true;
@@ -120,7 +139,7 @@ __attribute__((visibility("default"))) int open(const char* path, int flags, ...
   const mode_t mode = mode_arg(flags, ap);
   va_end(ap);
   int fd;
-  if (try_open(path, flags, fd)) return fd;
+  if (try_open(AT_FDCWD, path, flags, fd)) return fd;
   return fresh(real::open(path, flags, mode));
 }
 
@@ -130,19 +149,19 @@ __attribute__((visibility("default"))) int open64(const char* path, int flags, .
   const mode_t mode = mode_arg(flags, ap);
   va_end(ap);
   int fd;
-  if (try_open(path, flags, fd)) return fd;
+  if (try_open(AT_FDCWD, path, flags, fd)) return fd;
   return fresh(real::open(path, flags, mode));
 }
 
 __attribute__((visibility("default"))) int __open_2(const char* path, int flags) {
   int fd;
-  if (try_open(path, flags, fd)) return fd;
+  if (try_open(AT_FDCWD, path, flags, fd)) return fd;
   return fresh(real::open(path, flags, 0));
 }
 
 __attribute__((visibility("default"))) int __open64_2(const char* path, int flags) {
   int fd;
-  if (try_open(path, flags, fd)) return fd;
+  if (try_open(AT_FDCWD, path, flags, fd)) return fd;
   return fresh(real::open(path, flags, 0));
 }
 
@@ -152,7 +171,7 @@ __attribute__((visibility("default"))) int openat(int dirfd, const char* path, i
   const mode_t mode = mode_arg(flags, ap);
   va_end(ap);
   int fd;
-  if (path && path[0] == '/' && try_open(path, flags, fd)) return fd;
+  if (try_open(dirfd, path, flags, fd)) return fd;
   return fresh(real::openat(dirfd, path, flags, mode));
 }
 
@@ -162,31 +181,30 @@ __attribute__((visibility("default"))) int openat64(int dirfd, const char* path,
   const mode_t mode = mode_arg(flags, ap);
   va_end(ap);
   int fd;
-  if (path && path[0] == '/' && try_open(path, flags, fd)) return fd;
+  if (try_open(dirfd, path, flags, fd)) return fd;
   return fresh(real::openat(dirfd, path, flags, mode));
 }
 
 __attribute__((visibility("default"))) int __openat_2(int dirfd, const char* path, int flags) {
   int fd;
-  if (path && path[0] == '/' && try_open(path, flags, fd)) return fd;
+  if (try_open(dirfd, path, flags, fd)) return fd;
   return fresh(real::openat(dirfd, path, flags, 0));
 }
 
 __attribute__((visibility("default"))) int __openat64_2(int dirfd, const char* path, int flags) {
   int fd;
-  if (path && path[0] == '/' && try_open(path, flags, fd)) return fd;
+  if (try_open(dirfd, path, flags, fd)) return fd;
   return fresh(real::openat(dirfd, path, flags, 0));
 }
 
 static FILE* fopen_impl(const char* path, const char* mode) {
-  if (!inside() && path && mode && active() &&
-      (std::strncmp(path, "/dev/", 5) == 0 || std::strncmp(path, "/sys/", 5) == 0)) {
+  if (!inside() && path && mode && active()) {
     int flags = O_RDONLY;
     if (mode[0] == 'w' || mode[0] == 'a') flags = O_WRONLY;
     if (std::strchr(mode, '+')) flags = O_RDWR;
     if (std::strchr(mode, 'e')) flags |= O_CLOEXEC;
     int fd;
-    if (try_open(path, flags, fd)) {
+    if (try_open(AT_FDCWD, path, flags, fd)) {
       if (fd < 0) return nullptr;
       FILE* f = fdopen(fd, mode);
       if (!f) {
@@ -272,6 +290,9 @@ static int fcntl_impl(int fd, int cmd, va_list ap) {
   const long arg = va_arg(ap, long);
   const int r = real::fcntl(fd, cmd, arg);
   if ((cmd == F_DUPFD || cmd == F_DUPFD_CLOEXEC) && r >= 0) return dup_entry(fd, r);
+  // The access mode is the open's, as the kernel keeps it in the file (not the descriptor's behind it).
+  if (cmd == F_GETFL && r >= 0)
+    if (const FdEntry* e = fd_entry(fd)) return (r & ~O_ACCMODE) | static_cast<int>(e->access);
   return r;
 }
 

@@ -11,6 +11,7 @@
 #include <sys/sysmacros.h>
 #include <unistd.h>
 
+#include "linux/preload/node_path.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
@@ -20,21 +21,24 @@ using namespace l6470emu::preload;
 
 namespace {
 
-bool candidate(const char* path) {
-  return path && !inside() && active() && (strncmp(path, "/dev/", 5) == 0 || strncmp(path, "/sys/", 5) == 0);
-}
+bool candidate(const char* path) { return !inside() && active() && may_be_device_path(path); }
 
-// True when `path` is ours; fills `st`.
-bool virtual_stat(const char* path, struct stat* st, bool follow) {
-  if (!candidate(path)) return false;
+// 1 when `path` is ours (`st` filled), -1 when it is ours and fails (errno set: a path that goes
+// on past a node), 0 when it is not ours.
+int virtual_stat(const char* path, struct stat* st, bool follow) {
+  if (!candidate(path)) return 0;
   Guard guard;
   try {
     const VirtualPath v = lookup_virtual(path, follow);
-    if (v.type == VirtualPath::Type::none) return false;
+    if (v.type == VirtualPath::Type::none) return 0;
+    if (v.type == VirtualPath::Type::not_directory) {
+      errno = ENOTDIR;
+      return -1;
+    }
     fill_stat(v, st);
-    return true;
+    return 1;
   } catch (...) {
-    return false;
+    return 0;
   }
 }
 
@@ -77,8 +81,8 @@ void to_statx(const struct stat& st, struct statx* sx) {
 int do_fstatat(int dirfd, const char* path, struct stat* st, int flags) {
   if (path && path[0] == '\0' && (flags & AT_EMPTY_PATH)) {
     if (virtual_fstat(dirfd, st)) return 0;
-  } else if (path && path[0] == '/' && virtual_stat(path, st, !(flags & AT_SYMLINK_NOFOLLOW))) {
-    return 0;
+  } else if (path && path[0] == '/') {
+    if (const int r = virtual_stat(path, st, !(flags & AT_SYMLINK_NOFOLLOW)); r != 0) return r > 0 ? 0 : -1;
   }
   return real::fstatat(dirfd, path, st, flags);
 }
@@ -87,6 +91,10 @@ char* do_realpath(const char* path, char* resolved) {
   if (candidate(path)) {
     Guard guard;
     try {
+      if (lookup_virtual(path, true).type == VirtualPath::Type::not_directory) {
+        errno = ENOTDIR;
+        return nullptr;
+      }
       const std::string r = virtual_realpath(path);
       if (!r.empty()) {
         if (r.size() >= PATH_MAX) {
@@ -114,6 +122,10 @@ ssize_t do_readlink(const char* path, char* buf, size_t n) {
   try {
     const VirtualPath v = lookup_virtual(path, false);
     if (v.type == VirtualPath::Type::none) return -2;
+    if (v.type == VirtualPath::Type::not_directory) {
+      errno = ENOTDIR;
+      return -1;
+    }
     if (v.type != VirtualPath::Type::symlink) {
       errno = EINVAL;
       return -1;
@@ -128,7 +140,7 @@ ssize_t do_readlink(const char* path, char* buf, size_t n) {
 
 int do_access(const char* path, int mode) {
   struct stat st;
-  if (!virtual_stat(path, &st, true)) return -2;
+  if (const int r = virtual_stat(path, &st, true); r <= 0) return r == 0 ? -2 : -1;
   if ((mode & X_OK) && !S_ISDIR(st.st_mode)) {
     errno = EACCES;
     return -1;
@@ -143,14 +155,14 @@ extern "C" {
 #define L6470EMU_EXPORT __attribute__((visibility("default")))
 
 L6470EMU_EXPORT int stat(const char* path, struct stat* st) noexcept {
-  if (virtual_stat(path, st, true)) return 0;
+  if (const int r = virtual_stat(path, st, true); r != 0) return r > 0 ? 0 : -1;
   return real::stat(path, st);
 }
 L6470EMU_EXPORT int stat64(const char* path, struct stat64* st) noexcept {
   return stat(path, reinterpret_cast<struct stat*>(st));
 }
 L6470EMU_EXPORT int lstat(const char* path, struct stat* st) noexcept {
-  if (virtual_stat(path, st, false)) return 0;
+  if (const int r = virtual_stat(path, st, false); r != 0) return r > 0 ? 0 : -1;
   return real::lstat(path, st);
 }
 L6470EMU_EXPORT int lstat64(const char* path, struct stat64* st) noexcept {
@@ -188,9 +200,12 @@ L6470EMU_EXPORT int statx(int dirfd, const char* path, int flags, unsigned mask,
       to_statx(st, buf);
       return 0;
     }
-  } else if (path && path[0] == '/' && virtual_stat(path, &st, !(flags & AT_SYMLINK_NOFOLLOW))) {
-    to_statx(st, buf);
-    return 0;
+  } else if (path && path[0] == '/') {
+    if (const int r = virtual_stat(path, &st, !(flags & AT_SYMLINK_NOFOLLOW)); r != 0) {
+      if (r < 0) return -1;
+      to_statx(st, buf);
+      return 0;
+    }
   }
   return real::statx(dirfd, path, flags, mask, buf);
 }

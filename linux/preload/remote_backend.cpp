@@ -16,6 +16,7 @@
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/protocol.hpp"
+#include "linux/terminal_text.hpp"
 #include "linux/shm_channel.hpp"
 
 namespace l6470emu::preload {
@@ -27,17 +28,25 @@ class RemoteBackend final : public Backend {
     if (const char* shm = std::getenv("L6470EMU_SHM"); shm && std::strcmp(shm, "off") == 0) use_shared_ = false;
     std::lock_guard lock(m_);
     if (!connect_locked()) {
-      log_.line("cannot reach the daemon at " + path_ + " (" + std::strerror(errno) +
-                "): no emulated devices; start it with `l6470emu serve`");
+      if (!refused_.empty())
+        log_.line(refused_ + ": no emulated devices");
+      else
+        log_.line("cannot reach the daemon at " + shown_path() + " (" + std::strerror(errno) +
+                  "): no emulated devices; start it with `l6470emu serve`");
       return;
     }
     RequestHeader req{static_cast<std::uint32_t>(Op::hello), 0, 0, kProtocolVersion};
     ReplyHeader rep;
     std::vector<std::uint8_t> payload;
     int fd = -1;
-    if (!roundtrip_locked(req, {}, {}, rep, payload, fd, true) || rep.result < 0) {
-      log_.line("the daemon at " + path_ + " did not answer the hello (protocol " + std::to_string(kProtocolVersion) +
-                ")");
+    const bool answered = roundtrip_locked(req, {}, {}, rep, payload, fd, true);
+    if (!refused_.empty()) {
+      log_.line(refused_ + ": no emulated devices");
+      return;
+    }
+    if (!answered || rep.result < 0) {
+      log_.line("the daemon at " + shown_path() + " did not answer the hello (protocol " +
+                std::to_string(kProtocolVersion) + ")");
       return;
     }
     nodes_ = decode_catalogue(std::string(payload.begin(), payload.end()));
@@ -149,22 +158,51 @@ class RemoteBackend final : public Backend {
       return false;
     }
     protect_fd(sock_);
-    if (use_shared_) attach_shared_locked();
+    // Only a daemon of our own user (or root's) is told what the program does, or believed.
+    if (const std::string foreign = check_server_owner(sock_, path_); !foreign.empty()) {
+      refused_ = terminal_safe(foreign);
+      disconnect_locked();
+      errno = EACCES;
+      return false;
+    }
+    if (use_shared_ && !attach_shared_locked()) {
+      disconnect_locked();
+      errno = ECONNREFUSED;
+      return false;
+    }
     return true;
   }
 
+  std::string shown_path() const { return terminal_safe(path_); }
+
+  // A refusal from the daemon (kRefusalKind) as the reply in reply_: remembered for the log.
+  bool refused_locked() {
+    if (const auto why = decode_refusal(reply_.bytes())) {
+      refused_ = "the daemon at " + shown_path() + " refused this program: " + terminal_safe(*why);
+      return true;
+    }
+    return false;
+  }
+
   // Asks the daemon for a shared region; without one (an older daemon, no memfd) every request
-  // stays on the socket.
-  void attach_shared_locked() {
+  // stays on the socket. False when the daemon refused the connection.
+  bool attach_shared_locked() {
     const RequestHeader req{static_cast<std::uint32_t>(Op::attach_shm), 0, 0, 0};
     int fd = -1;
-    if (!send_packet(sock_, &req, sizeof req, {}, -1) || !recv_packet(sock_, reply_, fd, true)) return;
+    // A refused connection has its refusal waiting even when the request could not be sent.
+    (void)send_packet(sock_, &req, sizeof req, {}, -1);
+    if (!recv_packet(sock_, reply_, fd, true)) return true;
+    if (refused_locked()) {
+      if (fd >= 0) real::close(fd);
+      return false;
+    }
     ReplyHeader rep;
     if (reply_.size >= sizeof rep) std::memcpy(&rep, reply_.data.get(), sizeof rep);
     if (fd >= 0) {
       if (reply_.size >= sizeof rep && rep.result > 0) shared_ = SharedChannel::attach(fd);
       real::close(fd);  // the mapping stays; nothing of it in the host's descriptor table
     }
+    return true;
   }
 
   void disconnect_locked() {
@@ -183,7 +221,14 @@ class RemoteBackend final : public Backend {
         shared_.reset();
         continue;
       }
-      if (!exchange_locked(req, a, b, fd, cloexec)) {
+      const bool exchanged = exchange_locked(req, a, b, fd, cloexec);
+      if (!from_region_ && refused_locked()) {  // the daemon said why it does not serve us
+        if (fd >= 0) real::close(fd);
+        fd = -1;
+        disconnect_locked();
+        return false;
+      }
+      if (!exchanged) {
         disconnect_locked();
         if (req.op != static_cast<std::uint32_t>(Op::hello) && attempt == 0 && errno != EINTR) continue;
         return false;
@@ -232,7 +277,14 @@ class RemoteBackend final : public Backend {
     std::memcpy(packet_.data(), &req, sizeof req);
     if (!a.empty()) std::memcpy(packet_.data() + sizeof req, a.data(), a.size());
     if (!b.empty()) std::memcpy(packet_.data() + sizeof req + a.size(), b.data(), b.size());
-    if (!send_packet(sock_, packet_.data(), packet_.size(), {}, -1)) return false;
+    if (!send_packet(sock_, packet_.data(), packet_.size(), {}, -1)) {
+      // The daemon closed the connection; what it sent before (a refusal) is still to be read.
+      if (errno == EPIPE || errno == ECONNRESET) {
+        const int e = errno;
+        if (!recv_packet(sock_, reply_, fd, cloexec)) errno = e;
+      }
+      return false;
+    }
     // With a region, the daemon's thread listens to the region: tell it to read the socket.
     if (shared_) shared_->post_request(0, kShmOnSocket);
     return recv_packet(sock_, reply_, fd, cloexec, kReplySpinNs);
@@ -246,6 +298,7 @@ class RemoteBackend final : public Backend {
   std::vector<std::uint8_t> packet_, scratch_;
   Packet reply_;
   bool use_shared_ = true;
+  std::string refused_;  // why the daemon (or its owner) is not to be used, "" when it is
   std::unique_ptr<SharedChannel> shared_;
   bool from_region_ = false;  // the last reply is in shared_'s reply area, not in reply_
 };

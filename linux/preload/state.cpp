@@ -127,16 +127,6 @@ const std::vector<DeviceNode>& nodes() {
   return b ? b->nodes() : kNoNodes;
 }
 
-int node_index(const char* path) {
-  if (!path || !active()) return -1;
-  // Cheap filter first: only /dev/ and /sys/ paths can be ours.
-  if (path[0] != '/' || (std::strncmp(path, "/dev/", 5) != 0)) return -1;
-  const auto& n = nodes();
-  for (std::size_t i = 0; i < n.size(); ++i)
-    if (n[i].path == path) return static_cast<int>(i);
-  return -1;
-}
-
 FdEntry* fd_entry(int fd) {
   if (fd < 0) return nullptr;
   if (fd < kTableSize) return g_table[fd].load(std::memory_order_acquire);

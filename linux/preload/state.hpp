@@ -3,6 +3,8 @@
 // re-entrancy guard that sends the library's own calls straight to the C library.
 #pragma once
 
+#include <fcntl.h>
+
 #include <atomic>
 #include <cstdint>
 #include <string_view>
@@ -17,6 +19,7 @@ struct FdEntry {
   std::uint64_t handle = 0;
   HandleKind kind = HandleKind::spidev;
   std::uint32_t node = 0;                ///< device node index (the gpiochip for line requests)
+  std::uint32_t access = O_RDWR;         ///< O_ACCMODE bits of the open (line requests: O_RDONLY, as the kernel's)
   std::atomic<std::uint32_t> record{0};  ///< bytes per read() record (events), 0 = not readable as records
   std::atomic<int> refs{1};
 };
@@ -25,8 +28,6 @@ struct FdEntry {
 bool active();
 /// The backend, made on first call; nullptr when inactive.
 Backend* backend();
-/// Index of the device node at `path`, or -1 (also -1 when inactive).
-int node_index(const char* path);
 /// The device nodes (empty when inactive).
 const std::vector<DeviceNode>& nodes();
 

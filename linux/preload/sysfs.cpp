@@ -7,6 +7,7 @@
 
 #include <cstring>
 
+#include "linux/preload/node_path.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 
@@ -74,19 +75,24 @@ bool is_prefix_dir(std::string_view dir, std::string_view of) {
 
 VirtualPath lookup_virtual(std::string_view path, bool follow) {
   VirtualPath v;
-  if (!active() || path.size() < 5 || (path.compare(0, 5, "/dev/") != 0 && path.compare(0, 5, "/sys/") != 0)) return v;
-  const auto& ns = nodes();
-  if (path.compare(0, 5, "/dev/") == 0) {
-    for (std::size_t i = 0; i < ns.size(); ++i)
-      if (ns[i].path == path) {
-        v.type = VirtualPath::Type::char_device;
-        v.major = ns[i].major;
-        v.minor = ns[i].minor;
-        v.node = static_cast<int>(i);
-        return v;
-      }
+  if (!active() || path.empty() || path[0] != '/') return v;
+  // /dev nodes, however the path spells them (the kernel's walk: node_path.hpp).
+  int node = -1;
+  const NodeWalk walk = walk_to_node(path, node);
+  if (walk == NodeWalk::through_node) {
+    v.type = VirtualPath::Type::not_directory;
     return v;
   }
+  if (walk == NodeWalk::node) {
+    const DeviceNode& n = nodes()[static_cast<std::size_t>(node)];
+    v.type = VirtualPath::Type::char_device;
+    v.major = n.major;
+    v.minor = n.minor;
+    v.node = node;
+    return v;
+  }
+  if (path.size() < 5 || path.compare(0, 5, "/sys/") != 0) return v;
+  const auto& ns = nodes();
   const std::string p = canonical(path, follow);
   for (const DeviceNode& n : ns) {
     for (const std::string& link : link_paths(n))
@@ -135,8 +141,8 @@ VirtualPath lookup_virtual(std::string_view path, bool follow) {
 
 std::string virtual_realpath(std::string_view path) {
   const VirtualPath v = lookup_virtual(path, true);
-  if (v.type == VirtualPath::Type::none) return {};
-  if (v.type == VirtualPath::Type::char_device) return std::string(path);
+  if (v.type == VirtualPath::Type::none || v.type == VirtualPath::Type::not_directory) return {};
+  if (v.type == VirtualPath::Type::char_device) return nodes()[static_cast<std::size_t>(v.node)].path;
   return canonical(path, true);
 }
 
@@ -181,6 +187,7 @@ void fill_stat(const VirtualPath& v, struct stat* st) {
       st->st_size = static_cast<off_t>(v.content.size());
       break;
     case VirtualPath::Type::none:
+    case VirtualPath::Type::not_directory:
       break;
   }
 }

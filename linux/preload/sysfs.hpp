@@ -15,7 +15,8 @@ namespace l6470emu::preload {
 
 /// A path the preload answers for.
 struct VirtualPath {
-  enum class Type { none, char_device, directory, file, symlink } type = Type::none;
+  /// not_directory: the path goes on past an emulated node (stat and friends fail with ENOTDIR).
+  enum class Type { none, char_device, directory, file, symlink, not_directory } type = Type::none;
   std::string content;  ///< file contents, or the symlink target
   unsigned major = 0, minor = 0;
   int node = -1;        ///< device node index for char devices

@@ -1,12 +1,15 @@
 // `ctl` commands: status, get, sw, pin, fault, adc, axis, dump, chains, time, advance, trace.
 #include "linux/serve/control.hpp"
 
+#include <charconv>
+#include <climits>
 #include <cstdio>
 #include <sstream>
 #include <vector>
 
 #include "core/status.hpp"
 #include "linux/axis_config.hpp"
+#include "linux/terminal_text.hpp"
 
 namespace l6470emu {
 namespace {
@@ -15,6 +18,8 @@ struct Args {
   std::vector<std::string> words;   // positional words after the command
   std::string chain;                // --chain NAME ("" = the first chain)
   long chip = -1;                   // --chip K as the user numbers it (-1 = not given)
+  std::string chip_text;            // K as the user wrote it (a number too large for `chip` included)
+  bool chip_too_large = false;      // K has more digits than any chain has chips
   std::optional<NumberFrom> number_from;  // --number-from miso|mosi (none = the board's)
   std::string error;
 };
@@ -35,9 +40,18 @@ Args parse_args(const std::vector<std::string>& all) {
         a.number_from = number_from_named(v);
         if (!a.number_from) a.error = "--number-from must be miso (chip 0 drives MISO) or mosi (chip 0 reads the host's MOSI), not '" + v + "'";
       } else {
-        char* end = nullptr;
-        a.chip = std::strtol(v.c_str(), &end, 10);
-        if (v.empty() || *end || a.chip < 0) a.error = "--chip needs a chip number, not '" + v + "'";
+        // Digits only, read exactly: a number past any chain's size is a chip that does not exist.
+        a.chip_text = v;
+        unsigned long long k = 0;
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), k, 10);
+        if (v.empty() || end != v.data() + v.size() || (ec != std::errc{} && ec != std::errc::result_out_of_range)) {
+          a.error = "--chip needs a chip number, not '" + terminal_safe(v.substr(0, 60)) + "'";
+        } else if (ec == std::errc::result_out_of_range || k > static_cast<unsigned long long>(LONG_MAX)) {
+          a.chip_too_large = true;
+          a.chip = LONG_MAX;
+        } else {
+          a.chip = static_cast<long>(k);
+        }
       }
     } else {
       a.words.push_back(w);
@@ -45,6 +59,41 @@ Args parse_args(const std::vector<std::string>& all) {
   }
   return a;
 }
+
+}  // namespace
+
+std::string parse_advance_ms(const std::string& text, Tick& ticks) {
+  const std::string shown = "'" + terminal_safe(text.substr(0, 60)) + (text.size() > 60 ? "...'" : "'");
+  const std::string form = " is not a time to advance by: write milliseconds as digits with at most 9 decimals "
+                           "(e.g. 250 or 0.5), at most " + std::to_string(kMaxAdvanceMs) + " (about 115 days)";
+  const std::size_t dot = text.find('.');
+  const std::string_view whole = std::string_view(text).substr(0, dot);
+  const std::string_view frac = dot == std::string::npos ? std::string_view() : std::string_view(text).substr(dot + 1);
+  const auto digits = [](std::string_view s) {
+    for (char c : s)
+      if (c < '0' || c > '9') return false;
+    return true;
+  };
+  if (whole.empty() || !digits(whole) || !digits(frac) || (dot != std::string::npos && frac.empty()) || frac.size() > 9)
+    return shown + form;
+  // Leading zeros do not count towards the bound's digits; past 11 digits it is too large anyway.
+  const std::size_t first = std::min(whole.find_first_not_of('0'), whole.size());
+  if (whole.size() - first > 11) return shown + " is more than " + std::to_string(kMaxAdvanceMs) + " ms (about 115 days)";
+  std::uint64_t ms = 0;
+  for (char c : whole.substr(first)) ms = ms * 10 + static_cast<std::uint64_t>(c - '0');
+  std::uint64_t num = 0, den = 1;
+  for (char c : frac) {
+    num = num * 10 + static_cast<std::uint64_t>(c - '0');
+    den *= 10;
+  }
+  if (ms > kMaxAdvanceMs || (ms == kMaxAdvanceMs && num > 0))
+    return shown + " is more than " + std::to_string(kMaxAdvanceMs) + " ms (about 115 days)";
+  constexpr Tick kTicksPerMs = 1000 * kTicksPerMicrosecond;
+  ticks = ms * kTicksPerMs + num * kTicksPerMs / den;  // a fraction of a tick is dropped
+  return "";
+}
+
+namespace {
 
 std::string hex(std::uint32_t v, int digits) {
   char b[16];
@@ -115,8 +164,8 @@ int run_control(Board& board, const std::string& command, std::string& out) {
   const std::size_t ci = static_cast<std::size_t>(chain);
   std::size_t chips = 0;
   board.with_chain(ci, [&](Chain& c) { chips = c.size(); });
-  if (a.chip >= static_cast<long>(chips)) {
-    out = "ctl: chip " + std::to_string(a.chip) + " does not exist (the chain has " + std::to_string(chips) + ")\n";
+  if (a.chip_too_large || a.chip >= static_cast<long>(chips)) {
+    out = "ctl: chip " + a.chip_text + " does not exist (the chain has " + std::to_string(chips) + ")\n";
     return 1;
   }
   // --chip K is the user's number; k below is always the chain index.
@@ -333,17 +382,20 @@ int run_control(Board& board, const std::string& command, std::string& out) {
     o << (board.time().is_virtual() ? "virtual time (moves with bus traffic and `advance`)\n"
                                     : "wall clock x " + std::to_string(board.time().scale()) + "\n");
   } else if (cmd == "advance") {
-    char* end = nullptr;
-    const double ms = a.words.size() == 1 ? std::strtod(a.words[0].c_str(), &end) : -1;
-    if (a.words.size() != 1 || *end || !(ms >= 0)) {
+    if (a.words.size() != 1) {
       out = "ctl: usage: advance MS\n";
       return 2;
     }
-    if (!board.advance(static_cast<Tick>(ms * 1000.0 * kTicksPerMicrosecond))) {
+    Tick ticks = 0;
+    if (const std::string error = parse_advance_ms(a.words[0], ticks); !error.empty()) {
+      out = "ctl: advance: " + error + "\n";
+      return 2;
+    }
+    if (!board.advance(ticks)) {
       out = "ctl: the daemon runs on the wall clock; `advance` needs `serve --virtual-time`\n";
       return 1;
     }
-    o << "advanced " << ms << " ms\n";
+    o << "advanced " << a.words[0] << " ms (" << ticks << (ticks == 1 ? " tick)\n" : " ticks)\n");
   } else if (cmd == "trace") {
     // One native trace per chain; without --chain, `stop` ends every recording.
     if (a.words.size() == 2 && a.words[0] == "start") {

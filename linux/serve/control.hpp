@@ -2,6 +2,7 @@
 // without side effects, as text commands. Parsing and formatting only; the Board does the work.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -14,6 +15,14 @@ namespace l6470emu {
 /// Chip numbers, in --chip K and in the output, count as the board's numbering() says, or as
 /// `--number-from miso|mosi` in the command says; status, dump and chains say which, once.
 int run_control(Board& board, const std::string& command, std::string& output);
+
+/// Longest `ctl advance MS`, in ms: 10^10 ms, about 115 days (4·10^13 ticks, far from the tick's range).
+inline constexpr std::uint64_t kMaxAdvanceMs = 10'000'000'000;
+
+/// Reads the MS of `ctl advance MS` exactly (no float): digits, optionally a point and at most 9
+/// decimals, at most kMaxAdvanceMs. Sets `ticks` (a fraction of a tick dropped) and returns "", or
+/// returns one line saying what is wrong with the text (inf, nan, 1e3, -1 and 4e15 included).
+std::string parse_advance_ms(const std::string& text, Tick& ticks);
 
 /// Text of `ctl help`: with `numbering`, the daemon's convention; without, a client that has
 /// not asked the daemon (which numbers as its numbering= says).

@@ -12,7 +12,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
@@ -26,6 +29,8 @@
 #include "linux/board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/serve/control.hpp"
+#include "linux/serve/ctl_reply.hpp"
+#include "linux/terminal_text.hpp"
 #include "linux/shm_channel.hpp"
 
 namespace l6470emu {
@@ -58,13 +63,19 @@ int connect_to(const std::string& path) {
 
 /// Connections served at once; more are refused (each one is a thread and a packet buffer).
 constexpr std::size_t kMaxClients = 256;
+/// Connections of one process (SO_PEERCRED pid) served at once: the preload needs one (one more
+/// for a moment after fork), ctl one; the cap keeps one process from taking every slot.
+constexpr std::size_t kMaxClientsPerProcess = 16;
+/// How long SIGTERM waits for the connections to end (a thread sleeping on its region's futex
+/// ends within kShmAliveCheckMs). One still waiting out a message's bus time is not waited for.
+constexpr int kStopWaitMs = 3000;
 /// Stack of a connection thread: serving a request needs little (buffers live on the heap).
 constexpr std::size_t kConnectionStack = 256 * 1024;
 
 struct Connection {
   int fd = -1;
   pthread_t thread{};
-  bool done = false;
+  bool done = false;  // under the connections' lock
   pid_t pid = 0;
   std::atomic<bool> shared{false};                // requests come through a shared region
   std::atomic<std::uint64_t> shared_requests{0};  // served from the region
@@ -92,6 +103,13 @@ bool start_thread(pthread_t& thread, std::function<void()> body) {
     return false;
   }
   return true;
+}
+
+/// Tells a client why it is not served (kRefusalKind), without waiting, then closes the connection.
+void refuse(int sock, const std::string& why) {
+  const std::vector<std::uint8_t> p = encode_refusal(why);
+  (void)send(sock, p.data(), p.size(), MSG_DONTWAIT | MSG_NOSIGNAL);
+  close(sock);
 }
 
 /// Sends a reply on the socket (closing `pass_fd` after); false when the client is gone.
@@ -123,13 +141,13 @@ bool attach_shared(Connection& c, std::unique_ptr<SharedChannel>& shared) {
 /// briefly for the next request and then sleeps on the region's futex, looking every
 /// kShmAliveCheckMs whether the client is still there, so a client killed at any moment (even
 /// while the thread sleeps on its futex) ends only its own connection.
-void serve_connection(Board& board, const ControlHandler& control, Connection& c) {
+void serve_connection(Board& board, const ControlHandler& control, Connection& c, const std::atomic<bool>& stopping) {
   Packet packet;
   std::vector<std::uint8_t> payload;
   ReplyHeader reply;
   std::unique_ptr<SharedChannel> shared;
   std::unique_ptr<std::uint8_t[]> scratch(new std::uint8_t[kShmAreaBytes]);
-  const std::function<bool()> alive = [&c] { return peer_alive(c.fd); };
+  const std::function<bool()> alive = [&c, &stopping] { return !stopping && peer_alive(c.fd); };
   for (;;) {
     int pass_fd = -1;
     if (shared) {
@@ -270,6 +288,8 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   }
   std::list<Connection> connections;
   std::mutex connections_mutex;
+  std::condition_variable connection_ended;
+  std::atomic<bool> stopping{false};
   std::mutex control_mutex;  // ctl commands one at a time
   const ControlHandler control = [&](const std::string& command, std::string& text) {
     std::lock_guard lock(control_mutex);
@@ -299,6 +319,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   out.flush();
 
   bool warned_descriptors = false, warned_clients = false;
+  pid_t warned_process = 0;
   for (;;) {
     pollfd fds[2] = {{listener, POLLIN, 0}, {sfd, POLLIN, 0}};
     const int n = poll(fds, 2, 1000);
@@ -335,27 +356,43 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     if (getsockopt(c, SOL_SOCKET, SO_PEERCRED, &peer, &len) != 0 || (peer.uid != geteuid() && peer.uid != 0)) {
       log.line("serve: refused a client of user " + std::to_string(peer.uid) + " (pid " + std::to_string(peer.pid) +
                "): only user " + std::to_string(geteuid()) + " and root may use this daemon");
-      close(c);
+      refuse(c, "the daemon at " + socket_path + " serves only user " + std::to_string(geteuid()) +
+                    " and root, not user " + std::to_string(peer.uid));
       continue;
     }
     std::lock_guard lock(connections_mutex);
+    std::size_t of_process = 0;
+    for (const Connection& k : connections) of_process += !k.done && k.pid == peer.pid ? 1 : 0;
     if (connections.size() >= kMaxClients) {
       if (!warned_clients) log.line("serve: " + std::to_string(kMaxClients) + " clients connected; refusing more until some leave");
       warned_clients = true;
-      close(c);
+      refuse(c, "the daemon at " + socket_path + " already serves " + std::to_string(kMaxClients) +
+                    " clients, the most it serves at once; try again when some have left");
       continue;
     }
     warned_clients = false;
+    if (of_process >= kMaxClientsPerProcess) {
+      if (warned_process != peer.pid)
+        log.line("serve: process " + std::to_string(peer.pid) + " has " + std::to_string(of_process) +
+                 " connections, the most one process may have; refusing more of them");
+      warned_process = peer.pid;
+      refuse(c, "process " + std::to_string(peer.pid) + " already has " + std::to_string(of_process) +
+                    " connections to the daemon at " + socket_path + ", the most one process may have (" +
+                    std::to_string(kMaxClientsPerProcess) + ")");
+      continue;
+    }
     Connection& conn = connections.emplace_back();
     conn.fd = c;
     conn.pid = peer.pid;
-    if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex] {
-          serve_connection(board, control, conn);
+    if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex, &connection_ended, &stopping] {
+          serve_connection(board, control, conn, stopping);
           std::lock_guard l(connections_mutex);
           conn.done = true;
+          connection_ended.notify_all();
         })) {
-      log.line("serve: cannot start a thread for a client (" + std::string(std::strerror(errno)) + "); refused");
-      close(c);
+      const std::string why = std::strerror(errno);
+      log.line("serve: cannot start a thread for a client (" + why + "); refused");
+      refuse(c, "the daemon at " + socket_path + " cannot start a thread for this client (" + why + ")");
       connections.pop_back();
     }
   }
@@ -364,18 +401,45 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   out.flush();
   close(listener);
   unlink(socket_path.c_str());
+  // Every connection ends: its socket is shut down (a thread in recvmsg or sendmsg returns, one
+  // sleeping on its region's futex sees the hang-up at its next look) and `stopping` is set.
+  // A thread still waiting out a long message's bus time is not waited for.
+  stopping = true;
+  std::size_t stuck = 0;
   {
-    std::lock_guard lock(connections_mutex);
+    std::unique_lock lock(connections_mutex);
     for (auto& c : connections) shutdown(c.fd, SHUT_RDWR);
+    const auto all_done = [&] {
+      for (const auto& c : connections)
+        if (!c.done) return false;
+      return true;
+    };
+    connection_ended.wait_for(lock, std::chrono::milliseconds(kStopWaitMs), all_done);
+    for (auto it = connections.begin(); it != connections.end();) {
+      if (it->done) {
+        pthread_join(it->thread, nullptr);
+        close(it->fd);
+        it = connections.erase(it);
+      } else {
+        ++stuck;
+        ++it;
+      }
+    }
   }
-  for (auto& c : connections) {
-    pthread_join(c.thread, nullptr);
-    close(c.fd);
-  }
+  if (stuck > 0)
+    err << "l6470emu serve: " << stuck << (stuck == 1 ? " client is" : " clients are")
+        << " still in a message's bus time; stopping without waiting for " << (stuck == 1 ? "it" : "them") << "\n";
   kept.reset();  // the kernel nodes go away before the recordings end
   for (std::size_t i = 0; i < board.chain_count(); ++i) {
     std::string summary;
     if (board.stop_recording(i, &summary)) out << "l6470emu serve: recorded " << summary << "\n";
+  }
+  if (stuck > 0) {
+    // Threads still use the board: end the process here rather than destroy it under them.
+    out.flush();
+    err.flush();
+    std::fflush(nullptr);
+    _exit(0);
   }
   board.stop_pump();
   if (sfd >= 0) close(sfd);
@@ -383,9 +447,16 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
 }
 
 int run_ctl(const std::string& socket_path, const std::string& command, std::ostream& out, std::ostream& err) {
+  const std::string where = terminal_safe(socket_path);
   const int s = connect_to(socket_path);
   if (s < 0) {
-    err << "l6470emu ctl: no daemon at " << socket_path << " (" << std::strerror(errno) << "); start one with `l6470emu serve`\n";
+    err << "l6470emu ctl: no daemon at " << where << " (" << std::strerror(errno) << "); start one with `l6470emu serve`\n";
+    return 1;
+  }
+  // Whoever listens at the path must be us or root before it hears a command or is believed.
+  if (const std::string foreign = check_server_owner(s, socket_path); !foreign.empty()) {
+    close(s);
+    err << "l6470emu ctl: " << terminal_safe(foreign) << "\n";
     return 1;
   }
   RequestHeader req{static_cast<std::uint32_t>(Op::control), static_cast<std::uint32_t>(command.size()), 0, 0};
@@ -394,18 +465,23 @@ int run_ctl(const std::string& socket_path, const std::string& command, std::ost
   std::memcpy(packet.data() + sizeof req, command.data(), command.size());
   Packet reply;
   int fd = -1;
-  if (!send_packet(s, packet.data(), packet.size(), {}, -1) || !recv_packet(s, reply, fd, true) ||
-      reply.size < sizeof(ReplyHeader)) {
-    err << "l6470emu ctl: the daemon at " << socket_path << " did not answer\n";
-    close(s);
+  // A refused connection has its refusal waiting even when the command could not be sent.
+  const bool sent = send_packet(s, packet.data(), packet.size(), {}, -1);
+  const int send_errno = errno;
+  errno = 0;
+  const bool received = recv_packet(s, reply, fd, true);
+  const int recv_errno = errno;
+  close(s);
+  if (fd >= 0) close(fd);
+  if (!received) {
+    const int e = recv_errno ? recv_errno : sent ? 0 : send_errno;
+    err << "l6470emu ctl: the daemon at " << where << " did not answer ("
+        << (e ? std::strerror(e) : "it closed the connection") << ")\n";
     return 1;
   }
-  close(s);
-  ReplyHeader rep;
-  std::memcpy(&rep, reply.data.get(), sizeof rep);
-  const std::string text(reinterpret_cast<const char*>(reply.data.get()) + sizeof rep, reply.size - sizeof rep);
-  (rep.result == 0 ? out : err) << text;
-  return static_cast<int>(rep.result);
+  const CtlOutcome o = decode_ctl_reply(reply.bytes(), socket_path);
+  (o.on_stderr ? err : out) << o.text;
+  return o.status;
 }
 
 }  // namespace l6470emu

@@ -12,12 +12,14 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "linux/protocol.hpp"
+#include "raw_client.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu::test {
@@ -25,27 +27,10 @@ namespace {
 
 constexpr const char* kChain = "bus=0 cs=0 chips=L6470";
 
-int connect_to(const std::string& path) {
-  const int s = socket(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0);
-  sockaddr_un a{};
-  a.sun_family = AF_UNIX;
-  std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
-  if (connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-    close(s);
-    return -1;
-  }
-  return s;
-}
+int connect_to(const std::string& path) { return connect_raw(path); }
 
-/// Whether the daemon answers a hello on `fd` (false: it closed the connection or never answers).
-bool answers_hello(int fd) {
-  const RequestHeader req{static_cast<std::uint32_t>(Op::hello), 0, 0, kProtocolVersion};
-  if (send(fd, &req, sizeof req, MSG_NOSIGNAL) != static_cast<ssize_t>(sizeof req)) return false;
-  timeval tv{5, 0};
-  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  std::uint8_t buf[4096];
-  return recv(fd, buf, sizeof buf, 0) >= static_cast<ssize_t>(sizeof(ReplyHeader));
-}
+/// Whether the daemon answers a hello on `fd` (false: it refused, closed the connection or never answers).
+bool answers_hello(int fd) { return say_hello(fd).answered; }
 
 /// User and system CPU seconds a process has used so far.
 double cpu_seconds(pid_t pid) {
@@ -121,10 +106,13 @@ TEST_F(DaemonLimits, AClientOfAnotherUserIsRefusedEvenWhenTheSocketModeWouldLetI
   struct stat dst{};
   stat(dir.c_str(), &dst);
   chmod(dir.c_str(), dst.st_mode | 0011);
+  // ... refuses it, and tells it why.
   EXPECT_EQ(as_nobody([&] {
               const int fd = connect_to(path);
               if (fd < 0) return 2;
-              return answers_hello(fd) ? 1 : 0;
+              const HelloOutcome o = say_hello(fd);
+              if (o.answered) return 1;
+              return o.refusal && o.refusal->find("serves only user 0 and root, not user 65534") != std::string::npos ? 0 : 3;
             }),
             0);
   chmod(dir.c_str(), dst.st_mode);
@@ -180,17 +168,36 @@ TEST_F(DaemonLimits, OutOfDescriptorsTheDaemonWaitsInsteadOfSpinningAndRecovers)
   EXPECT_NE(r.err.find("out of file descriptors"), std::string::npos) << r.err;
 }
 
-TEST_F(DaemonLimits, ClientsPastTheCapAreRefusedAndTheRestServed) {
+TEST_F(DaemonLimits, ClientsPastTheCapAreRefusedToldWhyAndTheRestServed) {
   ServeDaemon d(kChain);
   ASSERT_TRUE(d.ready());
-  std::vector<int> clients;
-  for (int i = 0; i < 300; ++i)
-    if (const int fd = connect_to(d.socket()); fd >= 0) clients.push_back(fd);
-  ASSERT_EQ(clients.size(), 300u);
+  // 16 processes of 16 connections fill the 256 slots; the 17th process is refused, and told why.
+  std::vector<std::unique_ptr<ConnectionHolder>> holders;
   int answered = 0;
-  for (int fd : clients) answered += answers_hello(fd) ? 1 : 0;
+  for (int i = 0; i < 16; ++i) {
+    holders.push_back(std::make_unique<ConnectionHolder>(d.socket(), 16));
+    answered += holders.back()->answered();
+  }
   EXPECT_EQ(answered, 256);
-  for (int fd : clients) close(fd);
+  {
+    ConnectionHolder late(d.socket(), 4);
+    EXPECT_EQ(late.answered(), 0);
+    EXPECT_EQ(late.refused(), 4);
+    EXPECT_NE(late.first_refusal().find("already serves 256 clients, the most it serves at once"), std::string::npos)
+        << late.first_refusal();
+  }
+  // ctl and a preload program refused at the cap say so, not "did not answer".
+  const RunResult refused = d.ctl({"status"});
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("refused the connection: the daemon at " + d.socket() + " already serves 256 clients"),
+            std::string::npos)
+      << refused.err;
+  const RunResult program = run_program({system_python(), "-c", "import os; print(os.path.exists('/dev/spidev0.0'))"}, d.env());
+  EXPECT_EQ(program.out, "False\n");
+  EXPECT_NE(program.err.find("refused this program: the daemon at " + d.socket() + " already serves 256 clients"),
+            std::string::npos)
+      << program.err;
+  holders.clear();
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // the accept loop reaps at least once a second
   const RunResult t = d.ctl({"time"});
   EXPECT_EQ(t.status, 0) << t.err;
@@ -199,10 +206,31 @@ TEST_F(DaemonLimits, ClientsPastTheCapAreRefusedAndTheRestServed) {
   EXPECT_NE(r.err.find("256 clients connected; refusing more"), std::string::npos) << r.err;
 }
 
+TEST_F(DaemonLimits, OneProcessCannotTakeEverySlot) {
+  ServeDaemon d(kChain);
+  ASSERT_TRUE(d.ready());
+  ConnectionHolder greedy(d.socket(), 20);
+  EXPECT_EQ(greedy.answered(), 16);
+  EXPECT_EQ(greedy.refused(), 4);
+  EXPECT_NE(greedy.first_refusal().find("process " + std::to_string(greedy.pid()) +
+                                        " already has 16 connections to the daemon at " + d.socket() +
+                                        ", the most one process may have (16)"),
+            std::string::npos)
+      << greedy.first_refusal();
+  // Every other process is still served.
+  ConnectionHolder other(d.socket(), 2);
+  EXPECT_EQ(other.answered(), 2);
+  const RunResult c = d.ctl({"clients"});
+  EXPECT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(c.out.rfind("19 clients\n", 0), 0u) << c.out;  // 16 + 2 + ctl itself
+  EXPECT_NE(d.process().stop(SIGTERM).err.find("process " + std::to_string(greedy.pid()) + " has 16 connections"),
+            std::string::npos);
+}
+
 TEST_F(DaemonLimits, CtlSaysWhichChipDoesNotExist) {
   ServeDaemon d(kChain);
   ASSERT_TRUE(d.ready());
-  for (const char* k : {"3", "99999"}) {
+  for (const char* k : {"3", "99999", "99999999999999999999", "000000000000000000000000000000000000001"}) {
     const RunResult r = d.ctl({"get", "ABS_POS", "--chip", k});
     EXPECT_EQ(r.status, 1);
     EXPECT_EQ(r.err, std::string("ctl: chip ") + k + " does not exist (the chain has 1)\n");

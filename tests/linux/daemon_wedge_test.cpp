@@ -1,0 +1,72 @@
+// `l6470emu serve` cannot be wedged by its clients: one that attaches its shared region, leaves
+// a packet unread on its socket and dies is reaped like any other, and SIGTERM ends the daemon
+// whatever its clients left behind.
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "raw_client.hpp"
+#include "run_program.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+constexpr const char* kChain = "bus=0 cs=0 chips=L6470";
+
+class DaemonWedge : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string why = missing_prerequisites();
+    if (!why.empty()) GTEST_SKIP() << why;
+  }
+};
+
+/// `ctl clients` until it counts `n` clients (ctl itself included), at most ~10 s; the last answer.
+std::string wait_for_clients(const ServeDaemon& d, int n) {
+  const std::string want = std::to_string(n) + (n == 1 ? " client\n" : " clients\n");
+  std::string out;
+  for (int i = 0; i < 200; ++i) {
+    out = d.ctl({"clients"}).out;
+    if (out.rfind(want, 0) == 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return out;
+}
+
+TEST_F(DaemonWedge, ClientsThatDieWithAPacketUnreadAreReaped) {
+  ServeDaemon d(kChain);
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  // More dead connections than the daemon serves at once, from processes of 16 (the most one
+  // process may have): each batch must be reaped for the next to be served.
+  for (int batch = 0; batch < 3; ++batch) {
+    EXPECT_EQ(dead_clients_with_unread_packets(d.socket(), 16), 16) << "batch " << batch;
+    const std::string clients = wait_for_clients(d, 1);  // ctl's own connection only
+    ASSERT_EQ(clients.rfind("1 client\n", 0), 0u) << "batch " << batch << ": the dead are still listed:\n" << clients;
+  }
+  const RunResult r = run_program({client("spidev_reader"), "/dev/spidev0.0", "10", "0x01", "0"}, d.env());
+  EXPECT_EQ(r.out, "reads=10 torn=0\n") << r.err;
+  EXPECT_EQ(d.process().stop(SIGTERM, 10).status, 0);
+}
+
+TEST_F(DaemonWedge, SigtermEndsTheDaemonWhateverItsClientsLeftBehind) {
+  ServeDaemon d(kChain);
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  // A live client sleeping on its region's futex, and dead ones whose packets nobody reads.
+  Background holder({system_python(), "-c",
+                     "import spidev, time\ns = spidev.SpiDev(); s.open(0, 0); s.xfer2([0])\n"
+                     "print('done', flush=True)\ntime.sleep(60)\n"},
+                    d.env());
+  for (int i = 0; i < 1000 && holder.out().find("done") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(dead_clients_with_unread_packets(d.socket(), 8), 8);
+  const RunResult r = d.process().stop(SIGTERM, 10);
+  EXPECT_EQ(r.status, 0) << "the daemon did not end within 10 s of SIGTERM (status 137: killed)\n" << r.err;
+  EXPECT_NE(r.out.find("l6470emu serve: stopping"), std::string::npos) << r.out;
+}
+
+}  // namespace
+}  // namespace l6470emu::test
