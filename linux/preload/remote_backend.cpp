@@ -29,7 +29,7 @@ class RemoteBackend final : public Backend {
     std::lock_guard lock(m_);
     if (!connect_locked()) {
       if (!refused_.empty())
-        log_.line(refused_ + ": no emulated devices");
+        log_.line(refused_ + "; no emulated devices");
       else
         log_.line("cannot reach the daemon at " + shown_path() + " (" + std::strerror(errno) +
                   "): no emulated devices; start it with `l6470emu serve`");
@@ -41,7 +41,7 @@ class RemoteBackend final : public Backend {
     int fd = -1;
     const bool answered = roundtrip_locked(req, {}, {}, rep, payload, fd, true);
     if (!refused_.empty()) {
-      log_.line(refused_ + ": no emulated devices");
+      log_.line(refused_ + "; no emulated devices");
       return;
     }
     if (!answered || rep.result < 0) {

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -238,6 +239,27 @@ TEST_F(DaemonLimits, CtlSaysWhichChipDoesNotExist) {
   const RunResult r = d.ctl({"get", "ABS_POS", "--chip", "-1"});
   EXPECT_EQ(r.err, "ctl: --chip needs a chip number, not '-1'\n");
   EXPECT_EQ(d.ctl({"get", "ABS_POS", "--chip", "0"}).out, "chip 0: ABS_POS = 0x000000 (0)\n");
+}
+
+TEST_F(DaemonLimits, CtlAdvanceTakesOnlyExactBoundedMilliseconds) {
+  ServeDaemon d(kChain, {"--virtual-time"});
+  ASSERT_TRUE(d.ready());
+  // Each refused with one line and status 2; the daemon (UBSan-built too) carries on.
+  for (const char* bad : {"inf", "1e308", "4e15", "nan", "-1", "1e3", "0x10", "1.", ".5", "1.5.2", "1.0000000001",
+                          "10000000000.5", "10000000001", "99999999999999999999999"}) {
+    const RunResult r = d.ctl({"advance", bad});
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_EQ(r.err.rfind(std::string("ctl: advance: '") + bad + "' is ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_NE(d.ctl({"time"}).out.find(": 0 ticks"), std::string::npos);
+  const RunResult ok = d.ctl({"advance", "1.5"});
+  EXPECT_EQ(ok.out, "advanced 1.5 ms (6000 ticks)\n") << ok.err;
+  EXPECT_EQ(d.ctl({"advance", "0.00025"}).out, "advanced 0.00025 ms (1 tick)\n");
+  EXPECT_NE(d.ctl({"time"}).out.find(": 6001 ticks"), std::string::npos);
+  EXPECT_EQ(d.ctl({"advance", "10000000000"}).out, "advanced 10000000000 ms (40000000000000 ticks)\n");
+  EXPECT_NE(d.ctl({"time"}).out.find(": 40000000006001 ticks"), std::string::npos) << d.ctl({"time"}).out;
+  EXPECT_EQ(d.process().stop(SIGTERM).status, 0);
 }
 
 TEST_F(DaemonLimits, CtlTraceStartDoesNotEndARecordingInProgress) {
