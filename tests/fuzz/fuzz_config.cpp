@@ -1,6 +1,9 @@
 // libFuzzer harness of the board description parser (linux/config.hpp parse_board_config):
 // any text gives a config or one error line, never a crash; an accepted config's own
-// description (describe_board_config, what `serve` prints) reads back to the same chains.
+// description (describe_board_config, what `serve` prints) reads back to the same chains; an
+// accepted path= names a /dev node directly, and nothing but a character device exists there.
+#include <sys/stat.h>
+
 #include <string_view>
 
 #include "fuzz_support.hpp"
@@ -19,6 +22,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   }
   const BoardConfig& a = *r.config;
+  // path= rules: a node named directly under /dev/, and nothing but a spidev node (or nothing) there.
+  for (const ChainConfig& c : a.chains) {
+    FUZZ_CHECK(c.path.rfind("/dev/", 0) == 0 && c.path.find("//") == std::string::npos &&
+                   c.path.find("/./") == std::string::npos && c.path.find("/../") == std::string::npos &&
+                   c.path.back() != '/' && c.path.back() != '.',
+               "path %.300s accepted", c.path.c_str());
+    struct stat st{};
+    if (::stat(c.path.c_str(), &st) == 0)
+      FUZZ_CHECK(S_ISCHR(st.st_mode), "path %.300s accepted: it exists and is not a character device", c.path.c_str());
+  }
   if (a.chains.empty()) return 0;  // socket= only: nothing to describe
   const std::string description = describe_board_config(a);
   const ParseResult back = parse_board_config(description, "description");

@@ -1,6 +1,8 @@
 // A fault soak of `l6470emu serve` (bounded in time): 50 preload clients read through one
-// daemon while some are killed with SIGKILL mid-message and others throw garbage at the socket.
-// The daemon keeps serving, the survivors' answers stay exact, and the recording made throughout
+// daemon while some are killed with SIGKILL mid-message, others throw garbage at the socket,
+// others die with a packet left unread on their socket, and slow-bus clients (SCK at the
+// controller's slowest) share the bus, some killed mid-message. The daemon keeps serving and
+// reaps every dead client, the survivors' answers stay exact, and the recording made throughout
 // replays clean after the daemon is stopped with SIGTERM, and after SIGKILL.
 #include <signal.h>
 #include <unistd.h>
@@ -11,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raw_client.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu::test {
@@ -20,6 +23,19 @@ constexpr int kClients = 50;
 constexpr int kKilled = 10;
 constexpr int kGarbage = 4;
 constexpr const char* kReads = "1500";
+constexpr int kSlow = 4;        // slow-bus clients, half of them killed
+constexpr int kDeadBatches = 3;  // processes dying with 4 connections' packets unread
+
+/// `ctl clients` until it counts only ctl itself, at most ~10 s; the last answer.
+std::string wait_until_only_ctl(const ServeDaemon& d) {
+  std::string out;
+  for (int i = 0; i < 200; ++i) {
+    out = d.ctl({"clients"}).out;
+    if (out.rfind("1 client\n", 0) == 0) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return out;
+}
 
 class DaemonSoak : public ::testing::TestWithParam<int> {
  protected:
@@ -43,8 +59,19 @@ TEST_P(DaemonSoak, SurvivorsStayExactAndTheRecordingReplaysClean) {
   for (int i = 0; i < kGarbage; ++i)
     garbage.push_back(std::make_unique<Background>(
         std::vector<std::string>{system_python(), script("garbage_client.py"), d.socket(), std::to_string(i), "4"}));
-  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  // 1-byte NOPs at 3815 Hz: 2.1 ms of bus each, 40 of them per client.
+  std::vector<std::unique_ptr<Background>> slow;
+  for (int i = 0; i < kSlow; ++i)
+    slow.push_back(std::make_unique<Background>(
+        std::vector<std::string>{system_python(), "-c",
+                                 "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
+                                 "for _ in range(40): s.xfer2([0], 3815)\nprint('slow=done')\n"},
+        d.env()));
+  std::this_thread::sleep_for(std::chrono::milliseconds(350));
+  for (int i = 0; i < kDeadBatches; ++i) EXPECT_EQ(dead_clients_with_unread_packets(d.socket(), 4), 4);
+  std::this_thread::sleep_for(std::chrono::milliseconds(350));
   for (int i = 0; i < kKilled; ++i) readers[static_cast<std::size_t>(i * (kClients / kKilled))]->stop(SIGKILL);
+  for (int i = 0; i < kSlow / 2; ++i) slow[static_cast<std::size_t>(i)]->stop(SIGKILL);
 
   int survivors = 0;
   for (int i = 0; i < kClients; ++i) {
@@ -59,6 +86,13 @@ TEST_P(DaemonSoak, SurvivorsStayExactAndTheRecordingReplaysClean) {
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out.rfind("sent=", 0), 0u) << r.out;
   }
+  for (int i = kSlow / 2; i < kSlow; ++i) {
+    const RunResult r = slow[static_cast<std::size_t>(i)]->wait(60);
+    EXPECT_EQ(r.out, "slow=done\n") << r.err;
+  }
+  // Every client is gone, the killed, the dead with packets unread and the finished alike.
+  const std::string clients = wait_until_only_ctl(d);
+  EXPECT_EQ(clients.rfind("1 client\n", 0), 0u) << clients;
   // Still serving, and the killed clients' files were released.
   const RunResult after = run_program({client("spidev_reader"), "/dev/spidev0.0", "10", "0x03", "0x12345"}, d.env());
   EXPECT_EQ(after.out, "reads=10 torn=0\n") << after.err;
