@@ -23,6 +23,11 @@ namespace {
 
 bool candidate(const char* path) { return !inside() && active() && may_be_device_path(path); }
 
+// The C library declares the path arguments nonnull; programs pass NULL all the same (the kernel
+// answers EFAULT). Tested here, not in the functions themselves, where compilers would warn.
+bool absolute(const char* path) { return path && path[0] == '/'; }
+bool empty_path(const char* path) { return path && path[0] == '\0'; }
+
 // 1 when `path` is ours (`st` filled), -1 when it is ours and fails (errno set: a path that goes
 // on past a node), 0 when it is not ours.
 int virtual_stat(const char* path, struct stat* st, bool follow) {
@@ -79,9 +84,9 @@ void to_statx(const struct stat& st, struct statx* sx) {
 }
 
 int do_fstatat(int dirfd, const char* path, struct stat* st, int flags) {
-  if (path && path[0] == '\0' && (flags & AT_EMPTY_PATH)) {
+  if (empty_path(path) && (flags & AT_EMPTY_PATH)) {
     if (virtual_fstat(dirfd, st)) return 0;
-  } else if (path && path[0] == '/') {
+  } else if (absolute(path)) {
     if (const int r = virtual_stat(path, st, !(flags & AT_SYMLINK_NOFOLLOW)); r != 0) return r > 0 ? 0 : -1;
   }
   return real::fstatat(dirfd, path, st, flags);
@@ -195,12 +200,12 @@ L6470EMU_EXPORT int __fxstatat64(int, int dirfd, const char* path, struct stat64
 
 L6470EMU_EXPORT int statx(int dirfd, const char* path, int flags, unsigned mask, struct statx* buf) noexcept {
   struct stat st;
-  if (path && path[0] == '\0' && (flags & AT_EMPTY_PATH)) {
+  if (empty_path(path) && (flags & AT_EMPTY_PATH)) {
     if (virtual_fstat(dirfd, &st)) {
       to_statx(st, buf);
       return 0;
     }
-  } else if (path && path[0] == '/') {
+  } else if (absolute(path)) {
     if (const int r = virtual_stat(path, &st, !(flags & AT_SYMLINK_NOFOLLOW)); r != 0) {
       if (r < 0) return -1;
       to_statx(st, buf);
@@ -215,7 +220,7 @@ L6470EMU_EXPORT int access(const char* path, int mode) noexcept {
   return r == -2 ? real::access(path, mode) : r;
 }
 L6470EMU_EXPORT int faccessat(int dirfd, const char* path, int mode, int flags) noexcept {
-  if (path && path[0] == '/') {
+  if (absolute(path)) {
     const int r = do_access(path, mode);
     if (r != -2) return r;
   }
@@ -231,7 +236,7 @@ L6470EMU_EXPORT ssize_t readlink(const char* path, char* buf, size_t n) noexcept
   return r == -2 ? real::readlink(path, buf, n) : r;
 }
 L6470EMU_EXPORT ssize_t readlinkat(int dirfd, const char* path, char* buf, size_t n) noexcept {
-  if (path && path[0] == '/') {
+  if (absolute(path)) {
     const ssize_t r = do_readlink(path, buf, n);
     if (r != -2) return r;
   }

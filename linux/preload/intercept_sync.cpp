@@ -228,7 +228,8 @@ __attribute__((visibility("default"))) int pthread_join(pthread_t t, void** resu
   });
 }
 
-__attribute__((visibility("default"))) int pthread_cancel(pthread_t t) noexcept {
+// As glibc declares it: without __THROW (no noexcept), so that clang accepts the definition.
+__attribute__((visibility("default"))) int pthread_cancel(pthread_t t) {
   const int r = real::pthread_cancel(t);
   // A covered wait holds cancellation off (the library's own frames cannot be unwound): end the
   // thread's wait, so that it acts on the request as it leaves.
