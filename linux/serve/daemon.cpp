@@ -469,7 +469,8 @@ int run_ctl(const std::string& socket_path, const std::string& command, std::ost
   const bool sent = send_packet(s, packet.data(), packet.size(), {}, -1);
   const int send_errno = errno;
   errno = 0;
-  const bool received = recv_packet(s, reply, fd, true);
+  // Unsent for another reason than the daemon's end (too long a command): no answer will come.
+  const bool received = (sent || send_errno == EPIPE || send_errno == ECONNRESET) && recv_packet(s, reply, fd, true);
   const int recv_errno = errno;
   close(s);
   if (fd >= 0) close(fd);
