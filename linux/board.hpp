@@ -21,9 +21,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include "board/board_config.hpp"
 #include "daisychain/chain.hpp"
 #include "linux/clock.hpp"
-#include "linux/config.hpp"
 #include "linux/gpio_lines.hpp"
 #include "linux/log.hpp"
 #include "linux/spidev_rules.hpp"

@@ -4,9 +4,9 @@
 
 #include <linux/gpio.h>
 
+#include "board/trace_recorder.hpp"
 #include "linux/board.hpp"
 #include "linux/gpio_uapi.hpp"
-#include "linux/trace_recorder.hpp"
 
 namespace l6470emu {
 

@@ -9,8 +9,8 @@
 #include <atomic>
 #include <cstdint>
 
+#include "board/board_config.hpp"
 #include "linux/board.hpp"
-#include "linux/config.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/virtual_scheduler.hpp"
 

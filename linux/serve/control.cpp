@@ -5,8 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include "board/axis_config.hpp"
 #include "core/status.hpp"
-#include "linux/axis_config.hpp"
 
 namespace l6470emu {
 namespace {

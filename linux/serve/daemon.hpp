@@ -7,7 +7,7 @@
 #include <ostream>
 #include <string>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
 
 namespace l6470emu {
 

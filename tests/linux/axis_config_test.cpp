@@ -3,10 +3,10 @@
 // showing the true position next to ABS_POS and changing the load at runtime.
 #include <gtest/gtest.h>
 
+#include "board/axis_config.hpp"
+#include "board/board_config.hpp"
 #include "daisychain/host.hpp"
-#include "linux/axis_config.hpp"
 #include "linux/board.hpp"
-#include "linux/config.hpp"
 #include "linux/log.hpp"
 #include "linux/serve/control.hpp"
 
