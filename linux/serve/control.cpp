@@ -84,7 +84,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  trace stop                          stop recording (every chain, or the --chain one)\n";
 }
 
-int run_control(Board& board, const std::string& command, std::string& out) {
+int run_control(DeviceBoard& board, const std::string& command, std::string& out) {
   std::vector<std::string> all;
   {
     std::istringstream in(command);
