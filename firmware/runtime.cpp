@@ -200,8 +200,11 @@ void FirmwareRuntime::set_now(Tick tick) {
 void FirmwareRuntime::call() { spend(timing_.call_ticks); }
 
 void FirmwareRuntime::spend(Tick ticks) {
+  if (now_ + ticks >= timing_.limit_ticks) {
+    set_now(std::max(now_, timing_.limit_ticks));  // the run ends at the limit itself
+    stop_at_limit();
+  }
   set_now(now_ + ticks);
-  if (now_ >= timing_.limit_ticks) stop_at_limit();
   catch_up();
   if (!polled_.empty()) poll_levels();
   if (any_pending_) deliver();
