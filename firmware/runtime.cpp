@@ -608,6 +608,7 @@ LineSink make_log(const std::string& where) {
     }
   }
   return [out](std::string_view line) {
+    std::fflush(stdout);  // what the program printed before comes first
     std::fprintf(out, "l6470emu: %.*s\n", static_cast<int>(line.size()), line.data());
     std::fflush(out);
   };
