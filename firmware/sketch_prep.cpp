@@ -178,16 +178,13 @@ std::vector<Definition> find_definitions(std::string_view text) {
     const std::string& name = tokens[open - 1].text;
     if (!ident_start(name[0]) || open - 1 == start) continue;  // no return type: a macro call such as ISR(...)
     if (open >= 2 && tokens[open - 2].text == "::") continue;  // A::f: a member defined outside its class
-    std::string proto;
-    for (std::size_t j = start; j <= close_paren; ++j) {
-      const std::string& w = tokens[j].text;
-      if (!proto.empty() && !(w == "(" || w == ")" || w == "," || w == "*" || w == "&" || w == "[" || w == "]") &&
-          !(proto.back() == '(' || proto.back() == '*' || proto.back() == '&' || proto.back() == '['))
-        proto += ' ';
-      else if (!proto.empty() && (w == "*" || w == "&") && proto.back() != ' ' && proto.back() != '(' &&
-               proto.back() != '*' && proto.back() != '&')
-        proto += ' ';
-      proto += w;
+    // The tokens joined, spaced as people write them: "static unsigned long *at(const char *s)".
+    auto glue_before = [](const std::string& w) { return w == "(" || w == ")" || w == "," || w == "[" || w == "]" || w == "::"; };
+    auto glue_after = [](const std::string& w) { return w == "(" || w == "[" || w == "*" || w == "&" || w == "&&" || w == "::"; };
+    std::string proto = tokens[start].text;
+    for (std::size_t j = start + 1; j <= close_paren; ++j) {
+      if (!glue_before(tokens[j].text) && !glue_after(tokens[j - 1].text)) proto += ' ';
+      proto += tokens[j].text;
     }
     found.push_back({proto + ";", tokens[start].offset});
   }
