@@ -35,7 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       FUZZ_CHECK(line != std::string_view::npos, "the text of %s is changed, not split", f.path.c_str());
       const std::size_t resume = rest.find('\n', line + 1);
       FUZZ_CHECK(resume != std::string_view::npos, "a #line without its line");
-      const std::string_view tail = f.text.substr(k);
+      const std::string_view tail = std::string_view(f.text).substr(k);
       FUZZ_CHECK(rest.substr(resume + 1, tail.size()) == tail, "the text of %s after the prototypes differs",
                  f.path.c_str());
       at += resume + 1 + tail.size();
