@@ -18,30 +18,44 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (nul != std::string_view::npos) files.push_back({"more.ino", std::string(all.substr(nul + 1))});
   const std::string out = prepare_sketch(files);
   FUZZ_CHECK(out.rfind("#include <Arduino.h>\n", 0) == 0, "the unit does not begin with Arduino.h");
+  // The prototypes, as the preprocessor finds them in the files joined (its #line lines are
+  // directives, which the tokenizer skips), make the one block it may insert.
+  std::string joined;
+  for (const SketchFile& f : files) joined += "#line 1 \"" + f.path + "\"\n" + f.text + "\n";
+  std::string block;
+  for (const std::string& p : sketch_prototypes(joined)) block += p + "\n";
+  bool inserted = block.empty();  // no prototypes: nothing is inserted anywhere
+  block += "#line ";
   std::size_t at = 0;
   for (const SketchFile& f : files) {
-    // Each file's text is there, in order: the prototypes go between two of its pieces at most.
     const std::string head = "#line 1 \"" + f.path + "\"\n";
     const std::size_t begin = out.find(head, at);
     FUZZ_CHECK(begin != std::string::npos, "no #line for %s", f.path.c_str());
     at = begin + head.size();
     const std::string_view rest(out.data() + at, out.size() - at);
-    const bool whole = rest.substr(0, f.text.size()) == f.text;
-    if (!whole) {
-      // Split once by the prototypes: a prefix of the text, the block, then the rest of the text.
-      std::size_t k = 0;
-      while (k < f.text.size() && k < rest.size() && rest[k] == f.text[k]) ++k;
-      const std::size_t line = rest.find("\n#line ", k);
-      FUZZ_CHECK(line != std::string_view::npos, "the text of %s is changed, not split", f.path.c_str());
-      const std::size_t resume = rest.find('\n', line + 1);
-      FUZZ_CHECK(resume != std::string_view::npos, "a #line without its line");
-      const std::string_view tail = std::string_view(f.text).substr(k);
-      FUZZ_CHECK(rest.substr(resume + 1, tail.size()) == tail, "the text of %s after the prototypes differs",
-                 f.path.c_str());
-      at += resume + 1 + tail.size();
-    } else {
-      at += f.text.size();
+    const std::string_view text(f.text);
+    if (rest.substr(0, text.size()) == text && (inserted || rest.substr(text.size(), block.size()) != block)) {
+      at += text.size();
+      continue;
     }
+    // Split once by the block: a prefix of the text (perhaps followed by a newline of the
+    // block's own), the block and its #line line, then the rest of the text.
+    bool found = false;
+    for (std::size_t pos = rest.find(block); pos != std::string_view::npos && !found; pos = rest.find(block, pos + 1)) {
+      const std::size_t line_end = rest.find('\n', pos + block.size());
+      if (line_end == std::string_view::npos) break;
+      for (const std::size_t split : {pos, pos == 0 ? pos : pos - 1}) {
+        if (split > text.size() || rest.substr(0, split) != text.substr(0, split)) continue;
+        if (split != pos && rest[split] != '\n') continue;
+        const std::string_view tail = text.substr(split);
+        if (rest.substr(line_end + 1, tail.size()) != tail) continue;
+        found = true;
+        at += line_end + 1 + tail.size();
+        break;
+      }
+    }
+    FUZZ_CHECK(found && !inserted, "the text of %s is changed, not split once by the prototypes", f.path.c_str());
+    inserted = true;
   }
   FUZZ_CHECK(out.size() <= 4 * size + 200, "the unit is %zu bytes for %zu bytes of sketch", out.size(), size);
   return 0;
