@@ -28,6 +28,10 @@ using Json = nlohmann::json;
 
 /// Deeper nesting than this is refused (a Chrome trace needs 4 levels; arbitrary "args" a few more).
 constexpr std::size_t kMaxDepth = 512;
+/// The longest stretch without a complete token (a frame's bytes written "D0 D0 ...": 3 MiB).
+constexpr std::size_t kMaxToken = 4 * kMaxTraceFrameBytes;
+/// What is kept of that stretch for the message about a truncated file (its start is all it needs).
+constexpr std::size_t kKeptSince = 256;
 
 /// One annotation event, the fields the spi decoder writes.
 struct JsonEvent {
@@ -38,7 +42,7 @@ struct JsonEvent {
 
 /// The text as the parser reads it, a character at a time from the source's chunks: how far it
 /// has read, the line it is on, and what it read since the handler last heard of a token (for
-/// the message about a truncated file). A stretch of more than kMaxTraceLineBytes without a
+/// the message about a truncated file). A stretch of more than kMaxToken bytes without a
 /// complete token ends the input early (a gigabyte-long string, a file of blanks).
 class CharStream {
  public:
@@ -69,14 +73,14 @@ class CharStream {
     }
     ++offset_;
     last_ = c;
-    if (since_.size() >= kMaxTraceLineBytes) {
+    if (++since_count_ > kMaxToken) {
       too_long_ = true;
       done_ = true;  // the parser sees the end of the input, and the handler says why
       chunk_ = {};
       pos_ = 0;
       return;
     }
-    since_ += c;
+    if (since_.size() < kKeptSince) since_ += c;
   }
 
   /// Characters read.
@@ -87,11 +91,16 @@ class CharStream {
   }
   /// The last character read.
   char last() const { return last_; }
-  /// What was read since the handler's last token (and the character before it).
+  /// The start of what was read since the handler's last token (the character before it
+  /// first), at most kKeptSince characters.
   const std::string& since() const { return since_; }
+  /// Where since() begins (a character offset).
+  std::size_t since_begin() const { return offset_ - since_count_; }
   /// The handler heard of a token: keep only the last character read.
   void token_seen() {
-    if (since_.size() > 1) since_.erase(0, since_.size() - 1);
+    since_.assign(1, last_);
+    since_count_ = offset_ > 0 ? 1 : 0;
+    if (offset_ == 0) since_.clear();
   }
   /// Whether the input was cut because a token grew past kMaxTraceLineBytes.
   bool too_long() const { return too_long_; }
@@ -108,6 +117,7 @@ class CharStream {
   std::size_t last_newline_ = 0;
   char last_ = 0;
   std::string since_;
+  std::size_t since_count_ = 0;  // characters read since the last token (since_ keeps their start)
   bool too_long_ = false;
 };
 
@@ -241,9 +251,8 @@ class EventCollector final : public nlohmann::json_sax<Json> {
     // `position` counts the characters read, the end of the input included.
     error_line_ = stream_.line_of(position == 0 ? 0 : position - 1);
     if (stream_.too_long()) {
-      error_ = "more than " + std::to_string(kMaxTraceLineBytes) +
-               " bytes without a complete JSON token (a frame holds at most " + std::to_string(kMaxTraceFrameBytes) +
-               " bytes: not a sigrok-cli trace, or a damaged one)";
+      error_ = "more than " + std::to_string(kMaxToken) + " bytes without a complete JSON token (a frame holds at most " +
+               std::to_string(kMaxTraceFrameBytes) + " bytes: not a sigrok-cli trace, or a damaged one)";
     } else if (position > stream_.offset()) {
       error_ = truncated_message();
     } else if (ex.id == 406) {  // number overflow
@@ -344,7 +353,7 @@ class EventCollector final : public nlohmann::json_sax<Json> {
                                                                                               : last_value_end_;
     // What was read since the handler's last token (the character before it included).
     const std::string& since = stream_.since();
-    const std::size_t since_begin = offset() - since.size();
+    const std::size_t since_begin = stream_.since_begin();
     std::string_view rest = trim(std::string_view(since).substr(std::min(from > since_begin ? from - since_begin : 0, since.size())));
     std::string expected;
     switch (expect_) {
