@@ -24,6 +24,8 @@ class DiagnosticLog {
   /// and every later one go to stderr.
   void line(std::string_view text);
   bool enabled() const { return fd_ >= 0; }
+  /// Whether lines go to standard error ("stderr", or a file that could not be opened or written).
+  bool to_stderr() const { return fd_ == 2; }
   /// The errno of opening the log file, 0 if it opened (or none was named). When it failed,
   /// one line said so on stderr at construction (once per file and process) and lines go to
   /// stderr instead: a host program is never stopped by its log.
