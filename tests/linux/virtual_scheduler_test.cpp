@@ -348,6 +348,20 @@ TEST(VirtualScheduler, ManyThreadsSleepingInALoopSeeTheSameTimesEveryRun) {
   }
 }
 
+TEST(VirtualScheduler, MoreEdgesThanOneDecisionTakesBeforeADeadlineAreWorkedThroughNotLeftHanging) {
+  // An edge at every tick that wakes nobody (a line nobody waits on toggling): one decision stops
+  // after 10^5 of them, and the waiter takes the decision up again until its deadline comes.
+  FakeBoard board;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.next_edge = [&board] { return board.now.load() + 1; };
+  VirtualScheduler s(std::move(h), 0, 1);
+  VirtualScheduler::Wait w;
+  w.deadline = 250'000;
+  w.watches_board = true;
+  EXPECT_EQ(s.wait(w), End::timed_out);
+  EXPECT_EQ(board.now.load(), 250'000u);
+}
+
 /// A pipe whose read end the waiters of the deadlock tests poll: writing to it ends their waits.
 struct WakePipe {
   int fd[2] = {-1, -1};
