@@ -208,9 +208,13 @@ void VirtualHostTime::end_deadlocked(const std::string& report) {
     }
   }
   // Nothing recorded is lost: traces are finished (a gzip trace gets its end), the program's
-  // C stdio buffers written.
+  // standard output and error buffers written.
   for (std::size_t c = 0; c < board_.chain_count(); ++c) board_.stop_recording(c);
-  std::fflush(nullptr);
+  for (FILE* f : {stdout, stderr})  // (a stream another thread holds locked is left as it is)
+    if (ftrylockfile(f) == 0) {
+      fflush_unlocked(f);
+      funlockfile(f);
+    }
   _exit(kDeadlockExitStatus);
 }
 
