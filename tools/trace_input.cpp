@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <map>
 #include <sstream>
+#include <new>
 #include <stdexcept>
 
 #include "daisychain/chain_spec.hpp"
@@ -221,6 +222,19 @@ std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOpti
 
 TraceFile::TraceFile(std::string path, const TraceInputOptions& options)
     : path_(std::move(path)), format_(format_of(path_, options)), max_frames_(options.import.max_frames) {
+  try {
+    open(options);
+  } catch (const std::bad_alloc&) {
+    throw TraceError(path_, 0, out_of_memory());
+  }
+}
+
+std::string TraceFile::out_of_memory() const {
+  return "out of memory while reading it (an imported trace takes about 70 bytes a frame plus 3 a byte: a lower "
+         "--max-frames than " + std::to_string(max_frames_) + " refuses it sooner)";
+}
+
+void TraceFile::open(const TraceInputOptions& options) {
   if (format_ == TraceFormat::native) {
     header_ = NativeTraceReader(path_, max_frames_).header();
     return;
@@ -257,13 +271,17 @@ std::unique_ptr<TraceReader> TraceFile::read() const {
 }
 
 Trace TraceFile::load() const {
-  if (format_ != TraceFormat::native) return trace_;
-  Trace t;
-  NativeTraceReader r(path_, max_frames_);
-  t.header = r.header();
-  TraceEvent e;
-  while (r.next(e)) t.write(e);
-  return t;
+  try {
+    if (format_ != TraceFormat::native) return trace_;
+    Trace t;
+    NativeTraceReader r(path_, max_frames_);
+    t.header = r.header();
+    TraceEvent e;
+    while (r.next(e)) t.write(e);
+    return t;
+  } catch (const std::bad_alloc&) {
+    throw TraceError(path_, 0, out_of_memory());
+  }
 }
 
 std::vector<const Variant*> chain_for_trace(const std::string& spec, const TraceFile& file, std::string& how) {

@@ -45,6 +45,9 @@ class TraceFile {
   Trace load() const;
 
  private:
+  void open(const TraceInputOptions& options);
+  std::string out_of_memory() const;
+
   std::string path_;
   TraceFormat format_;
   std::uint64_t max_frames_;

@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -30,7 +31,7 @@ struct Measured {
   long max_rss_kb = 0;   ///< ru_maxrss of the process
 };
 
-Measured run_measured(const std::vector<std::string>& args) {
+Measured run_measured(const std::vector<std::string>& args, rlim_t address_space = RLIM_INFINITY) {
   TempDir dir;
   const std::string out_path = dir.file("out.txt");
   std::vector<std::string> argv = {L6470EMU_BINARY};
@@ -40,6 +41,10 @@ Measured run_measured(const std::vector<std::string>& args) {
   cargv.push_back(nullptr);
   const pid_t pid = fork();
   if (pid == 0) {
+    if (address_space != RLIM_INFINITY) {
+      const rlimit limit{address_space, address_space};
+      setrlimit(RLIMIT_AS, &limit);
+    }
     const int fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1);
     dup2(fd, 2);
@@ -182,6 +187,33 @@ TEST(TraceBombs, ASaleaeCaptureWithMoreFramesThanAllowedIsRefusedAtTheRowThatPas
   EXPECT_EQ(m.status, 2) << m.out;
   EXPECT_NE(m.out.find(path + ":32: the trace holds more than 10 frames, the limit"), std::string::npos) << m.out;
   EXPECT_EQ(run_measured({"decode", "--max-frames", "20", path}).status, 0);
+}
+
+TEST(TraceBombs, AnImportThatRunsOutOfMemoryIsOneLineNamingTheFileNotStdBadAlloc) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "a sanitizer build's program cannot run under an address-space limit";
+#endif
+  // A Saleae export without Enable rows, one frame per byte: 3 million frames in memory take
+  // ~200 MB, more than the 160 MB of address space the program is given here.
+  TempDir dir;
+  std::string csv = "name,type,start_time,duration,\"mosi\",\"miso\"\n";
+  csv.reserve(3'000'000 * 40);
+  char row[96];
+  for (int i = 0; i < 3'000'000; ++i) {
+    std::snprintf(row, sizeof row, "\"SPI\",\"result\",%d.%06d,1e-07,0xD0,0x00\n", i / 1'000'000, i % 1'000'000);
+    csv += row;
+  }
+  const std::string gz = dir.file("many.csv.gz");
+  write_gz(gz, csv);
+  csv.clear();
+  csv.shrink_to_fit();
+  const Measured m = run_measured({"replay", gz}, 160u << 20);
+  EXPECT_EQ(m.status, 2) << m.out;
+  EXPECT_NE(m.out.find("l6470emu replay: " + gz + ": out of memory while reading it (an imported trace takes about 70 "
+                       "bytes a frame plus 3 a byte: a lower --max-frames than 10000000 refuses it sooner)\n"),
+            std::string::npos)
+      << m.out;
+  EXPECT_EQ(m.out.find("bad_alloc"), std::string::npos) << m.out;
 }
 
 TEST(TraceBombs, AnUmockdevRecordingWithAHugeFrameOrAnEndlessLineIsRefusedWithinBoundedMemory) {
