@@ -120,7 +120,7 @@ std::int64_t saturated_ns(const timespec& ts) {
 
 std::int64_t add_saturated(std::int64_t a, std::int64_t b) { return a > kKtimeMax - b ? kKtimeMax : a + b; }
 
-VirtualHostTime::VirtualHostTime(Board& board, const TimeConfig& config)
+VirtualHostTime::VirtualHostTime(DeviceBoard& board, const TimeConfig& config)
     : board_(board),
       time_(board.time()),
       boottime_offset_ns_(real_clock_ns(CLOCK_BOOTTIME) - real_clock_ns(CLOCK_MONOTONIC)),
@@ -137,7 +137,7 @@ VirtualHostTime::VirtualHostTime(Board& board, const TimeConfig& config)
 
 VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   VirtualScheduler::Hooks h;
-  Board& board = board_;
+  DeviceBoard& board = board_;
   h.now = [&board] { return board.time().now(); };
   h.advance_to = [&board](Tick t) { board.advance_to(t); };
   h.next_edge = [&board] { return board.next_edge_tick(); };

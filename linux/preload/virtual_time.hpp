@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <string>
 
-#include "linux/board.hpp"
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
+#include "linux/device_board.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/virtual_scheduler.hpp"
 
@@ -39,7 +39,7 @@ class VirtualHostTime {
  public:
   /// Makes `board`'s time the program's; `config` gives the idle grace. Counts the threads that
   /// exist already (/proc/self/task) as running.
-  VirtualHostTime(Board& board, const TimeConfig& config);
+  VirtualHostTime(DeviceBoard& board, const TimeConfig& config);
   ~VirtualHostTime();
   VirtualHostTime(const VirtualHostTime&) = delete;
   VirtualHostTime& operator=(const VirtualHostTime&) = delete;
@@ -106,7 +106,7 @@ class VirtualHostTime {
   std::string describe_board();
   [[noreturn]] void end_deadlocked(const std::string& report);
 
-  Board& board_;
+  DeviceBoard& board_;
   BoardTime& time_;
   std::int64_t boottime_offset_ns_;  // real BOOTTIME - MONOTONIC at the start
   std::int64_t tai_offset_ns_;       // real TAI - REALTIME at the start
