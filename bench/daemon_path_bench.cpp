@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/shm_channel.hpp"
 
@@ -24,7 +24,7 @@ struct VirtualBoard {
                    file(board.open(0, true)) {}
   ~VirtualBoard() { close(file.fd); }
   DiagnosticLog log{"off"};
-  Board board;
+  DeviceBoard board;
   NewFile file;
 };
 

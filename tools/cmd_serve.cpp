@@ -5,7 +5,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "linux/config.hpp"
+#include "linux/board_config_file.hpp"
+#include "linux/device_paths.hpp"
 #include "linux/serve/control.hpp"
 #include "linux/serve/daemon.hpp"
 #include "tools/kernel_nodes.hpp"
@@ -64,7 +65,9 @@ std::optional<int> ServeCommands::run() {
       parsed = load_board_config_file(config_file_);
     else
       parsed = parse_board_config(chain_.empty() ? "bus=0 cs=0 chips=L6470" : chain_, "--chain");
-    if (!parsed.config) {
+    if (parsed.config)  // a node path this machine already uses for something else is refused too
+      parsed.error.message = check_device_paths(*parsed.config, config_file_.empty() ? "--chain" : config_file_);
+    if (!parsed.config || !parsed.error.message.empty()) {
       std::cerr << parsed.error.message << "\n";
       return 2;
     }

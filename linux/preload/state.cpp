@@ -11,7 +11,8 @@
 #include <string>
 #include <unordered_map>
 
-#include "linux/config.hpp"
+#include "linux/board_config_file.hpp"
+#include "linux/device_paths.hpp"
 #include "linux/log.hpp"
 #include "linux/preload/real.hpp"
 
@@ -57,16 +58,21 @@ __attribute__((constructor)) void load_config() {
   const char* chain = std::getenv("L6470EMU_CHAIN");
   const char* file = std::getenv("L6470EMU_CONFIG");
   ParseResult parsed;
+  std::string origin;
   if (chain && *chain) {
-    parsed = parse_board_config(chain, "L6470EMU_CHAIN");
+    origin = "L6470EMU_CHAIN";
+    parsed = parse_board_config(chain, origin);
   } else if (file && *file) {
+    origin = file;
     parsed = load_board_config_file(file);
   } else if (socket && *socket) {
     parsed.config = BoardConfig{};
   } else {
     return;  // nothing configured: the library stays out of the way
   }
-  if (!parsed.config) {
+  // A node path this machine already uses for something else would be taken over: refused too.
+  if (parsed.config) parsed.error.message = check_device_paths(*parsed.config, origin);
+  if (!parsed.config || !parsed.error.message.empty()) {
     std::string line = parsed.error.message + "\n";
     raw_write_all(2, line.data(), line.size());
     _exit(2);
@@ -190,5 +196,7 @@ void real_close_protected(int fd) {
 void log_line(std::string_view text) {
   if (g_log) g_log->line(text);
 }
+
+bool log_is_stderr() { return g_log && g_log->to_stderr(); }
 
 }  // namespace l6470emu::preload

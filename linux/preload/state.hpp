@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/preload/backend.hpp"
 
 namespace l6470emu::preload {
@@ -62,5 +62,7 @@ void real_close_protected(int fd);
 
 /// Reports a line on the diagnostic log of this process (stderr unless log= says otherwise).
 void log_line(std::string_view text);
+/// Whether log_line() writes to standard error (also when the log is off: false).
+bool log_is_stderr();
 
 }  // namespace l6470emu::preload

@@ -7,8 +7,8 @@
 #include <sstream>
 #include <vector>
 
+#include "board/axis_config.hpp"
 #include "core/status.hpp"
-#include "linux/axis_config.hpp"
 #include "linux/terminal_text.hpp"
 
 namespace l6470emu {
@@ -133,7 +133,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  trace stop                          stop recording (every chain, or the --chain one)\n";
 }
 
-int run_control(Board& board, const std::string& command, std::string& out) {
+int run_control(DeviceBoard& board, const std::string& command, std::string& out) {
   std::vector<std::string> all;
   {
     std::istringstream in(command);

@@ -1,12 +1,12 @@
 // The daemon's control interface (`l6470emu ctl ...`): the physical world and inspection
-// without side effects, as text commands. Parsing and formatting only; the Board does the work.
+// without side effects, as text commands. Parsing and formatting only; the DeviceBoard does the work.
 #pragma once
 
 #include <cstdint>
 #include <optional>
 #include <string>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 
 namespace l6470emu {
 
@@ -14,7 +14,7 @@ namespace l6470emu {
 /// Returns the exit status for `ctl` (0 ok, 1 failed, 2 usage) and the text to print.
 /// Chip numbers, in --chip K and in the output, count as the board's numbering() says, or as
 /// `--number-from miso|mosi` in the command says; status, dump and chains say which, once.
-int run_control(Board& board, const std::string& command, std::string& output);
+int run_control(DeviceBoard& board, const std::string& command, std::string& output);
 
 /// Longest `ctl advance MS`, in ms: 10^10 ms, about 115 days (4·10^13 ticks, far from the tick's range).
 inline constexpr std::uint64_t kMaxAdvanceMs = 10'000'000'000;

@@ -1,13 +1,15 @@
-// libFuzzer harness of the board description parser (linux/config.hpp parse_board_config):
+// libFuzzer harness of the board description parser (board/board_config.hpp parse_board_config):
 // any text gives a config or one error line, never a crash; an accepted config's own
-// description (describe_board_config, what `serve` prints) reads back to the same chains; an
-// accepted path= names a /dev node directly, and nothing but a character device exists there.
+// description (describe_board_config, what `serve` prints) reads back to the same chains,
+// their microcontroller pins and a firmware run's timing; an accepted path= names a /dev node
+// directly, and what linux/device_paths.hpp lets pass is nothing or a character device.
 #include <sys/stat.h>
 
 #include <string_view>
 
+#include "board/board_config.hpp"
 #include "fuzz_support.hpp"
-#include "linux/config.hpp"
+#include "linux/device_paths.hpp"
 
 using namespace l6470emu;
 
@@ -28,9 +30,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(p.rfind("/dev/", 0) == 0 && p.size() > 6 && p.find("//") == std::string::npos &&
                    p.find("/./") == std::string::npos && p.find("/../") == std::string::npos,
                "path %.300s accepted", c.path.c_str());
-    struct stat st{};
-    if (::stat(c.path.c_str(), &st) == 0)
-      FUZZ_CHECK(S_ISCHR(st.st_mode), "path %.300s accepted: it exists and is not a character device", c.path.c_str());
+  }
+  if (const std::string e = check_device_paths(a, "fuzz.conf"); e.empty()) {
+    for (const ChainConfig& c : a.chains) {
+      struct stat st{};
+      if (::stat(c.path.c_str(), &st) == 0)
+        FUZZ_CHECK(S_ISCHR(st.st_mode), "path %.300s let pass: it exists and is not a character device", c.path.c_str());
+    }
+  } else {
+    FUZZ_CHECK(e.find('\n') == std::string::npos, "device path error is not one line: %.300s", e.c_str());
   }
   if (a.chains.empty()) return 0;  // socket= only: nothing to describe
   const std::string description = describe_board_config(a);
@@ -44,10 +52,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const ChainConfig &x = a.chains[i], &y = b.chains[i];
     FUZZ_CHECK(x.bus == y.bus && x.cs == y.cs && x.path == y.path && x.chips == y.chips && x.gpiochip == y.gpiochip &&
                    x.max_speed_hz == y.max_speed_hz && x.mode == y.mode && x.bufsiz == y.bufsiz &&
-                   x.axes == y.axes,
+                   x.axes == y.axes && x.pins == y.pins,
                "chain %zu reads back differently from its description:\n%.300s", i, description.c_str());
   }
-  FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace,
+  FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace && a.firmware == b.firmware,
              "time or trace reads back differently from the description:\n%.300s", description.c_str());
   return 0;
 }

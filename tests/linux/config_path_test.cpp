@@ -1,6 +1,7 @@
 // path= takes a node over in host programs, so it may name only what does not exist yet or a
 // spidev node: another driver's node (/dev/kvm, /dev/loop0, /dev/hwrng, ...), a file or a
-// directory there is refused with one line, by the parser and by serve and the preload using it.
+// directory there is refused with one line, by the Linux front's check (linux/device_paths.hpp)
+// and so by serve and the preload.
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
@@ -12,7 +13,8 @@
 
 #include <gtest/gtest.h>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
+#include "linux/device_paths.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu {
@@ -20,7 +22,9 @@ namespace {
 
 std::string error_for_path(const std::string& path) {
   const ParseResult r = parse_board_config("chips=L6470 path=" + path, "T");
-  return r.config ? "(accepted)" : r.error.message;
+  if (!r.config) return r.error.message;
+  const std::string e = check_device_paths(*r.config, "T");
+  return e.empty() ? "(accepted)" : e;
 }
 
 bool exists(const std::string& path) {
@@ -34,8 +38,8 @@ TEST(ConfigPath, ExistingNodesOfOtherDriversAreRefused) {
     if (!exists(node)) continue;
     ++tried;
     const std::string e = error_for_path(node);
-    EXPECT_EQ(e.rfind(std::string("l6470emu: config T, clause 1: path '") + node + "' is an existing ", 0), 0u) << e;
-    EXPECT_NE(e.find("not a spidev node: the emulator would take it over in the host program"), std::string::npos) << e;
+    EXPECT_EQ(e.rfind(std::string("l6470emu: config T: chain 1 (bus=0 cs=0): path '") + node + "' is an existing ", 0), 0u) << e;
+    EXPECT_NE(e.find("not a spidev node: the emulator would take it over in host programs"), std::string::npos) << e;
     EXPECT_EQ(e.find('\n'), std::string::npos) << e;
   }
   if (tried == 0) GTEST_SKIP() << "none of /dev/kvm, /dev/loop0, /dev/hwrng, /dev/loop-control, /dev/autofs here";
@@ -66,19 +70,19 @@ class DevScratch : public ::testing::Test {
 };
 
 TEST_F(DevScratch, OnlyASpidevNodeOrNothingIsAcceptedAtPath) {
-  const std::string tail = ", not a spidev node: the emulator would take it over in the host program (write a path "
+  const std::string tail = ", not a spidev node: the emulator would take it over in host programs (write a path "
                            "that does not exist, e.g. path=/dev/spidev9.0, or leave path= out)";
   // The kernel's name of the device ('null') comes from /sys/dev/char, when /sys is there.
   const std::string other = error_for_path(dir_ + "/other");
-  EXPECT_EQ(other.rfind("l6470emu: config T, clause 1: path '" + dir_ + "/other' is an existing character device (1:3", 0),
+  EXPECT_EQ(other.rfind("l6470emu: config T: chain 1 (bus=0 cs=0): path '" + dir_ + "/other' is an existing character device (1:3", 0),
             0u) << other;
   EXPECT_NE(other.find(") of another driver" + tail), std::string::npos) << other;
   EXPECT_EQ(error_for_path(dir_ + "/block"),
-            "l6470emu: config T, clause 1: path '" + dir_ + "/block' is an existing block device (7:200)" + tail);
+            "l6470emu: config T: chain 1 (bus=0 cs=0): path '" + dir_ + "/block' is an existing block device (7:200)" + tail);
   EXPECT_EQ(error_for_path(dir_ + "/file"),
-            "l6470emu: config T, clause 1: path '" + dir_ + "/file' is an existing regular file" + tail);
+            "l6470emu: config T: chain 1 (bus=0 cs=0): path '" + dir_ + "/file' is an existing regular file" + tail);
   EXPECT_EQ(error_for_path(dir_ + "/sub"),
-            "l6470emu: config T, clause 1: path '" + dir_ + "/sub' is an existing directory" + tail);
+            "l6470emu: config T: chain 1 (bus=0 cs=0): path '" + dir_ + "/sub' is an existing directory" + tail);
   EXPECT_NE(error_for_path(dir_ + "/file/x").find("is a path that cannot be looked at (Not a directory)"),
             std::string::npos);
   EXPECT_EQ(error_for_path(dir_ + "/spidev9.7"), "(accepted)");    // the kernel's spidev: the emulator stands in

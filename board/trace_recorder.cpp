@@ -1,0 +1,106 @@
+// ChainTraceRecorder: a RecordingChain writing to a native trace file, with write errors caught.
+#include "board/trace_recorder.hpp"
+
+#include <exception>
+
+#include "spi/trace_file.hpp"
+#include "spi/trace_native.hpp"
+
+namespace l6470emu {
+
+/// The file, behind a sink that turns write errors into a stopped recording (no exception
+/// may reach a host program's C call through the preload library).
+class ChainTraceRecorder::Sink final : public TraceSink {
+ public:
+  explicit Sink(const std::string& path) : writer_(path) {}
+  void write_header(const TraceHeader& h) override {
+    guard([&] { writer_.write_header(h); });
+  }
+  void write(const TraceEvent& e) override {
+    guard([&] { writer_.write(e); });
+  }
+  std::string error;
+
+ private:
+  template <class F>
+  void guard(F&& f) {
+    if (!error.empty()) return;
+    try {
+      f();
+    } catch (const std::exception& x) {
+      error = x.what();
+    } catch (...) {
+      error = "trace write failed";
+    }
+  }
+  NativeTraceWriter writer_;
+};
+
+std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(Chain& chain, const std::string& path,
+                                                             std::string& error) noexcept {
+  try {
+    auto sink = std::make_unique<Sink>(path);
+    std::unique_ptr<ChainTraceRecorder> r(new ChainTraceRecorder(chain, std::move(sink), path));
+    if (!r->error().empty()) {
+      error = r->error();
+      return nullptr;
+    }
+    return r;
+  } catch (const std::exception& x) {
+    error = x.what();
+  } catch (...) {
+    error = path + ": cannot record";
+  }
+  return nullptr;
+}
+
+ChainTraceRecorder::ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path)
+    : sink_(std::move(sink)), recording_(chain, *sink_), path_(std::move(path)) {}
+
+ChainTraceRecorder::~ChainTraceRecorder() = default;
+
+const std::string& ChainTraceRecorder::error() const { return sink_->error; }
+
+void ChainTraceRecorder::set_input(std::size_t chip, Pin pin, bool level) {
+  if (pin == Pin::SW) recording_.set_sw_pin(chip, level);
+  if (pin == Pin::STCK) recording_.set_stck_pin(chip, level);
+  if (pin == Pin::STBY_RST) recording_.set_stby_rst_pin(chip, level);
+}
+
+void ChainTraceRecorder::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
+  switch (fault) {
+    case TraceFault::UVLO: recording_.set_undervoltage(chip, value != 0); break;
+    case TraceFault::UVLO_ADC: recording_.set_adc_undervoltage(chip, value != 0); break;
+    case TraceFault::OCD: recording_.set_overcurrent(chip, value != 0); break;
+    case TraceFault::STALL_A: recording_.set_stall(chip, Bridge::A, value != 0); break;
+    case TraceFault::STALL_B: recording_.set_stall(chip, Bridge::B, value != 0); break;
+    case TraceFault::THERMAL: recording_.set_thermal(chip, static_cast<Thermal>(value & 3)); break;
+    case TraceFault::ADCIN: recording_.set_adc_input(chip, value); break;
+  }
+}
+
+void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value) {
+  switch (fault) {
+    case TraceFault::UVLO: chip.set_undervoltage(value != 0); break;
+    case TraceFault::UVLO_ADC: chip.set_adc_undervoltage(value != 0); break;
+    case TraceFault::OCD: chip.set_overcurrent(value != 0); break;
+    case TraceFault::STALL_A: chip.set_stall(Bridge::A, value != 0); break;
+    case TraceFault::STALL_B: chip.set_stall(Bridge::B, value != 0); break;
+    case TraceFault::THERMAL: chip.set_thermal(static_cast<Thermal>(value & 3)); break;
+    case TraceFault::ADCIN: chip.set_adc_input(value); break;
+  }
+}
+
+std::string trace_path_for_chain(const std::string& path, const std::string& name, std::size_t chains) {
+  if (chains <= 1) return path;
+  // A ".gz" stays last: "run.trace.gz" -> "run.spidev0.1.trace.gz".
+  const std::string gz = gzip_file_name(path) ? ".gz" : "";
+  const std::string base = path.substr(0, path.size() - gz.size());
+  const std::size_t slash = base.rfind('/');
+  const std::size_t dot = base.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash) || dot == (slash == std::string::npos ? 0 : slash + 1))
+    return base + "." + name + gz;
+  return base.substr(0, dot) + "." + name + base.substr(dot) + gz;
+}
+
+}  // namespace l6470emu

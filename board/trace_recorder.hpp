@@ -1,0 +1,59 @@
+// Recording one chain of the board into a native trace file (docs/trace-format.md): a
+// RecordingChain over the chain and a NativeTraceWriter flushed event by event, so a killed
+// process leaves a complete file. Never throws after it is open: a write error stops the
+// recording and is reported once. Knows nothing of spidev or gpio; the Board drives it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "board/pins.hpp"
+#include "daisychain/recording_chain.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// A native trace being recorded from one chain. Single-threaded: its owner (the Board) serialises every call.
+class ChainTraceRecorder {
+ public:
+  /// Creates or truncates `path` and writes the header (the chain and its BUSY/FLAG levels).
+  /// Returns nullptr and sets `error` (one line) when the file cannot be created.
+  static std::unique_ptr<ChainTraceRecorder> open(Chain& chain, const std::string& path, std::string& error) noexcept;
+  ~ChainTraceRecorder();
+  ChainTraceRecorder(const ChainTraceRecorder&) = delete;
+  ChainTraceRecorder& operator=(const ChainTraceRecorder&) = delete;
+
+  /// What SPI goes through: the chain, recording every CS frame at its CS rising edge.
+  SpiDevice& device() { return recording_; }
+  /// An input pin (SW, STCK, STBY_RST) of chip `chip` changes: applied to the chip and recorded.
+  void set_input(std::size_t chip, Pin pin, bool level);
+  /// A backdoor event (fault on/off, thermal class, ADCIN code): applied to the chip and recorded.
+  void fault(std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// Records BUSY/FLAG levels that changed since they were last seen.
+  void observe_outputs() { recording_.observe_outputs(); }
+
+  const std::string& path() const { return path_; }
+  std::uint64_t frames() const { return recording_.frames_recorded(); }
+  /// The first write error ("" while all is well); events after it are dropped.
+  const std::string& error() const;
+
+ private:
+  class Sink;
+  ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path);
+
+  std::unique_ptr<Sink> sink_;
+  RecordingChain recording_;
+  std::string path_;
+};
+
+/// Applies a backdoor event to `chip` without recording it (what ChainTraceRecorder::fault
+/// does when nothing records).
+void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value);
+
+/// The trace file of chain `name` when a board with `chains` chains records to `path`: `path`
+/// itself for one chain, else the chain's name inserted before the extension
+/// ("run.trace" -> "run.spidev0.1.trace").
+std::string trace_path_for_chain(const std::string& path, const std::string& name, std::size_t chains);
+
+}  // namespace l6470emu

@@ -1,0 +1,23 @@
+// Variant names as the config and the ctl interface spell them: core's table, plus aliases.
+#include <string>
+
+#include "board/board_config.hpp"
+
+namespace l6470emu {
+
+const Variant* lookup_variant(std::string_view name) {
+  // Aliases users write for the same part; extend here when a new spelling shows up.
+  if (name == "powerstep" || name == "powerSTEP") name = "powerSTEP01";
+  return find_variant(name);
+}
+
+std::string known_variant_names() {
+  std::string out;
+  for (const Variant* v : all_variants()) {
+    if (!out.empty()) out += ", ";
+    out += v->name;
+  }
+  return out;
+}
+
+}  // namespace l6470emu

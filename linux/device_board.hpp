@@ -1,0 +1,230 @@
+// The emulated board's device nodes, as a transport serves them: a spidev node per chain and a
+// gpiochip per chain carrying its chips' pins, in front of the OS-free Board (board/board.hpp),
+// and the open files / line requests of the host programs, with the kernel's semantics
+// (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
+// Every open file or line request is a handle backed by a SOCK_SEQPACKET socketpair: the
+// host program gets one end as its file descriptor (poll/read see edge events natively),
+// the board keeps the other, and a handle lives until every copy of the host's end is closed.
+// Used in process by the preload library and, behind a Unix socket, by `l6470emu serve`.
+#pragma once
+
+#include <linux/spi/spidev.h>
+
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <span>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "board/board.hpp"
+#include "board/board_config.hpp"
+#include "daisychain/chain.hpp"
+#include "linux/clock.hpp"
+#include "linux/gpio_lines.hpp"
+#include "linux/log.hpp"
+#include "linux/spidev_rules.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// What kind of open file a handle is.
+enum class HandleKind : std::uint8_t {
+  spidev = 1,           ///< an open /dev/spidevB.C
+  gpiochip = 2,         ///< an open /dev/gpiochipN
+  line_handle_v1 = 3,   ///< GPIO_GET_LINEHANDLE_IOCTL result
+  line_event_v1 = 4,    ///< GPIO_GET_LINEEVENT_IOCTL result (reads struct gpioevent_data)
+  line_request_v2 = 5,  ///< GPIO_V2_GET_LINE_IOCTL result (reads struct gpio_v2_line_event)
+};
+
+/// A device node the board provides.
+struct DeviceNode {
+  enum class Type : std::uint8_t { spidev, gpiochip } type;
+  std::string path;      ///< "/dev/spidev0.0", "/dev/gpiochip0"
+  std::string name;      ///< "spidev0.0", "gpiochip0" (sysfs name)
+  unsigned major = 0;
+  unsigned minor = 0;
+  std::uint32_t bufsiz = 0;  ///< spidev: the bufsiz module parameter (EMSGSIZE limit)
+};
+
+/// A file the board created for a host program: result < 0 is -errno.
+struct NewFile {
+  long result = 0;
+  std::uint64_t handle = 0;
+  int fd = -1;  ///< the host's end; the caller owns it
+  HandleKind kind = HandleKind::spidev;
+};
+
+/// Called after every SPI message with the chain index, the message and the bytes (for
+/// observers of the traffic; native traces are recorded by start_recording instead).
+using MessageObserver = std::function<void(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
+                                           std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx,
+                                           Tick end_tick)>;
+
+/// The emulated hardware (a Board) and the kernel-side state of its device nodes. Thread-safe:
+/// one lock covers the board and the nodes.
+class DeviceBoard {
+ public:
+  /// Builds the chains and gpiochips of `config`; diagnostics go to `log`. The board's time is
+  /// read from `host` (the kernel's clocks unless a test injects its own).
+  DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostClock& host = real_host_clock());
+  ~DeviceBoard();
+  DeviceBoard(const DeviceBoard&) = delete;
+  DeviceBoard& operator=(const DeviceBoard&) = delete;
+
+  /// The device nodes, in a fixed order (index = device index for open()).
+  const std::vector<DeviceNode>& nodes() const { return nodes_; }
+
+  // ---- the host programs' side: what the kernel would do ---------------------
+
+  /// open() of node `device`; `cloexec` makes the host's end close-on-exec.
+  NewFile open(std::size_t device, bool cloexec);
+  /// A host program closed a descriptor of `handle`: if no copy of it is left anywhere,
+  /// the handle is released now (spidev's last-close reset, gpio lines freed).
+  void closed(std::uint64_t handle);
+  /// ioctl other than SPI_IOC_MESSAGE on `handle`. `arg` holds the _IOC_SIZE(cmd) argument bytes
+  /// (copied in for _IOC_WRITE, copied out for _IOC_READ by the caller). A line request fills
+  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno.
+  long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
+  /// SPI_IOC_MESSAGE(n): `tx` holds the tx data of the transfers with a tx_buf, concatenated;
+  /// `rx` (spidev_rx_bytes long) receives the rx data. Returns the total length or -errno.
+  /// Like a kernel transfer, the call takes the message's bus time: the message starts when
+  /// the bus is free (now, or when the message before it on the same bus ends) and the call
+  /// returns when the board's time reaches its end (a sleep in wall mode, a wait in virtual mode).
+  long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                   std::span<std::uint8_t> rx);
+  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx);
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx);
+
+  // ---- the physical world (ctl, tests) ----------------------------------------
+
+  std::size_t chain_count() const { return board_.chain_count(); }
+  /// Index in nodes() of chain `chain`'s spidev node.
+  std::size_t spidev_node(std::size_t chain) const;
+  /// Number of chips of chain `chain`.
+  std::size_t chip_count(std::size_t chain) const;
+  /// How diagnostics and `ctl` number the chips (the config's numbering=). Chip arguments of
+  /// DeviceBoard's own functions are always chain indices (0 drives MISO).
+  NumberFrom numbering() const { return board_.numbering(); }
+  /// The numbering of chain `chain`: its chain indices as users see them.
+  ChipNumbering chip_numbering(std::size_t chain) const { return board_.chip_numbering(chain); }
+  /// "spidev0.0 (3 x L6470, gpiochip0)".
+  std::string chain_summary(std::size_t chain) const;
+  /// Index of the chain on node path or name ("spidev0.0", "/dev/spidev0.0", "0.0"), or -1.
+  int find_chain(const std::string& name) const;
+  /// Runs `f` on chain `chain` brought up to the clock, then reports the pin edges it caused.
+  void with_chain(std::size_t chain, const std::function<void(Chain&)>& f);
+  /// Drives an input pin of chip `chip` (SW, STCK, STBY_RST) as the physical world would.
+  /// Returns false for an output pin or a bad index.
+  bool drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level);
+  /// Level of a pin of a chip (what a host reading the line would see before active-low).
+  bool pin_level(std::size_t chain, std::size_t chip, Pin pin);
+  /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
+  bool advance(Tick ticks);
+  /// Virtual time: moves the board's time to `tick` if it is later and brings every chain
+  /// there, delivering the BUSY/FLAG edges of watched lines at their own ticks. Wall time: false.
+  bool advance_to(Tick tick);
+  /// The earliest tick at which a watched BUSY/FLAG line will change by itself (kNever: none).
+  /// A host thread waiting on line events wakes then.
+  Tick next_edge_tick();
+  /// Current tick of chain `chain`.
+  Tick now(std::size_t chain);
+  /// The board's time (the one owner of the clock: spidev, gpio events, ctl, traces).
+  BoardTime& time() { return board_.time(); }
+  const BoardTime& time() const { return board_.time(); }
+  /// Attaches (or with an empty function detaches) the SPI message observer.
+  void set_message_observer(MessageObserver observer);
+  /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain `chain`,
+  /// recorded when the chain is being recorded. Returns false for a bad index.
+  bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+
+  // ---- trace recording (the Board's, under the lock) ---------------------------------
+
+  /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
+  /// progress on the chain is stopped first): every CS frame, every input pin change (host gpio
+  /// or ctl), every backdoor event and the BUSY/FLAG changes, each line flushed as it is written.
+  /// Returns "" or one line saying why not.
+  std::string start_recording(std::size_t chain, const std::string& path);
+  /// Starts recording every chain: into `path` for one chain, else trace_path_for_chain files.
+  std::string start_recording_all(const std::string& path);
+  /// Stops recording chain `chain` (a frame still open, CS held low, is not written).
+  /// Returns false when it was not recording; `summary` gets "N frames to PATH".
+  bool stop_recording(std::size_t chain, std::string* summary = nullptr);
+  /// Where chain `chain` is being recorded ("" = not recording).
+  std::string recording_path(std::size_t chain);
+  /// After fork() in the child: drops the parent's recordings without writing to them.
+  void forget_recordings_after_fork();
+
+  /// Open handles, by kind, as text (for `ctl dump`).
+  std::string describe_handles();
+
+  /// Starts the thread that delivers BUSY/FLAG edges on time in wall mode and notices host
+  /// ends closed in other processes. Started on demand; the daemon starts it at once.
+  void start_pump();
+  /// Stops it (also done by the destructor).
+  void stop_pump();
+  /// After fork() in the child: the pump thread did not survive; forget it (restarted on demand).
+  void forget_pump_after_fork();
+  /// The lock of the whole board (for fork handlers).
+  std::mutex& mutex() { return m_; }
+
+ private:
+  struct ChainDev;
+  struct LineDev;
+  struct GpioDev;
+  struct Handle;
+
+  Handle* find(std::uint64_t id, HandleKind kind);
+  Handle* find_any(std::uint64_t id);
+  NewFile make_handle(HandleKind kind, std::size_t dev, bool cloexec, std::unique_ptr<Handle>& out);
+  void release(Handle& h);
+  void release_if_closed(std::uint64_t id);
+
+  // time and edges
+  long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                       std::span<std::uint8_t> rx, Tick& end);
+  void wait_for(Tick tick);
+  void report_edge(const PinEdge& edge);
+  void watch_line(GpioDev& g, unsigned offset, bool watched);
+  bool physical_level(GpioDev& g, unsigned offset);
+  void set_chip_input(GpioDev& g, unsigned offset, bool level);
+  void send_line_event(Handle& h, unsigned index, bool rising, Tick tick);
+  void notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_type);
+  void wake_pump();
+  void pump_loop();
+
+  // gpio ioctls (device_board_gpio.cpp)
+  long gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
+  long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg);
+  void fill_v2_info(GpioDev& g, unsigned offset, void* info);
+  long request_lines(Handle& chip, HandleKind kind, const std::vector<unsigned>& offsets,
+                     const std::vector<std::uint64_t>& flags, const std::vector<int>& values, const char* consumer,
+                     std::uint32_t event_buffer_size, const std::vector<std::uint32_t>& debounce, NewFile* created);
+  long reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
+                         const std::vector<std::uint32_t>& debounce);
+  bool logical_value(Handle& h, unsigned index);
+
+  DiagnosticLog& log_;
+  Board board_;
+  std::vector<DeviceNode> nodes_;
+  std::vector<std::unique_ptr<ChainDev>> chains_;  // the spidev node of each chain of board_
+  std::vector<std::unique_ptr<GpioDev>> gpios_;
+  std::vector<int> node_target_;  // node index -> chain or gpio index
+  std::unordered_map<std::uint64_t, std::unique_ptr<Handle>> handles_;
+  std::mt19937_64 handle_ids_;  // seeded from getrandom(): handle ids are capabilities
+  MessageObserver observer_;
+
+  std::mutex m_;
+  std::thread pump_;
+  bool pump_running_ = false;
+  bool pump_stop_ = false;
+  int wake_fd_ = -1;
+};
+
+}  // namespace l6470emu
