@@ -151,9 +151,10 @@ void DeviceBoard::release(Handle& h) {
 // ---------------------------------------------------------------- spidev
 
 long DeviceBoard::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
-                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                              const std::function<bool()>& caller_alive) {
   Tick end = 0;
-  const long r = run_spi_message(handle, xfers, tx, rx, end);
+  const long r = run_spi_message(handle, xfers, tx, rx, end, caller_alive);
   if (r >= 0) wait_for(end);  // the call takes the message's bus time, as a kernel transfer does
   return r;
 }
@@ -167,9 +168,15 @@ void DeviceBoard::wait_for(Tick tick) {
   time().wait_until(tick);
 }
 
+void DeviceBoard::wait_for_bus(std::unique_lock<std::mutex>& lock, unsigned bus) {
+  if (sliced_in_flight_ == 0) return;  // the usual case: no lookup
+  bus_released_.wait(lock, [&] { return !bus_owned_[bus]; });
+}
+
 long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
-                                  std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end) {
-  std::lock_guard lock(m_);
+                                  std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end,
+                                  const std::function<bool()>& caller_alive) {
+  std::unique_lock lock(m_);
   Handle* h = find(handle, HandleKind::spidev);
   if (!h) return -EBADF;
   if (xfers.empty()) return 0;  // spidev answers SPI_IOC_MESSAGE(0) without touching the bus
@@ -185,16 +192,62 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
     if (x.speed_hz > kChipMaxSpeedHz || (x.bits_per_word != 0 && x.bits_per_word != 8)) suspicious = true;
   if (suspicious)
     check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
+  // The settings as they are now: the message keeps them even if they change while it is sliced.
+  const SpidevSettings settings = c.spi;
+  const unsigned bus = board_.chain_config(chain).bus;
+  wait_for_bus(lock, bus);
+  thread_local SpidevWireMessage message;  // its buffers keep their capacity from one message to the next
+  message.prepare(settings, xfers, tx);
   // The message starts when the bus is free: now, or when the message before it on this bus ends
   // (its caller may still be waiting for that end). The board runs the bus; spidev says what to clock.
-  run_spidev_message(board_.begin_transfer(chain), c.spi, xfers, tx, rx);
-  end = board_.end_transfer(chain);
-  if (board_.has_watched_pins(chain)) wake_pump();
+  const bool sliced = caller_alive && !time().is_virtual() && message.bus_ticks() > kBusSliceTicks;
+  if (!sliced) {
+    message.run(board_.begin_transfer(chain), kNever);
+    end = board_.end_transfer(chain);
+    message.finish(rx);
+    if (board_.has_watched_pins(chain)) wake_pump();
+    if (observer_) observer_(chain, xfers, tx, rx, end);
+    return total;
+  }
+  // A long message of a caller that may die: the bus is the message's until it ends or is given
+  // up; a slice at a time, the caller sleeping until half a slice before each slice's end (so the
+  // next follows back to back, as in one piece) and asking after the caller in between.
+  ++sliced_in_flight_;
+  bus_owned_[bus] = true;
+  struct Owner {
+    DeviceBoard& b;
+    std::unique_lock<std::mutex>& lock;
+    unsigned bus;
+    ~Owner() {
+      if (!lock.owns_lock()) lock.lock();
+      b.bus_owned_[bus] = false;
+      --b.sliced_in_flight_;
+      b.bus_released_.notify_all();
+    }
+  } owner{*this, lock, bus};
+  for (SpiDevice* dev = &board_.begin_transfer(chain);;) {
+    const bool done = message.run(*dev, kBusSliceTicks);
+    end = board_.end_transfer(chain);
+    if (board_.has_watched_pins(chain)) wake_pump();
+    if (done) break;
+    lock.unlock();
+    wait_for(end > kBusSliceTicks / 2 ? end - kBusSliceTicks / 2 : 0);
+    const bool alive = caller_alive();
+    lock.lock();
+    dev = &board_.begin_transfer(chain);
+    if (!alive) {
+      // Given up: CS rises now (the board's time when it was noticed), the bus is free from now.
+      message.abandon(*dev);
+      end = board_.end_transfer(chain);
+      return -EPIPE;
+    }
+  }
+  message.finish(rx);
   if (observer_) observer_(chain, xfers, tx, rx, end);
   return total;
 }
 
-long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) {
+long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive) {
   spi_ioc_transfer x{};
   x.rx_buf = 1;
   x.len = static_cast<std::uint32_t>(rx.size());
@@ -204,10 +257,11 @@ long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) {
     if (!h) return -EBADF;
     if (rx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx);
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx, caller_alive);
 }
 
-long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) {
+long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx,
+                            const std::function<bool()>& caller_alive) {
   spi_ioc_transfer x{};
   x.tx_buf = 1;
   x.len = static_cast<std::uint32_t>(tx.size());
@@ -217,7 +271,7 @@ long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> 
     if (!h) return -EBADF;
     if (tx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {});
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {}, caller_alive);
 }
 
 long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {

@@ -96,11 +96,21 @@ class DeviceBoard {
   /// Like a kernel transfer, the call takes the message's bus time: the message starts when
   /// the bus is free (now, or when the message before it on the same bus ends) and the call
   /// returns when the board's time reaches its end (a sleep in wall mode, a wait in virtual mode).
+  ///
+  /// `caller_alive` (a daemon's client, which may die while its message is on the bus): on the
+  /// wall clock, a message longer than kBusSliceTicks is clocked a slice at a time, the caller
+  /// sleeping out each slice's bus time and `caller_alive` asked between slices. When it says no,
+  /// nothing more is clocked, CS rises, and the bus is free for the others at once (-EPIPE): a
+  /// live client never waits out a dead one's bus time. Others on the bus wait for the message
+  /// as they wait for any (the bus is its until it ends).
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                   std::span<std::uint8_t> rx);
+                   std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive = {});
   /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
-  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx);
-  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx);
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive = {});
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, const std::function<bool()>& caller_alive = {});
+
+  /// Bus time of one slice of a long message whose caller may die (10 ms).
+  static constexpr Tick kBusSliceTicks = 10 * 1000 * kTicksPerMicrosecond;
 
   // ---- the physical world (ctl, tests) ----------------------------------------
 
@@ -188,7 +198,9 @@ class DeviceBoard {
 
   // time and edges
   long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                       std::span<std::uint8_t> rx, Tick& end);
+                       std::span<std::uint8_t> rx, Tick& end, const std::function<bool()>& caller_alive);
+  /// Waits (the lock held by `lock`) until no sliced message owns `bus`.
+  void wait_for_bus(std::unique_lock<std::mutex>& lock, unsigned bus);
   void wait_for(Tick tick);
   void report_edge(const PinEdge& edge);
   void watch_line(GpioDev& g, unsigned offset, bool watched);
@@ -221,6 +233,11 @@ class DeviceBoard {
   MessageObserver observer_;
 
   std::mutex m_;
+  // Buses a sliced message owns until it ends (its caller sleeping between slices, the lock
+  // released): other messages on them wait for bus_released_.
+  std::unordered_map<unsigned, bool> bus_owned_;
+  std::size_t sliced_in_flight_ = 0;
+  std::condition_variable bus_released_;
   std::thread pump_;
   bool pump_running_ = false;
   bool pump_stop_ = false;

@@ -129,7 +129,7 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
 }
 
 void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet, ReplyHeader& reply,
-                   std::vector<std::uint8_t>& out, int& pass_fd) {
+                   std::vector<std::uint8_t>& out, int& pass_fd, const std::function<bool()>& client_alive) {
   reply = {};
   out.clear();
   pass_fd = -1;
@@ -193,7 +193,7 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(rx_len), 0);
-      reply.result = board.spi_message(req.handle, xfers, tx, out);
+      reply.result = board.spi_message(req.handle, xfers, tx, out, client_alive);
       if (reply.result < 0) out.clear();
       return;
     }
@@ -203,12 +203,12 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(req.arg), 0);
-      reply.result = board.spi_read(req.handle, out);
+      reply.result = board.spi_read(req.handle, out, client_alive);
       if (reply.result < 0) out.clear();
       return;
     }
     case Op::spi_write:
-      reply.result = board.spi_write(req.handle, payload);
+      reply.result = board.spi_write(req.handle, payload, client_alive);
       return;
     case Op::control: {
       std::string text;
@@ -225,13 +225,13 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
 
 SharedOutcome serve_shared_request(DeviceBoard& board, const ControlHandler& control, SharedChannel& channel,
                                    std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& out,
-                                   int& pass_fd) {
+                                   int& pass_fd, const std::function<bool()>& client_alive) {
   std::uint32_t flags = 0;
   const std::size_t n = channel.take_request(scratch, flags);
   pass_fd = -1;
   if (flags & kShmOnSocket) return SharedOutcome::request_on_socket;
   try {
-    serve_request(board, control, {scratch, n}, reply, out, pass_fd);
+    serve_request(board, control, {scratch, n}, reply, out, pass_fd, client_alive);
   } catch (const std::exception&) {
     reply = {};
     reply.result = -ENOMEM;

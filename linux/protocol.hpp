@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -102,8 +103,11 @@ using ControlHandler = std::function<int(const std::string& command, std::string
 
 /// Serves one request on `board` (the daemon side). Fills `reply` and its payload;
 /// `pass_fd` gets a descriptor to send along (the caller closes its copy after sending).
+/// `client_alive` says whether the client is still there: a long SPI message of a client that
+/// died is given up midway (DeviceBoard::spi_message), so that no one waits out its bus time.
 void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet,
-                   ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload, int& pass_fd);
+                   ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload, int& pass_fd,
+                   const std::function<bool()>& client_alive = {});
 
 /// What serve_shared_request did with the request posted in a shared channel.
 enum class SharedOutcome {
@@ -118,6 +122,6 @@ enum class SharedOutcome {
 /// into `scratch` (kShmAreaBytes), its size checked against the area.
 SharedOutcome serve_shared_request(DeviceBoard& board, const ControlHandler& control, SharedChannel& channel,
                                    std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload,
-                                   int& pass_fd);
+                                   int& pass_fd, const std::function<bool()>& client_alive = {});
 
 }  // namespace l6470emu

@@ -3,6 +3,7 @@
 
 #include <asm/ioctl.h>
 #include <cerrno>
+#include <algorithm>
 #include <climits>
 #include <vector>
 
@@ -175,32 +176,32 @@ std::size_t spidev_rx_bytes(std::span<const spi_ioc_transfer> xfers) {
   return n;
 }
 
-void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
-                        std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  thread_local std::vector<std::uint8_t> wire_tx, wire_rx;
-  thread_local std::vector<SpiTransfer> transfers;
+void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
+                                std::span<const std::uint8_t> tx) {
   // Wire buffers for the transfers that have a buffer; bufferless ones (zeros out, nothing in)
   // need none, however long they are.
   std::size_t total = 0;
   for (const auto& x : xfers)
     if (x.tx_buf || x.rx_buf) total += x.len;
-  wire_tx.assign(total, 0);
-  wire_rx.assign(total, 0);
+  wire_tx_.assign(total, 0);
+  wire_rx_.assign(total, 0);
+  settings_ = s;
+  xfers_ = xfers;
   const bool lsb_first = (s.mode & SPI_LSB_FIRST) != 0;
 
   std::size_t off = 0, tx_off = 0;
   for (const auto& x : xfers) {
     const unsigned w = word_bytes(x.bits_per_word ? x.bits_per_word : s.bits_per_word);
     if (x.tx_buf) {
-      to_wire(tx.data() + tx_off, wire_tx.data() + off, x.len, w, lsb_first);
+      to_wire(tx.data() + tx_off, wire_tx_.data() + off, x.len, w, lsb_first);
       tx_off += x.len;
     }
     if (x.tx_buf || x.rx_buf) off += x.len;
   }
 
-  BusTiming timing;
-  timing.default_speed_hz = s.speed_hz ? s.speed_hz : s.max_speed_hz;
-  timing.cs_high_ticks = ticks_from_us(10);  // spi.c's default cs_change delay
+  timing_ = {};
+  timing_.default_speed_hz = s.speed_hz ? s.speed_hz : s.max_speed_hz;
+  timing_.cs_high_ticks = ticks_from_us(10);  // spi.c's default cs_change delay
   auto speed_of = [&](const spi_ioc_transfer& x) {
     std::uint32_t hz = x.speed_hz ? x.speed_hz : s.speed_hz;
     if (hz == 0) hz = s.max_speed_hz;
@@ -208,66 +209,160 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
     return hz;
   };
 
-  if (s.mode & SPI_CS_HIGH) {
+  transfers_.clear();
+  next_ = 0;
+  done_in_next_ = 0;
+  cs_high_left_ = 0;
+  bus_ticks_ = 0;
+  cs_high_mode_ = (s.mode & SPI_CS_HIGH) != 0;
+  if (cs_high_mode_) {
     // The chip's CS input is active low: an active-high CS never selects it. Time still passes.
-    Tick t = dev.now();
-    for (const auto& x : xfers) t += transfer_ticks(x.len, speed_of(x)) + ticks_from_us(x.delay_usecs);
-    dev.advance_to(t);
-  } else {
-    transfers.clear();
-    off = 0;
-    for (const auto& x : xfers) {
-      const std::uint32_t hz = speed_of(x);
-      const unsigned w = word_bytes(x.bits_per_word ? x.bits_per_word : s.bits_per_word);
-      if (!x.tx_buf && !x.rx_buf) {
-        // Bufferless: zeros out, MISO dropped; its word delays are time inside the transfer.
-        SpiTransfer t;
-        t.len = x.len;
-        t.speed_hz = hz;
-        t.delay_usecs = x.delay_usecs;
-        t.cs_change = x.cs_change != 0;
-        if (x.word_delay_usecs && x.len > w) t.gap_ticks = ((x.len + w - 1) / w - 1) * ticks_from_us(x.word_delay_usecs);
-        transfers.push_back(t);
-        continue;
-      }
-      if (x.word_delay_usecs && x.len > w) {
-        // One sub-transfer per word, the word delay between them, CS held.
-        for (std::size_t k = 0; k < x.len; k += w) {
-          const bool last_word = k + w >= x.len;
-          SpiTransfer t;
-          t.tx = std::span<const std::uint8_t>(wire_tx.data() + off + k, w);
-          t.rx = std::span<std::uint8_t>(wire_rx.data() + off + k, w);
-          t.len = w;
-          t.speed_hz = hz;
-          t.delay_usecs = last_word ? x.delay_usecs : x.word_delay_usecs;
-          t.cs_change = last_word && x.cs_change;
-          transfers.push_back(t);
-        }
-      } else {
-        SpiTransfer t;
-        t.tx = std::span<const std::uint8_t>(wire_tx.data() + off, x.len);
-        t.rx = std::span<std::uint8_t>(wire_rx.data() + off, x.len);
-        t.len = x.len;
-        t.speed_hz = hz;
-        t.delay_usecs = x.delay_usecs;
-        t.cs_change = x.cs_change != 0;
-        transfers.push_back(t);
-      }
-      off += x.len;
-    }
-    run_message(dev, transfers, timing);
+    for (const auto& x : xfers) cs_high_left_ += transfer_ticks(x.len, speed_of(x)) + ticks_from_us(x.delay_usecs);
+    bus_ticks_ = cs_high_left_;
+    return;
   }
-
   off = 0;
-  std::size_t rx_off = 0;
   for (const auto& x : xfers) {
+    const std::uint32_t hz = speed_of(x);
     const unsigned w = word_bytes(x.bits_per_word ? x.bits_per_word : s.bits_per_word);
+    if (!x.tx_buf && !x.rx_buf) {
+      // Bufferless: zeros out, MISO dropped; its word delays are time inside the transfer.
+      SpiTransfer t;
+      t.len = x.len;
+      t.speed_hz = hz;
+      t.delay_usecs = x.delay_usecs;
+      t.cs_change = x.cs_change != 0;
+      if (x.word_delay_usecs && x.len > w) t.gap_ticks = ((x.len + w - 1) / w - 1) * ticks_from_us(x.word_delay_usecs);
+      transfers_.push_back(t);
+      continue;
+    }
+    if (x.word_delay_usecs && x.len > w) {
+      // One sub-transfer per word, the word delay between them, CS held.
+      for (std::size_t k = 0; k < x.len; k += w) {
+        const bool last_word = k + w >= x.len;
+        SpiTransfer t;
+        t.tx = std::span<const std::uint8_t>(wire_tx_.data() + off + k, w);
+        t.rx = std::span<std::uint8_t>(wire_rx_.data() + off + k, w);
+        t.len = w;
+        t.speed_hz = hz;
+        t.delay_usecs = last_word ? x.delay_usecs : x.word_delay_usecs;
+        t.cs_change = last_word && x.cs_change;
+        transfers_.push_back(t);
+      }
+    } else {
+      SpiTransfer t;
+      t.tx = std::span<const std::uint8_t>(wire_tx_.data() + off, x.len);
+      t.rx = std::span<std::uint8_t>(wire_rx_.data() + off, x.len);
+      t.len = x.len;
+      t.speed_hz = hz;
+      t.delay_usecs = x.delay_usecs;
+      t.cs_change = x.cs_change != 0;
+      transfers_.push_back(t);
+    }
+    off += x.len;
+  }
+}
+
+Tick SpidevWireMessage::bus_ticks() const {
+  if (cs_high_mode_) return bus_ticks_;
+  Tick total = 0;
+  for (std::size_t i = 0; i < transfers_.size(); ++i) {
+    const SpiTransfer& t = transfers_[i];
+    total += Tick{t.len} * transfer_ticks(1, t.speed_hz ? t.speed_hz : timing_.default_speed_hz) + t.gap_ticks +
+             ticks_from_us(t.delay_usecs) + (raises_after(i) ? timing_.cs_high_ticks : 0);
+  }
+  return total;
+}
+
+bool SpidevWireMessage::raises_after(std::size_t i) const {
+  // run_message: after a transfer other than the last, cs_change raises CS; after the last, it keeps CS low.
+  const bool last = i + 1 == transfers_.size();
+  return last ? !transfers_[i].cs_change : transfers_[i].cs_change;
+}
+
+bool SpidevWireMessage::run(SpiDevice& dev, Tick budget) {
+  if (cs_high_mode_) {
+    const Tick step = std::min(budget, cs_high_left_);
+    dev.advance_to(dev.now() + step);
+    cs_high_left_ -= step;
+    return cs_high_left_ == 0;
+  }
+  if (budget == kNever && next_ == 0 && done_in_next_ == 0) {
+    run_message(dev, transfers_, timing_);  // the whole message at once (the usual case)
+    next_ = transfers_.size();
+    return true;
+  }
+  // A piece: whole transfers and parts of one, as much as fits the budget (at least one byte).
+  // Each keeps CS as the whole message would: run_message raises CS after the last transfer of
+  // a call unless its cs_change says otherwise, so the piece's last one is given the cs_change
+  // that makes run_message do what it would have done there in the whole message.
+  piece_.clear();
+  Tick used = 0;
+  bool last_raises = false;
+  while (next_ < transfers_.size() && (used < budget || piece_.empty())) {
+    const SpiTransfer& t = transfers_[next_];
+    const Tick per_byte = transfer_ticks(1, t.speed_hz ? t.speed_hz : timing_.default_speed_hz);
+    std::uint32_t take = t.len - done_in_next_;
+    if (budget != kNever) {
+      const Tick room = used < budget ? budget - used : 0;
+      take = static_cast<std::uint32_t>(std::min<Tick>(take, std::max<Tick>(1, room / per_byte)));
+      // Bufferless transfers are clocked in blocks of 4096 (message.cpp): cut only between blocks.
+      if (t.tx.empty() && t.rx.empty() && take < t.len - done_in_next_)
+        take = std::min<std::uint32_t>(t.len - done_in_next_, (take + 4095) / 4096 * 4096);
+    }
+    SpiTransfer part = t;
+    part.len = take;
+    if (!t.tx.empty()) part.tx = t.tx.subspan(done_in_next_, take);
+    if (!t.rx.empty()) part.rx = t.rx.subspan(done_in_next_, take);
+    const bool finishes = done_in_next_ + take == t.len;
+    if (!finishes) {
+      part.delay_usecs = 0;
+      part.gap_ticks = 0;
+    }
+    last_raises = finishes && raises_after(next_);
+    part.cs_change = last_raises;  // as a transfer in the middle of a call: raise when it would
+    piece_.push_back(part);
+    used += Tick{take} * per_byte +
+            (finishes ? t.gap_ticks + ticks_from_us(t.delay_usecs) + (last_raises ? timing_.cs_high_ticks : 0) : 0);
+    if (finishes) {
+      ++next_;
+      done_in_next_ = 0;
+    } else {
+      done_in_next_ += take;
+    }
+  }
+  if (!piece_.empty()) {
+    piece_.back().cs_change = !last_raises;  // the last of the call: cs_change keeps CS low
+    run_message(dev, piece_, timing_);
+  }
+  return next_ == transfers_.size();
+}
+
+void SpidevWireMessage::abandon(SpiDevice& dev) {
+  if (!cs_high_mode_ && dev.selected()) dev.deselect();
+  next_ = transfers_.size();
+  cs_high_left_ = 0;
+}
+
+void SpidevWireMessage::finish(std::span<std::uint8_t> rx) const {
+  const bool lsb_first = (settings_.mode & SPI_LSB_FIRST) != 0;
+  std::size_t off = 0, rx_off = 0;
+  for (const auto& x : xfers_) {
+    const unsigned w = word_bytes(x.bits_per_word ? x.bits_per_word : settings_.bits_per_word);
     if (x.rx_buf) {
-      from_wire(wire_rx.data() + off, rx.data() + rx_off, x.len, w, lsb_first);
+      from_wire(wire_rx_.data() + off, rx.data() + rx_off, x.len, w, lsb_first);
       rx_off += x.len;
     }
     if (x.tx_buf || x.rx_buf) off += x.len;
   }
+}
+
+void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
+                        std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  thread_local SpidevWireMessage message;  // its buffers keep their capacity from one message to the next
+  message.prepare(s, xfers, tx);
+  message.run(dev, kNever);
+  message.finish(rx);
 }
 
 void check_spidev_settings_for_chip(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,

@@ -10,7 +10,10 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <vector>
 
+#include "core/tick.hpp"
+#include "spi/message.hpp"
 #include "spi/spi_device.hpp"
 
 namespace l6470emu {
@@ -94,6 +97,42 @@ std::size_t spidev_rx_bytes(std::span<const spi_ioc_transfer> xfers);
 /// SPI_CS_HIGH the chip's active-low CS never selects it: nothing reaches it and MISO reads 0.
 void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
                         std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+
+/// A validated spidev message as the wire carries it (run_spidev_message's steps, apart): its
+/// bytes in wire order and the transfers run_message clocks, which can be clocked a piece at a
+/// time (a caller that may die while its message is on the bus) with the chip seeing exactly what
+/// it sees when they are clocked at once: the same bytes at the same ticks, CS falling and rising
+/// where it would. Reusable: prepare() keeps the buffers' capacity.
+class SpidevWireMessage {
+ public:
+  /// Takes the message (`xfers` and its concatenated `tx` data, which must outlive the message's
+  /// use) into wire order. Nothing is clocked yet.
+  void prepare(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx);
+  /// Ticks the whole message takes on the bus (bytes, word delays, delays, CS-high times).
+  Tick bus_ticks() const;
+  /// Clocks on `dev` from where the last call stopped, about `budget` ticks of bus time (whole
+  /// bytes, at least one; kNever: all the rest). Returns true when the message is all clocked.
+  bool run(SpiDevice& dev, Tick budget);
+  /// Gives up the rest of the message: nothing more is clocked, and CS rises now if it is held
+  /// (as when a controller stops mid-message).
+  void abandon(SpiDevice& dev);
+  /// Copies what was received into `rx` (the rx data of the transfers with an rx_buf, in host order).
+  void finish(std::span<std::uint8_t> rx) const;
+
+ private:
+  bool raises_after(std::size_t i) const;
+
+  SpidevSettings settings_;
+  std::span<const spi_ioc_transfer> xfers_;
+  BusTiming timing_;
+  std::vector<std::uint8_t> wire_tx_, wire_rx_;
+  std::vector<SpiTransfer> transfers_, piece_;
+  std::size_t next_ = 0;             // the transfer clocked next
+  std::uint32_t done_in_next_ = 0;   // its bytes clocked already
+  bool cs_high_mode_ = false;        // SPI_CS_HIGH: the chip is never selected, only time passes
+  Tick cs_high_left_ = 0;            // SPI_CS_HIGH: bus time still to pass
+  Tick bus_ticks_ = 0;               // SPI_CS_HIGH: the whole message's
+};
 
 /// Settings of `s` (and of the transfers) the chip cannot work with, as one line each:
 /// SPI mode other than 3, LSB first, CS active high, SCK above 5 MHz. `report` is called once

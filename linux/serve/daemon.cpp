@@ -153,7 +153,8 @@ void serve_connection(DeviceBoard& board, const ControlHandler& control, Connect
     int pass_fd = -1;
     if (shared) {
       if (!shared->wait_request(kRequestSpinNs, alive)) break;
-      const SharedOutcome done = serve_shared_request(board, control, *shared, scratch.get(), reply, payload, pass_fd);
+      const SharedOutcome done =
+          serve_shared_request(board, control, *shared, scratch.get(), reply, payload, pass_fd, alive);
       if (done != SharedOutcome::request_on_socket) {
         ++c.shared_requests;
         if (done == SharedOutcome::reply_on_socket) {
@@ -175,7 +176,7 @@ void serve_connection(DeviceBoard& board, const ControlHandler& control, Connect
       }
     }
     try {
-      serve_request(board, control, packet.bytes(), reply, payload, pass_fd);
+      serve_request(board, control, packet.bytes(), reply, payload, pass_fd, alive);
     } catch (const std::exception&) {
       reply = {};
       reply.result = -ENOMEM;

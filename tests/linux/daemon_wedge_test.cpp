@@ -1,15 +1,20 @@
 // `l6470emu serve` cannot be wedged by its clients: one that attaches its shared region, leaves
-// a packet unread on its socket and dies is reaped like any other, and SIGTERM ends the daemon
-// whatever its clients left behind.
+// a packet unread on its socket and dies is reaped like any other, one killed in the middle of a
+// long message does not hold the bus for the rest of it, and SIGTERM ends the daemon whatever its
+// clients left behind.
 #include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "raw_client.hpp"
+#include "spi/message.hpp"
+#include "spi/trace_native.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu::test {
@@ -66,6 +71,43 @@ TEST_F(DaemonWedge, SigtermEndsTheDaemonWhateverItsClientsLeftBehind) {
   const RunResult r = d.process().stop(SIGTERM, 10);
   EXPECT_EQ(r.status, 0) << "the daemon did not end within 10 s of SIGTERM (status 137: killed)\n" << r.err;
   EXPECT_NE(r.out.find("l6470emu serve: stopping"), std::string::npos) << r.out;
+}
+
+TEST_F(DaemonWedge, ALiveClientNeverWaitsOutTheBusTimeOfADeadOne) {
+  const std::string trace = temp_socket_path("dead-bus") + ".trace";
+  ServeDaemon d(kChain, {"--record", trace, "--log", "off"});
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  // 4096 NOPs at the controller's slowest clock: 8.6 s of bus time in one message.
+  Background slow({system_python(), "-c",
+                   "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
+                   "print('start', flush=True)\ns.xfer2([0] * 4096, 3815)\nprint('finished')\n"},
+                  d.env());
+  for (int i = 0; i < 1000 && slow.out().find("start") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // in the middle of its message
+  EXPECT_EQ(slow.stop(SIGKILL).out, "start\n");
+  const RunResult fast = run_program(
+      {system_python(), "-c",
+       "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\nprint(s.xfer2([0xD0, 0, 0]))\n"},
+      d.env());
+  EXPECT_EQ(fast.status, 0) << fast.err;
+  EXPECT_EQ(d.process().stop(SIGTERM).status, 0);
+  // The recording says when each message had the bus: the dead one's frame was cut short where
+  // its client died, and the live one's began right after, long before the dead one would have ended.
+  std::ifstream in(trace);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const Trace t = read_native_trace(text, trace);
+  std::vector<TraceEvent> frames;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i].kind == TraceEventKind::frame) frames.push_back(t[i]);
+  ASSERT_EQ(frames.size(), 2u) << text.substr(0, 2000);
+  const Tick full = 4096 * transfer_ticks(1, 3815);
+  EXPECT_GT(frames[0].mosi.size(), 0u);
+  EXPECT_LT(frames[0].mosi.size(), 4096u) << "the dead client's message was clocked to its end";
+  EXPECT_LT(frames[0].duration, full);
+  EXPECT_LT(frames[1].tick, frames[0].tick + full) << "the live client waited for the dead one's bus time";
+  EXPECT_EQ(frames[1].mosi.size(), 3u);
+  unlink(trace.c_str());
 }
 
 }  // namespace
