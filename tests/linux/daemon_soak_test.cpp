@@ -1,9 +1,10 @@
 // A fault soak of `l6470emu serve` (bounded in time): 50 preload clients read through one
 // daemon while some are killed with SIGKILL mid-message, others throw garbage at the socket,
 // others die with a packet left unread on their socket, and slow-bus clients (SCK at the
-// controller's slowest) share the bus, some killed mid-message. The daemon keeps serving and
-// reaps every dead client, the survivors' answers stay exact, and the recording made throughout
-// replays clean after the daemon is stopped with SIGTERM, and after SIGKILL.
+// controller's slowest, each message longer than the daemon's 10 ms slice) share the bus, some
+// killed mid-message. The daemon keeps serving and reaps every dead client, the survivors'
+// answers stay exact, and the recording made throughout replays clean after the daemon is
+// stopped with SIGTERM, and after SIGKILL.
 #include <signal.h>
 #include <unistd.h>
 
@@ -59,13 +60,14 @@ TEST_P(DaemonSoak, SurvivorsStayExactAndTheRecordingReplaysClean) {
   for (int i = 0; i < kGarbage; ++i)
     garbage.push_back(std::make_unique<Background>(
         std::vector<std::string>{system_python(), script("garbage_client.py"), d.socket(), std::to_string(i), "4"}));
-  // 1-byte NOPs at 3815 Hz: 2.1 ms of bus each, 40 of them per client.
+  // Messages of 8 NOPs at 3815 Hz: 16.8 ms of bus each, longer than a slice (the daemon clocks
+  // them a slice at a time, giving up a killed client's at the next slice), 30 per client.
   std::vector<std::unique_ptr<Background>> slow;
   for (int i = 0; i < kSlow; ++i)
     slow.push_back(std::make_unique<Background>(
         std::vector<std::string>{system_python(), "-c",
                                  "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
-                                 "for _ in range(40): s.xfer2([0], 3815)\nprint('slow=done')\n"},
+                                 "for _ in range(30): s.xfer2([0] * 8, 3815)\nprint('slow=done')\n"},
         d.env()));
   std::this_thread::sleep_for(std::chrono::milliseconds(350));
   for (int i = 0; i < kDeadBatches; ++i) EXPECT_EQ(dead_clients_with_unread_packets(d.socket(), 4), 4);
