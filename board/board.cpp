@@ -8,11 +8,8 @@
 
 namespace l6470emu {
 
-/// How often each kind of chip diagnostic is logged in full per chip.
-constexpr std::uint64_t kDiagnosticRepeats = 10;
-
 Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
-    : log_(std::move(log)), time_(config.time, host), numbering_(config.numbering) {
+    : log_(std::move(log)), sanitizer_(config.check, log_), time_(config.time, host), numbering_(config.numbering) {
   for (const ChainConfig& cc : config.chains) {
     std::vector<Chip> chips;
     chips.reserve(cc.chips.size());
@@ -29,24 +26,13 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     initial[static_cast<unsigned>(Pin::STCK)] = false;  // SW open (pulled up), STBY_RST high (running), STCK low
     cs->wire.assign(cs->chain.size(), initial);
     cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
+    cs->checker = std::make_unique<ChainChecker>(sanitizer_, cs->chain, cs->name, numbering_);
+    cs->bus = std::make_unique<ChainBus>(cs->chain, *cs->checker);
+    // The chips' diagnostics (WRONG_CMD, NOTPERF_CMD, dropped bits and answers) are rules the
+    // sanitizer names: logged (rate-limited) under check=warn, the run's end under check=error.
     for (std::size_t k = 0; k < cs->chain.size(); ++k) {
-      const std::string where = cs->name + ": " + ChipNumbering(numbering_, cs->chain.size()).label(k) + ": ";
-      // A driver looping on a bad command must not flood the log: each kind is shown
-      // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
-      cs->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {
-        const std::size_t i = d.kind == DiagnosticKind::wrong_cmd ? 0 : d.kind == DiagnosticKind::notperf_cmd ? 1 : 2;
-        const char* kind = i == 0 ? "WRONG_CMD" : i == 1 ? "NOTPERF_CMD" : "ignored";
-        const std::uint64_t n = ++seen[i];
-        if (n < kDiagnosticRepeats) {
-          log_(where + kind + ": " + d.message);
-        } else if (n == kDiagnosticRepeats) {
-          log_(where + kind + ": " + d.message + "  (further ones of this kind are counted, not shown)");
-        } else {
-          std::uint64_t p = kDiagnosticRepeats;
-          while (p < n && p <= UINT64_MAX / 10) p *= 10;
-          if (p == n) log_(where + kind + ": " + std::to_string(n) + " so far");
-        }
-      });
+      ChainChecker* checker = cs->checker.get();
+      cs->chain.chip(k).set_diagnostic_sink([checker, k](const Diagnostic& d) { checker->chip_diagnostic(k, d); });
     }
     chains_.push_back(std::move(cs));
   }
@@ -94,7 +80,7 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
 
 // ---------------------------------------------------------------- SPI
 
-SpiDevice& Board::begin_transfer(std::size_t chain) {
+SpiDevice& Board::begin_transfer(std::size_t chain, const WireSettings& wire) {
   ChainState& c = state(chain);
   // The use starts when the bus is free: now, or when the use before it on this bus ends.
   const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
@@ -102,18 +88,24 @@ SpiDevice& Board::begin_transfer(std::size_t chain) {
   record_outputs(c);
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
-    if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) spi_of(*other).deselect();
-  return spi_of(c);
+    if (other.get() != &c && other->config.bus == c.config.bus && other->bus->selected()) {
+      other->bus->set_device(spi_of(*other));
+      other->bus->deselect_wire();
+    }
+  c.bus->set_device(spi_of(c));
+  c.bus->begin(wire);
+  return *c.bus;
 }
 
 Tick Board::end_transfer(std::size_t chain) {
   ChainState& c = state(chain);
+  c.bus->end();
   if (!c.watched.empty()) emit_changes(c, c.chain.now());
   return bus_free_[c.config.bus] = c.chain.now();
 }
 
 Tick Board::transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing) {
-  run_message(begin_transfer(chain), transfers, timing);
+  run_message(begin_transfer(chain, timing.wire), transfers, timing);
   return end_transfer(chain);
 }
 

@@ -30,6 +30,8 @@ struct Board::ChainState {
   std::vector<PinLevels> last;        // watched pins: the level last reported
   std::vector<WatchedPin> watched;    // sorted
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
+  std::unique_ptr<ChainChecker> checker;         // the sanitizer's checks of this chain
+  std::unique_ptr<ChainBus> bus;                 // what begin_transfer hands out
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

@@ -51,6 +51,9 @@ class Chip {
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
   bool collecting_arguments() const { return collecting_; }
+  /// While collecting_arguments(): the command being collected and how many argument bytes it still needs.
+  Command collecting_command() const { return collecting_ ? pending_.command : Command::NOP; }
+  std::uint8_t arguments_missing() const { return collecting_ ? static_cast<std::uint8_t>(pending_.arg_bytes - args_seen_) : 0; }
 
   /// Whether the chip takes part in SPI (false while STBY/RST is held low).
   bool spi_enabled() const { return stby_level_; }
@@ -159,9 +162,14 @@ class Chip {
   void exec_set_param(std::uint8_t address, std::uint32_t value);
   void write_register(const RegisterInfo& r, std::uint32_t value);
   void load_response(std::uint32_t value, std::uint8_t bytes) {
+    if (response_left_ != 0 && sink_) answer_dropped("a new GetParam/GetStatus replaced it");
     response_ = value;
     response_left_ = bytes;
   }
+  /// Diagnostics only a sink hears of (no STATUS flag): an answer dropped before all its
+  /// bytes were shifted out, a value with bits the register or argument lacks.
+  void answer_dropped(const char* by);
+  void check_unused_bits(const Opcode& op, std::uint32_t arg);
   void refresh_profile();
   void clear_status_on_get_status() {
     if (!latched_clean_) clear_latches();
@@ -173,8 +181,8 @@ class Chip {
   void drive_sw(bool level);
   void switch_turn_on_event();
   void switch_release_event();
-  void wrong_command(std::uint8_t byte, const char* why);
-  void not_performable(const char* what);
+  void wrong_command(std::uint8_t byte, const char* why, DiagnosticDetail detail = DiagnosticDetail::none);
+  void not_performable(const char* what, DiagnosticDetail detail = DiagnosticDetail::none);
   AlarmFlags live_alarms() const;
   LiveStatus live_status() const;
   bool motion_command_allowed(const char* what);

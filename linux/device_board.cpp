@@ -151,11 +151,21 @@ void DeviceBoard::release(Handle& h) {
 // ---------------------------------------------------------------- spidev
 
 long DeviceBoard::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
-                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, std::string* check_report) {
   Tick end = 0;
-  const long r = run_spi_message(handle, xfers, tx, rx, end);
+  const long r = run_spi_message(handle, xfers, tx, rx, end, check_report);
   if (r >= 0) wait_for(end);  // the call takes the message's bus time, as a kernel transfer does
   return r;
+}
+
+CheckConfig DeviceBoard::check_config() {
+  std::lock_guard lock(m_);
+  return board_.sanitizer().config();
+}
+
+void DeviceBoard::set_check_config(const CheckConfig& config) {
+  std::lock_guard lock(m_);
+  board_.sanitizer().set_config(config);
 }
 
 void DeviceBoard::wait_for(Tick tick) {
@@ -168,7 +178,8 @@ void DeviceBoard::wait_for(Tick tick) {
 }
 
 long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
-                                  std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end) {
+                                  std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end,
+                                  std::string* check_report) {
   std::lock_guard lock(m_);
   Handle* h = find(handle, HandleKind::spidev);
   if (!h) return -EBADF;
@@ -178,23 +189,26 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
   const long total = validate_spidev_message(c.spi, xfers);
   if (total < 0) return total;
   if (tx.size() != spidev_tx_bytes(xfers) || rx.size() != spidev_rx_bytes(xfers)) return -EFAULT;
-  // Settings the chip cannot work with are reported once each (cheap test first: the usual case is clean).
-  bool suspicious = (c.spi.mode & (SPI_CPOL | SPI_CPHA | SPI_LSB_FIRST | SPI_CS_HIGH)) != SPI_MODE_3 ||
-                    c.spi.speed_hz > kChipMaxSpeedHz || c.spi.bits_per_word != 8;
-  for (const auto& x : xfers)
-    if (x.speed_hz > kChipMaxSpeedHz || (x.bits_per_word != 0 && x.bits_per_word != 8)) suspicious = true;
-  if (suspicious)
-    check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
   // The message starts when the bus is free: now, or when the message before it on this bus ends
-  // (its caller may still be waiting for that end). The board runs the bus; spidev says what to clock.
-  run_spidev_message(board_.begin_transfer(chain), c.spi, xfers, tx, rx);
+  // (its caller may still be waiting for that end). The board runs the bus as a host with the
+  // node's settings drives it (its sanitizer names what the chip cannot work with); spidev says
+  // what to clock.
+  run_spidev_message(board_.begin_transfer(chain, spidev_wire_settings(c.spi)), c.spi, xfers, tx, rx);
   end = board_.end_transfer(chain);
   if (board_.has_watched_pins(chain)) wake_pump();
   if (observer_) observer_(chain, xfers, tx, rx, end);
+  if (board_.sanitizer().failed()) {
+    // check=error: the run ends here. The message happened (the chips took it as they would);
+    // the caller gets the report instead of its result.
+    std::optional<std::string> report = board_.take_check_failure();
+    if (check_report == nullptr) return -EIO;
+    *check_report = std::move(*report);
+    return kCheckFailed;
+  }
   return total;
 }
 
-long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) {
+long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, std::string* check_report) {
   spi_ioc_transfer x{};
   x.rx_buf = 1;
   x.len = static_cast<std::uint32_t>(rx.size());
@@ -204,10 +218,10 @@ long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) {
     if (!h) return -EBADF;
     if (rx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx);
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx, check_report);
 }
 
-long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) {
+long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, std::string* check_report) {
   spi_ioc_transfer x{};
   x.tx_buf = 1;
   x.len = static_cast<std::uint32_t>(tx.size());
@@ -217,7 +231,7 @@ long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> 
     if (!h) return -EBADF;
     if (tx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {});
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {}, check_report);
 }
 
 long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {
@@ -236,11 +250,8 @@ long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::
     if (_IOC_TYPE(cmd) != SPI_IOC_MAGIC) return -ENOTTY;
     const long r = spidev_settings_ioctl(c.spi, cmd, v);
     if (r < 0) return r;
-    if (_IOC_DIR(cmd) & _IOC_READ) {
+    if (_IOC_DIR(cmd) & _IOC_READ)
       for (std::size_t i = 0; i < n; ++i) arg[i] = static_cast<std::uint8_t>(v >> (8 * i));
-    } else {
-      c.reported = 0;  // new settings: report their problems afresh
-    }
     return r;
   }
   if (h->kind == HandleKind::gpiochip) return gpiochip_ioctl(*h, cmd, arg, created);

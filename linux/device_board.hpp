@@ -60,6 +60,11 @@ struct NewFile {
   HandleKind kind = HandleKind::spidev;
 };
 
+/// What spi_message, spi_read and spi_write return when the message broke a rule of the chip
+/// under check=error (board/sanitizer.hpp): the caller ends its host program's run with the
+/// report (the preload: exit status kSanitizerExitStatus). Not an errno value.
+inline constexpr long kCheckFailed = -0x5A17;
+
 /// Called after every SPI message with the chain index, the message and the bytes (for
 /// observers of the traffic; native traces are recorded by start_recording instead).
 using MessageObserver = std::function<void(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
@@ -96,11 +101,22 @@ class DeviceBoard {
   /// Like a kernel transfer, the call takes the message's bus time: the message starts when
   /// the bus is free (now, or when the message before it on the same bus ends) and the call
   /// returns when the board's time reaches its end (a sleep in wall mode, a wait in virtual mode).
+  /// Under check=error, a message that breaks a rule of the chip still runs as the chip would
+  /// take it; then the call returns kCheckFailed with the sanitizer's report in `check_report`
+  /// (without one, -EIO: the report is in the log).
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                   std::span<std::uint8_t> rx);
-  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
-  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx);
-  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx);
+                   std::span<std::uint8_t> rx, std::string* check_report = nullptr);
+  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno
+  /// (kCheckFailed as spi_message).
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, std::string* check_report = nullptr);
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, std::string* check_report = nullptr);
+
+  // ---- the driver sanitizer -------------------------------------------------------
+
+  /// The board's check settings (check=, check.allow=).
+  CheckConfig check_config();
+  /// Changes them (L6470EMU_CHECK over the description's check=).
+  void set_check_config(const CheckConfig& config);
 
   // ---- the physical world (ctl, tests) ----------------------------------------
 
@@ -188,7 +204,7 @@ class DeviceBoard {
 
   // time and edges
   long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                       std::span<std::uint8_t> rx, Tick& end);
+                       std::span<std::uint8_t> rx, Tick& end, std::string* check_report);
   void wait_for(Tick tick);
   void report_edge(const PinEdge& edge);
   void watch_line(GpioDev& g, unsigned offset, bool watched);

@@ -152,8 +152,10 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(rx_len), 0);
-      reply.result = board.spi_message(req.handle, xfers, tx, out);
+      std::string report;
+      reply.result = board.spi_message(req.handle, xfers, tx, out, &report);
       if (reply.result < 0) out.clear();
+      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());  // the client ends with it
       return;
     }
     case Op::spi_read: {
@@ -162,13 +164,18 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(req.arg), 0);
-      reply.result = board.spi_read(req.handle, out);
+      std::string report;
+      reply.result = board.spi_read(req.handle, out, &report);
       if (reply.result < 0) out.clear();
+      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());
       return;
     }
-    case Op::spi_write:
-      reply.result = board.spi_write(req.handle, payload);
+    case Op::spi_write: {
+      std::string report;
+      reply.result = board.spi_write(req.handle, payload, &report);
+      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());
       return;
+    }
     case Op::control: {
       std::string text;
       const std::string command(payload.begin(), payload.end());

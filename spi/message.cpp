@@ -14,11 +14,14 @@ Tick transfer_ticks(std::uint32_t bytes, std::uint32_t speed_hz) {
 }
 
 void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const BusTiming& timing) {
+  WireSettings wire = timing.wire;
   for (std::size_t i = 0; i < transfers.size(); ++i) {
     const SpiTransfer& t = transfers[i];
     const bool last = i + 1 == transfers.size();
-    if (!dev.selected()) dev.select();
+    if (!dev.selected()) dev.select_wire();
     const std::uint32_t speed = t.speed_hz ? t.speed_hz : timing.default_speed_hz;
+    wire.speed_hz = speed;
+    wire.bits_per_word = t.bits_per_word ? t.bits_per_word : timing.wire.bits_per_word;
     const Tick per_byte = transfer_ticks(1, speed);
     if (t.tx.empty() && t.rx.empty()) {
       // No buffers (the kernel allows up to INT_MAX bytes of them): zeros out, MISO dropped,
@@ -29,14 +32,15 @@ void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const B
       for (std::uint32_t k = 0; k < t.len;) {
         const std::uint32_t block = std::min<std::uint32_t>(t.len - k, sizeof kZeros);
         dev.advance_to(dev.now() + per_byte * block);
-        dev.exchange(std::span<const std::uint8_t>(kZeros, block), std::span<std::uint8_t>(sink, block));
+        dev.exchange_wire(std::span<const std::uint8_t>(kZeros, block), std::span<std::uint8_t>(sink, block), wire);
         k += block;
       }
     } else {
       for (std::uint32_t k = 0; k < t.len; ++k) {
         const std::uint8_t out = t.tx.empty() ? 0 : t.tx[k];
+        std::uint8_t in = 0;
         dev.advance_to(dev.now() + per_byte);
-        const std::uint8_t in = dev.exchange(out);
+        dev.exchange_wire(std::span<const std::uint8_t>(&out, 1), std::span<std::uint8_t>(&in, 1), wire);
         if (!t.rx.empty()) t.rx[k] = in;
       }
     }
@@ -44,7 +48,7 @@ void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const B
     if (t.delay_usecs) dev.advance_to(dev.now() + ticks_from_us(t.delay_usecs));
     const bool raise = last ? !t.cs_change : t.cs_change;
     if (raise) {
-      dev.deselect();
+      dev.deselect_wire();
       dev.advance_to(dev.now() + timing.cs_high_ticks);
     }
   }

@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "linux/log.hpp"
+#include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
@@ -46,6 +47,7 @@ bool try_open(const char* path, int flags, int& fd) {
   try {
     const int node = node_index(path);
     if (node < 0) {
+      note_missing_node(path);
       const VirtualPath v = lookup_virtual(path, true);
       if (v.type == VirtualPath::Type::file) {
         fd = open_virtual_file(v, flags);

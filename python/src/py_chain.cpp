@@ -13,7 +13,7 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
       frame_gap_(frame_gap) {
   for (std::size_t k = 0; k < chain_->size(); ++k) {
     chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), k](const Diagnostic& d) {
-      static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored"};
+      static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored", "unused_bits", "answer_lost"};
       if (store->kept.size() == kMaxDiagnostics) {
         store->kept.pop_front();
         ++store->dropped;

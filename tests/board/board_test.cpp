@@ -69,13 +69,15 @@ TEST(BoardSpi, AFrontDrivingItsOwnChipSelectClocksOneByteAtATimeAndEachByteTakes
     front.chip_select(true);
     miso[i] = front.transfer(mosi[i]);
     front.chip_select(false);
+    v.board.advance(4);  // the host keeps CS high for 1 µs (t_disCS is 800 ns)
   }
   EXPECT_EQ(miso[1], 0x2E);
   EXPECT_EQ(miso[2], 0x88);  // CONFIG's reset value
   // 8 bits at 5 MHz are 1.6 µs: 7 whole ticks a byte; the chip-select edges take no bus time.
   EXPECT_EQ(transfer_ticks(1, 5'000'000), Tick{7});
-  EXPECT_EQ(v.board.time().now(), Tick{3 * 7});
-  EXPECT_EQ(v.board.now(0), Tick{3 * 7});
+  EXPECT_EQ(v.board.time().now(), Tick{3 * (7 + 4)});
+  EXPECT_EQ(v.board.now(0), Tick{3 * (7 + 4)});
+  EXPECT_TRUE(v.log.empty()) << v.log.front();
   EXPECT_FALSE(v.board.chain(0).selected());
 }
 

@@ -253,7 +253,7 @@ TEST(BoardConfig, ACommentRunsToTheEndOfTheLineEvenPastASemicolon) {
   EXPECT_EQ(r.config->chains.size(), 1u);
   EXPECT_EQ(error_of("bus=0 chips=L6470 # ok\n; colour=red", 3), "unknown key 'colour' (chain keys: chips, bus, cs, "
                                                                  "path, gpiochip, speed, mode, bufsiz; board-wide keys: "
-                                                                 "time, scale, idle, log, socket, trace, numbering)");
+                                                                 "time, scale, idle, log, socket, trace, numbering, check, check.allow)");
 }
 
 TEST(BoardConfig, DefaultGpiochipsAvoidTheNumbersOtherChainsAskFor) {
