@@ -21,8 +21,11 @@ void ChainBus::select_wire() {
     return;
   }
   if (dev_->selected()) return;
-  dev_->select_wire();
-  checker_->selected(dev_->now());
+  if (timed_)
+    dev_->select_wire();
+  else
+    dev_->select();
+  checker_->selected(dev_->now(), timed_);
 }
 
 std::uint8_t ChainBus::exchange(std::uint8_t mosi) {

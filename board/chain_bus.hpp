@@ -20,6 +20,9 @@ class ChainBus final : public SpiDevice {
 
   /// The device the bytes go to (the chain, or its recording while it is recorded).
   void set_device(SpiDevice& device) { dev_ = &device; }
+  /// A front whose CS edges carry no time of their own (Python's Chain.frame: time moves only
+  /// when told): no t_disCS, neither the chips' missed answer load nor its check.
+  void set_untimed() { timed_ = false; }
   /// A use begins: the host drives the bus with `wire`.
   void begin(const WireSettings& wire);
   /// The use ends (the checks of a whole message).
@@ -43,6 +46,7 @@ class ChainBus final : public SpiDevice {
   ChainChecker* checker_;
   WireSettings wire_;
   bool host_selected_ = false;  // CS active high: the host's CS is asserted (the chain's is not)
+  bool timed_ = true;
 };
 
 }  // namespace l6470emu

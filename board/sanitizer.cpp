@@ -83,8 +83,7 @@ void Sanitizer::report(const Violation& v) {
   if (config_.level == CheckLevel::off || config_.allowed.contains(v.rule)) return;
   if (config_.level == CheckLevel::error) {
     if (failure_) return;  // one report: the first
-    failure_ = v;
-    if (log_) log_(violation_line(v) + " [check=error: the run ends]");
+    failure_ = v;  // the front ends the run with it (and says so in its log)
     return;
   }
   if (!log_) return;
@@ -197,7 +196,7 @@ void ChainChecker::check_settings(const WireSettings& wire) {
   }
 }
 
-void ChainChecker::selected(Tick tick) {
+void ChainChecker::selected(Tick tick, bool timed) {
   ++frame_;
   frame_bytes_ = 0;
   in_frame_ = true;
@@ -205,7 +204,7 @@ void ChainChecker::selected(Tick tick) {
   timed_settings_ = true;
   keep_mosi_ = false;
   if (!on()) return;
-  if (last_frame_had_bytes_ && tick - last_deselect_ < kDeselectMinTicks) {
+  if (timed && last_frame_had_bytes_ && tick - last_deselect_ < kDeselectMinTicks) {
     const Tick high = tick - last_deselect_;
     sanitizer_.report(make(Rule::CS_DESELECT_TIME, std::nullopt, std::nullopt,
                            "CS was high for " + std::to_string(high * 250) + " ns before this frame (t_disCS is at least " +

@@ -56,7 +56,7 @@ class Sanitizer {
 
   /// A broken rule: dropped when the level is off or the rule allowed; under warn a log line
   /// (each rule shown ten times per chain and chip, then counted at every power of ten); under
-  /// error the first one is kept as the failure (and logged), later ones dropped until it is taken.
+  /// error the first one is kept as the failure, later ones dropped until it is taken.
   void report(const Violation& v);
   /// Whether a failure is waiting to be taken.
   bool failed() const { return failure_.has_value(); }
@@ -85,8 +85,9 @@ class ChainChecker {
   void begin_use(const WireSettings& wire);
   /// The use ends: a message of several frames that leaves some chips mid-command (COMMAND_SPLIT).
   void end_use();
-  /// CS fell at `tick` (the chain is selected).
-  void selected(Tick tick);
+  /// CS fell at `tick` (the chain is selected); `timed`: the CS edges' times are the host's
+  /// (t_disCS is checked).
+  void selected(Tick tick, bool timed = true);
   /// `tx` is about to be clocked with `wire` (the clocks ended at `tick`, as run_message charges them).
   void clocked(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick);
   /// CS is about to rise: the chips are about to decode their registers.

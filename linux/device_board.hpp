@@ -113,6 +113,8 @@ class DeviceBoard {
 
   // ---- the driver sanitizer -------------------------------------------------------
 
+  /// Where the board's diagnostics go.
+  DiagnosticLog& log() { return log_; }
   /// The board's check settings (check=, check.allow=).
   CheckConfig check_config();
   /// Changes them (L6470EMU_CHECK over the description's check=).

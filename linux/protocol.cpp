@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <sstream>
@@ -87,6 +88,19 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
   }
 }
 
+namespace {
+
+// check=error: the client's run ends with the report (its preload exits); the daemon says so in
+// its own log and goes on serving the others.
+void failed_check(DeviceBoard& board, const std::string& report, std::vector<std::uint8_t>& out) {
+  const std::string first = report.substr(0, report.find('\n'));
+  board.log().line(first.substr(std::min(first.size(), first.find("driver sanitizer"))) +
+                   " [check=error: the client's run ends]");
+  out.assign(report.begin(), report.end());
+}
+
+}  // namespace
+
 void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet, ReplyHeader& reply,
                    std::vector<std::uint8_t>& out, int& pass_fd) {
   reply = {};
@@ -155,7 +169,7 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
       std::string report;
       reply.result = board.spi_message(req.handle, xfers, tx, out, &report);
       if (reply.result < 0) out.clear();
-      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());  // the client ends with it
+      if (reply.result == kCheckFailed) failed_check(board, report, out);  // the client ends with it
       return;
     }
     case Op::spi_read: {
@@ -167,13 +181,13 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
       std::string report;
       reply.result = board.spi_read(req.handle, out, &report);
       if (reply.result < 0) out.clear();
-      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());
+      if (reply.result == kCheckFailed) failed_check(board, report, out);
       return;
     }
     case Op::spi_write: {
       std::string report;
       reply.result = board.spi_write(req.handle, payload, &report);
-      if (reply.result == kCheckFailed) out.assign(report.begin(), report.end());
+      if (reply.result == kCheckFailed) failed_check(board, report, out);
       return;
     }
     case Op::control: {

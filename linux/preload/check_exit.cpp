@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <mutex>
 #include <set>
@@ -29,8 +30,11 @@ void end_run_for_check(const std::string& report) {
   {
     Guard guard;
     raw_write_all(2, report.data(), report.size());
-    log_line(report.substr(0, report.find('\n')) + " (the run ends with exit status " +
-             std::to_string(kSanitizerExitStatus) + ")");
+    if (!log_is_stderr()) {
+      const std::string first = report.substr(0, report.find('\n'));
+      log_line(first.substr(std::min(first.size(), first.find("driver sanitizer"))) + " (the run ends with exit status " +
+               std::to_string(kSanitizerExitStatus) + ")");
+    }
   }
   _exit(kSanitizerExitStatus);
 }

@@ -225,4 +225,6 @@ void log_line(std::string_view text) {
   if (g_log) g_log->line(text);
 }
 
+bool log_is_stderr() { return g_config == nullptr || g_config->log == "stderr"; }
+
 }  // namespace l6470emu::preload
