@@ -21,8 +21,11 @@ namespace {
 constexpr const char* kKnown[] = {
     "L6470EMU_CHAIN", "L6470EMU_CONFIG", "L6470EMU_SOCKET", "L6470EMU_LOG",         "L6470EMU_TRACE",
     "L6470EMU_SHM",   "L6470EMU_CHECK",  "L6470EMU_CHECK_ALLOW",
-    // read by the l6470emu program and the test suite, not by the preload: known all the same
-    "L6470EMU_PYTHON", "L6470EMU_PYTHONPATH", "L6470EMU_SOURCE_DIR", "L6470EMU_UPDATE_FIXTURES", nullptr};
+    // read by the l6470emu program, the Python package, the benchmarks and the test suite, not
+    // by the preload: known all the same
+    "L6470EMU_PYTHON", "L6470EMU_PYTHONPATH", "L6470EMU_PRELOAD", "L6470EMU_PROGRAM", "L6470EMU_SOURCE_DIR",
+    "L6470EMU_UPDATE_FIXTURES", "L6470EMU_BUILD", "L6470EMU_SOURCE", "L6470EMU_VM_TIMEOUT", "L6470EMU_VM_KEEP",
+    "L6470EMU_WORKLOAD", nullptr};
 
 }  // namespace
 
