@@ -27,7 +27,7 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     cs->wire.assign(cs->chain.size(), initial);
     cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
     cs->checker = std::make_unique<ChainChecker>(sanitizer_, cs->chain, cs->name, numbering_);
-    cs->bus = std::make_unique<ChainBus>(cs->chain, *cs->checker);
+    cs->bus = std::make_unique<ChainBus>(cs->chain, cs->chain, *cs->checker);
     // The chips' diagnostics (WRONG_CMD, NOTPERF_CMD, dropped bits and answers) are rules the
     // sanitizer names: logged (rate-limited) under check=warn, the run's end under check=error.
     for (std::size_t k = 0; k < cs->chain.size(); ++k) {

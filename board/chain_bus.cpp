@@ -20,12 +20,12 @@ void ChainBus::select_wire() {
     host_selected_ = true;
     return;
   }
-  if (dev_->selected()) return;
+  if (chain_->selected()) return;
   if (timed_)
-    dev_->select_wire();
+    dev_ == chain_ ? chain_->select_wire() : dev_->select_wire();
   else
     dev_->select();
-  checker_->selected(dev_->now(), timed_);
+  checker_->selected(chain_->now(), timed_);
 }
 
 std::uint8_t ChainBus::exchange(std::uint8_t mosi) {
@@ -39,8 +39,11 @@ void ChainBus::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::ui
     std::fill(rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()), std::uint8_t{0});
     return;
   }
-  if (dev_->selected()) checker_->clocked(tx, wire, dev_->now());
-  dev_->exchange_wire(tx, rx, wire);
+  checker_->clocked(tx, wire, chain_->now());  // (nothing while CS is high)
+  if (dev_ == chain_)
+    chain_->exchange_wire(tx, rx, wire);  // (a direct call: Chain is final)
+  else
+    dev_->exchange_wire(tx, rx, wire);
 }
 
 void ChainBus::deselect_wire() {
@@ -48,10 +51,10 @@ void ChainBus::deselect_wire() {
     host_selected_ = false;
     return;
   }
-  if (!dev_->selected()) return;
+  if (!chain_->selected()) return;
   checker_->deselecting();
-  dev_->deselect_wire();
-  checker_->deselected(dev_->now());
+  dev_ == chain_ ? chain_->deselect_wire() : dev_->deselect_wire();
+  checker_->deselected(chain_->now());
 }
 
 }  // namespace l6470emu

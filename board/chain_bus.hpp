@@ -4,6 +4,7 @@
 #pragma once
 
 #include "board/sanitizer.hpp"
+#include "daisychain/chain.hpp"
 #include "spi/spi_device.hpp"
 #include "spi/wire.hpp"
 
@@ -15,8 +16,8 @@ namespace l6470emu {
 /// chain is never selected: bytes reach nothing, MISO reads 0x00, time still passes.
 class ChainBus final : public SpiDevice {
  public:
-  /// `device` is the chain or its recording, `checker` the chain's checks; both outlive the bus.
-  ChainBus(SpiDevice& device, ChainChecker& checker) : dev_(&device), checker_(&checker) {}
+  /// `device` is `chain` or its recording, `checker` the chain's checks; all outlive the bus.
+  ChainBus(SpiDevice& device, Chain& chain, ChainChecker& checker) : dev_(&device), chain_(&chain), checker_(&checker) {}
 
   /// The device the bytes go to (the chain, or its recording while it is recorded).
   void set_device(SpiDevice& device) { dev_ = &device; }
@@ -34,15 +35,17 @@ class ChainBus final : public SpiDevice {
   std::uint8_t exchange(std::uint8_t mosi) override;
   void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override { exchange_wire(tx, rx, wire_); }
   void deselect() override { deselect_wire(); }
-  bool selected() const override { return wire_.cs_active_high ? host_selected_ : dev_->selected(); }
+  bool selected() const override { return wire_.cs_active_high ? host_selected_ : chain_->selected(); }
   void select_wire() override;
   void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override;
   void deselect_wire() override;
-  Tick now() const override { return dev_->now(); }
-  void advance_to(Tick tick) override { dev_->advance_to(tick); }
+  // Time is the chain's (a recording only forwards it).
+  Tick now() const override { return chain_->now(); }
+  void advance_to(Tick tick) override { chain_->advance_to(tick); }
 
  private:
   SpiDevice* dev_;
+  Chain* chain_;
   ChainChecker* checker_;
   WireSettings wire_;
   bool host_selected_ = false;  // CS active high: the host's CS is asserted (the chain's is not)

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "daisychain/explain.hpp"
 #include "daisychain/protocol_tracker.hpp"
 #include "spi/message.hpp"
 
@@ -139,22 +140,16 @@ Violation ChainChecker::make(Rule rule, std::optional<std::size_t> chip, std::op
   return v;
 }
 
-void ChainChecker::begin_use(const WireSettings& wire) {
-  frames_in_use_ = 0;
-  if (!on()) return;
-  if (wire.cs_active_high && !reported_cs_high_) {
-    reported_cs_high_ = true;
+void ChainChecker::check_cs_polarity(const WireSettings& wire) {
+  reported_cs_high_ = wire.cs_active_high;
+  if (wire.cs_active_high)
     sanitizer_.report(make(Rule::CS_ACTIVE_HIGH, std::nullopt, std::nullopt,
                            "the host asserts CS high; the chip's CS is active low, so it is never selected: no byte "
                            "reaches it and MISO reads 0x00"));
-  } else if (!wire.cs_active_high) {
-    reported_cs_high_ = false;
-  }
 }
 
 void ChainChecker::check_settings(const WireSettings& wire) {
   checked_ = wire;
-  checked_any_ = true;
   const std::optional<std::uint64_t> byte = frame_bytes_;
   const unsigned mode = wire.mode & 3u;
   if (mode != 3 && static_cast<int>(mode) != reported_mode_) {
@@ -196,14 +191,7 @@ void ChainChecker::check_settings(const WireSettings& wire) {
   }
 }
 
-void ChainChecker::selected(Tick tick, bool timed) {
-  ++frame_;
-  frame_bytes_ = 0;
-  in_frame_ = true;
-  cs_fall_ = tick;
-  timed_settings_ = true;
-  keep_mosi_ = false;
-  if (!on()) return;
+void ChainChecker::selected_checks(Tick tick, bool timed) {
   if (timed && last_frame_had_bytes_ && tick - last_deselect_ < kDeselectMinTicks) {
     const Tick high = tick - last_deselect_;
     sanitizer_.report(make(Rule::CS_DESELECT_TIME, std::nullopt, std::nullopt,
@@ -218,10 +206,9 @@ void ChainChecker::selected(Tick tick, bool timed) {
   }
 }
 
-void ChainChecker::clocked(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick) {
-  if (!in_frame_ || tx.empty()) return;
-  if (on()) {
-    if (!checked_any_ || !(wire == checked_)) check_settings(wire);
+void ChainChecker::clocked_checks(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick) {
+  {
+    if (!(wire == checked_)) check_settings(wire);
     if (frame_bytes_ == 0 && wire.cs_setup_timed && wire.speed_hz != 0) {
       const Tick clocks = tx.size() * transfer_ticks(1, wire.speed_hz);
       const Tick first_edge = tick >= clocks ? tick - clocks : 0;
@@ -234,14 +221,13 @@ void ChainChecker::clocked(std::span<const std::uint8_t> tx, const WireSettings&
     }
     if (keep_mosi_) mosi_.insert(mosi_.end(), tx.begin(), tx.end());
   }
-  frame_bytes_ += tx.size();
 }
 
-void ChainChecker::deselecting() {
-  in_decode_ = true;
-  if (!on() || frame_bytes_ == 0) return;
+void ChainChecker::deselecting_checks() {
   const std::size_t n = chain_.size(), len = static_cast<std::size_t>(frame_bytes_);
-  if (len % n != 0) {
+  if (len == n) {
+    // the usual frame
+  } else if (len % n != 0) {
     std::string what = std::to_string(len) + " byte" + (len == 1 ? "" : "s") + " in a frame for a chain of " +
                        std::to_string(n) + ": ";
     if (len < n) {
@@ -276,16 +262,71 @@ void ChainChecker::deselecting() {
   }
 }
 
-void ChainChecker::deselected(Tick tick) {
-  in_decode_ = false;
-  in_frame_ = false;
-  last_frame_had_bytes_ = frame_bytes_ > 0;
-  last_deselect_ = tick;
-  if (frame_bytes_ > 0) ++frames_in_use_;
+void ChainChecker::check_decode(std::size_t k, const Chip& chip, std::uint8_t byte) {
+  // An answer a new GetParam, GetStatus or ResetDevice drops, or a command's last argument byte
+  // with bits the chip drops: the chips raise no flag for either, so the checker looks before
+  // they decode.
+  if (!chip.spi_enabled()) return;
+  const std::size_t len = static_cast<std::size_t>(frame_bytes_);
+  if (chip.arguments_missing() == 1) {
+    check_unused_bits(k, chip, (chip.arguments_so_far() << 8) | byte, decoded_at(len, k));
+    return;
+  }
+  // Only GetParam (0x20-0x3F), GetStatus and ResetDevice drop an answer.
+  if (((byte & 0xE0) != 0x20 && byte != 0xD0 && byte != 0xC0) || chip.collecting_arguments()) return;
+  const Command c = chip.variant().opcodes[byte].command;
+  if (c != Command::GetParam && c != Command::GetStatus && c != Command::ResetDevice) return;
+  const std::uint8_t pending = chip.answer_bytes_pending();
+  sanitizer_.report(make(Rule::ANSWER_LOST, k, decoded_at(len, k),
+                         std::to_string(pending) + " byte" + (pending == 1 ? "" : "s") +
+                             " of an earlier answer never shifted out: " + opcode_name(byte, chip.registers()) +
+                             (c == Command::ResetDevice ? " drops it" : " replaces it")));
 }
 
-void ChainChecker::end_use() {
-  if (!on() || frames_in_use_ < 2) return;
+std::optional<std::uint64_t> ChainChecker::decoded_at(std::size_t len, std::size_t chip) const {
+  if (const auto b = mosi_byte_decoded_by(len, chain_.size(), chip)) return *b;
+  return std::nullopt;
+}
+
+void ChainChecker::check_unused_bits(std::size_t k, const Chip& chip, std::uint32_t arg,
+                                     std::optional<std::uint64_t> where) {
+  // The bits of the argument bytes the command or register has; a signed position may carry its
+  // sign into the bits above (a sign-extended value is the same position).
+  const Opcode& op = chip.collecting_opcode();
+  unsigned bits = 0;
+  const unsigned bytes = op.arg_bytes;
+  bool is_signed = false;
+  std::string name, what;
+  switch (op.command) {
+    case Command::SetParam: {
+      const RegisterInfo* r = chip.registers().at_address(op.param);
+      if (r == nullptr || r->access == Access::R) return;
+      bits = r->bits;
+      is_signed = r->is_signed();
+      name = "SetParam(" + std::string(r->name) + ")";
+      what = "the register has";
+      break;
+    }
+    case Command::Move: bits = 22; name = "Move"; what = "N_STEP has"; break;
+    case Command::GoTo: bits = 22; is_signed = true; name = "GoTo"; what = "ABS_POS has"; break;
+    case Command::GoTo_DIR: bits = 22; is_signed = true; name = "GoTo_DIR"; what = "ABS_POS has"; break;
+    case Command::Run: bits = 20; name = "Run"; what = "SPD has"; break;
+    case Command::GoUntil: bits = 20; name = "GoUntil"; what = "SPD has"; break;
+    default: return;
+  }
+  if (bits >= 8 * bytes) return;
+  const std::uint32_t all = bytes >= 4 ? 0xFFFFFFFFu : (1u << (8 * bytes)) - 1u;
+  const std::uint32_t mask = (1u << bits) - 1u;
+  const std::uint32_t extra = arg & all & ~mask;
+  if (extra == 0) return;
+  if (is_signed && ((arg >> (bits - 1)) & 1u) != 0 && extra == (all & ~mask)) return;  // sign-extended
+  sanitizer_.report(make(Rule::UNUSED_BITS, k, where,
+                         name + " value " + hex_value(arg & all, 8 * bytes) + " has bits above the " +
+                             std::to_string(bits) + " " + what + " (" + hex_value(extra, 8 * bytes) +
+                             "): the chip keeps " + hex_value(arg & mask, 8 * bytes)));
+}
+
+void ChainChecker::check_split() {
   const std::size_t n = chain_.size();
   std::optional<std::size_t> waiting, done;
   for (std::size_t k = 0; k < n; ++k) {
@@ -314,8 +355,6 @@ void ChainChecker::chip_diagnostic(std::size_t chip, const Diagnostic& d) {
   switch (d.kind) {
     case DiagnosticKind::wrong_cmd: rule = Rule::WRONG_CMD; break;
     case DiagnosticKind::notperf_cmd: rule = Rule::NOTPERF_CMD; break;
-    case DiagnosticKind::unused_bits: rule = Rule::UNUSED_BITS; break;
-    case DiagnosticKind::answer_lost: rule = Rule::ANSWER_LOST; break;
     case DiagnosticKind::ignored: return;
   }
   if (d.detail == DiagnosticDetail::read_only_write) rule = Rule::READ_ONLY_WRITE;

@@ -82,18 +82,53 @@ class ChainChecker {
   ChainChecker(Sanitizer& sanitizer, const Chain& chain, std::string name, NumberFrom numbering = NumberFrom::miso);
 
   /// A bus use begins (a message): `wire` is how the host drives the bus.
-  void begin_use(const WireSettings& wire);
+  void begin_use(const WireSettings& wire) {
+    frames_in_use_ = 0;
+    if (wire.cs_active_high != reported_cs_high_ && on()) check_cs_polarity(wire);
+  }
   /// The use ends: a message of several frames that leaves some chips mid-command (COMMAND_SPLIT).
-  void end_use();
+  void end_use() {
+    if (frames_in_use_ >= 2 && on()) check_split();
+  }
   /// CS fell at `tick` (the chain is selected); `timed`: the CS edges' times are the host's
   /// (t_disCS is checked).
-  void selected(Tick tick, bool timed = true);
+  void selected(Tick tick, bool timed = true) {
+    ++frame_;
+    frame_bytes_ = 0;
+    in_frame_ = true;
+    cs_fall_ = tick;
+    keep_mosi_ = false;
+    if (!on()) return;
+    if ((timed && last_frame_had_bytes_ && tick - last_deselect_ < kDeselectMinTicks) || chain_.standby_in_frame())
+      selected_checks(tick, timed);
+  }
   /// `tx` is about to be clocked with `wire` (the clocks ended at `tick`, as run_message charges them).
-  void clocked(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick);
+  void clocked(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick) {
+    if (!in_frame_ || tx.empty()) return;
+    // The usual byte: settings as checked before, not the frame's first, no chip in standby.
+    if (on() && ((frame_bytes_ == 0 && wire.cs_setup_timed) || keep_mosi_ || !(wire == checked_)))
+      clocked_checks(tx, wire, tick);
+    frame_bytes_ += tx.size();
+  }
   /// CS is about to rise: the chips are about to decode their registers.
-  void deselecting();
+  void deselecting() {
+    in_decode_ = true;
+    if (!on() || frame_bytes_ == 0) return;
+    if (frame_bytes_ != chain_.size() || keep_mosi_) deselecting_checks();
+    // What each chip is about to decode, against what it holds (check_decode): most chips have
+    // neither an answer pending nor a last argument byte coming, two loads each.
+    chain_.for_each_register([this](std::size_t k, const Chip& chip, std::uint8_t byte) {
+      if (chip.answer_bytes_pending() != 0 || chip.arguments_missing() == 1) check_decode(k, chip, byte);
+    });
+  }
   /// CS rose at `tick` (the chips decoded).
-  void deselected(Tick tick);
+  void deselected(Tick tick) {
+    in_decode_ = false;
+    in_frame_ = false;
+    last_frame_had_bytes_ = frame_bytes_ > 0;
+    last_deselect_ = tick;
+    if (frame_bytes_ > 0) ++frames_in_use_;
+  }
   /// A diagnostic of chip `chip` (chain index).
   void chip_diagnostic(std::size_t chip, const Diagnostic& d);
 
@@ -103,7 +138,15 @@ class ChainChecker {
  private:
   Violation make(Rule rule, std::optional<std::size_t> chip, std::optional<std::uint64_t> byte, std::string what) const;
   bool on() const { return sanitizer_.level() != CheckLevel::off; }
+  void clocked_checks(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick);
+  void check_cs_polarity(const WireSettings& wire);
+  void check_split();
+  void selected_checks(Tick tick, bool timed);
+  void deselecting_checks();
   void check_settings(const WireSettings& wire);
+  void check_decode(std::size_t chip, const Chip& c, std::uint8_t byte);
+  std::optional<std::uint64_t> decoded_at(std::size_t frame_len, std::size_t chip) const;
+  void check_unused_bits(std::size_t chip, const Chip& c, std::uint32_t arg, std::optional<std::uint64_t> byte);
 
   Sanitizer& sanitizer_;
   const Chain& chain_;
@@ -121,8 +164,7 @@ class ChainChecker {
   // The message.
   std::uint64_t frames_in_use_ = 0;
   // Settings already reported (once per distinct problem): the last bad value of each.
-  WireSettings checked_{};
-  bool checked_any_ = false;
+  WireSettings checked_{0, false, false, 255, 0, false};  // no host has 255-bit words: the first settings are checked
   int reported_mode_ = -1, reported_bits_ = -1;
   bool reported_lsb_ = false, reported_cs_high_ = false;
   std::uint32_t reported_speed_ = 0;

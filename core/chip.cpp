@@ -77,7 +77,6 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
       collecting_ = false;
-      if (sink_) check_unused_bits(pending_, arg_);
       execute(pending_, arg_);
       if (axis_) axis_after_change();
     }
@@ -186,7 +185,6 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
     case Command::ResetDevice:
       if (!motion_.hiz && reset_device_refused_when_enabled())
         return not_performable("ResetDevice while the bridges are enabled");
-      if (response_left_ != 0 && sink_) answer_dropped("ResetDevice dropped it");
       reset_logic();
       come_out_of_reset();
       return;
@@ -358,47 +356,6 @@ void Chip::not_performable(const char* what, DiagnosticDetail detail) {
   latched_.notperf_cmd = true;
   latched_changed();
   if (sink_) sink_({now_, DiagnosticKind::notperf_cmd, what, detail});
-}
-
-void Chip::answer_dropped(const char* by) {
-  const unsigned left = response_left_;
-  sink_({now_, DiagnosticKind::answer_lost,
-         std::to_string(left) + " byte" + (left == 1 ? "" : "s") + " of an earlier answer never shifted out (" + by + ")"});
-}
-
-void Chip::check_unused_bits(const Opcode& op, std::uint32_t arg) {
-  // The bits of the argument bytes the command or register has; a signed position may carry
-  // its sign into the bits above (a sign-extended value means the same position).
-  unsigned bits = 0, bytes = op.arg_bytes;
-  bool is_signed = false;
-  const char* what = "";
-  std::string name;
-  switch (op.command) {
-    case Command::SetParam: {
-      const RegisterInfo* r = table_->at_address(op.param);
-      if (r == nullptr || r->access == Access::R) return;
-      bits = r->bits;
-      is_signed = r->is_signed();
-      name = "SetParam(" + std::string(r->name) + ")";
-      what = "the register has";
-      break;
-    }
-    case Command::Move: bits = 22; name = "Move"; what = "N_STEP has"; break;
-    case Command::GoTo: bits = 22; is_signed = true; name = "GoTo"; what = "ABS_POS has"; break;
-    case Command::GoTo_DIR: bits = 22; is_signed = true; name = "GoTo_DIR"; what = "ABS_POS has"; break;
-    case Command::Run: bits = 20; name = "Run"; what = "SPD has"; break;
-    case Command::GoUntil: bits = 20; name = "GoUntil"; what = "SPD has"; break;
-    default: return;
-  }
-  if (bits >= 8 * bytes) return;
-  const std::uint32_t all = bytes >= 4 ? 0xFFFFFFFFu : (1u << (8 * bytes)) - 1u;
-  const std::uint32_t mask = (1u << bits) - 1u;
-  const std::uint32_t extra = arg & all & ~mask;
-  if (extra == 0) return;
-  if (is_signed && ((arg >> (bits - 1)) & 1u) != 0 && extra == (all & ~mask)) return;  // sign-extended
-  sink_({now_, DiagnosticKind::unused_bits,
-         name + " value " + hex(arg & all, 2 * bytes) + " has bits above the " + std::to_string(bits) + " " + what +
-             " (" + hex(extra, 2 * bytes) + "): the chip keeps " + hex(arg & mask, 2 * bytes)});
 }
 
 // ---------------------------------------------------------------- time

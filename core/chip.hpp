@@ -51,9 +51,15 @@ class Chip {
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
   bool collecting_arguments() const { return collecting_; }
-  /// While collecting_arguments(): the command being collected and how many argument bytes it still needs.
+  /// While collecting_arguments(): the command being collected (its opcode's decoding), how many
+  /// argument bytes it still needs and the ones it has, MSB first (for the sanitizer, board/).
   Command collecting_command() const { return collecting_ ? pending_.command : Command::NOP; }
+  const Opcode& collecting_opcode() const { return pending_; }
   std::uint8_t arguments_missing() const { return collecting_ ? static_cast<std::uint8_t>(pending_.arg_bytes - args_seen_) : 0; }
+  std::uint32_t arguments_so_far() const { return collecting_ ? arg_ : 0; }
+  /// Bytes of the GetParam/GetStatus answer not yet loaded into the shift register (a new
+  /// GetParam or GetStatus drops them).
+  std::uint8_t answer_bytes_pending() const { return response_left_; }
 
   /// Whether the chip takes part in SPI (false while STBY/RST is held low).
   bool spi_enabled() const { return stby_level_; }
@@ -162,14 +168,9 @@ class Chip {
   void exec_set_param(std::uint8_t address, std::uint32_t value);
   void write_register(const RegisterInfo& r, std::uint32_t value);
   void load_response(std::uint32_t value, std::uint8_t bytes) {
-    if (response_left_ != 0 && sink_) answer_dropped("a new GetParam/GetStatus replaced it");
     response_ = value;
     response_left_ = bytes;
   }
-  /// Diagnostics only a sink hears of (no STATUS flag): an answer dropped before all its
-  /// bytes were shifted out, a value with bits the register or argument lacks.
-  void answer_dropped(const char* by);
-  void check_unused_bits(const Opcode& op, std::uint32_t arg);
   void refresh_profile();
   void clear_status_on_get_status() {
     if (!latched_clean_) clear_latches();

@@ -1,6 +1,5 @@
-// Diagnostics: host mistakes the chip notices (unknown opcodes, refused commands, values with
-// bits it drops, answers it drops). The chip reports them to an optional sink; it never stops
-// because of them.
+// Diagnostics: host mistakes the chip notices (unknown opcodes, refused commands).
+// The chip reports them to an optional sink; it never stops because of them.
 #pragma once
 
 #include <cstdint>
@@ -16,8 +15,6 @@ enum class DiagnosticKind : std::uint8_t {
   wrong_cmd,    ///< byte that is no command, or a register address that does not exist
   notperf_cmd,  ///< command refused in the current state
   ignored,      ///< a byte or pin change the chip ignored (standby, ...)
-  unused_bits,  ///< a SetParam value or command argument with bits the chip drops (no flag raised)
-  answer_lost,  ///< a GetParam/GetStatus answer replaced before all its bytes were shifted out (no flag)
 };
 
 /// More about a wrong_cmd or notperf_cmd diagnostic.

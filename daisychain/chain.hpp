@@ -75,7 +75,16 @@ class Chain final : public SpiDevice {
   /// chips had no time to load their answers, so each register still holds the byte it received.
   void select_wire() override;
   /// Clocks `tx` as a host with `wire` settings does; rx gets what the host reads.
-  void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override;
+  void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override {
+    if (tx.size() == 1 && selected_ && wire.mode == 3 && !wire.lsb_first && !standby_in_frame_) {
+      // One byte on the byte path (a clock-idle-high byte: the latches are where previous_bit0 says).
+      rx[0] = last_out0_ = exchange(tx[0]);
+      mosi_level_ = tx[0] & 1u;
+      latch_at_ = LatchAt::previous_bit0;
+      return;
+    }
+    exchange_wire_bytes(tx, rx, wire);
+  }
   /// CS rising edge: as deselect(), keeping each chip's SDO latch for the next frame.
   void deselect_wire() override;
   /// One CS frame of a host with `wire` settings: select_wire, exchange_wire, deselect_wire.
@@ -84,6 +93,13 @@ class Chain final : public SpiDevice {
   std::uint8_t sdo_latch(std::size_t i) const;
   /// Whether some chip was in standby at the last CS falling edge (its bytes are lost).
   bool standby_in_frame() const { return standby_in_frame_; }
+  /// Calls f(i, chip i, the byte in its register) for every chip, chip 0 first, as they stand:
+  /// no side effects (the sanitizer looks at what the chips are about to decode).
+  template <typename F>
+  void for_each_register(F&& f) const {
+    const std::size_t n = ring_.size();
+    for (std::size_t i = 0, slot = head_; i < n; ++i, slot = slot + 1 == n ? 0 : slot + 1) f(i, chips_[i], ring_[slot]);
+  }
   /// Chip `i` as it stands, without bringing it up to the chain's time or any other side effect
   /// (for looking at what does not depend on time: its decoder, its STBY level).
   const Chip& peek_chip(std::size_t i) const { return chips_.at(i); }
@@ -107,10 +123,12 @@ class Chain final : public SpiDevice {
   Tick now_ = 0;
 
   // ---- the bit-level interface's state (chain_wire.cpp) ----
-  /// Where each chip's SDO latch is to be found: stored in latch_, or (inside a frame, no chip
-  /// in standby) as the top bit of its register after a clock-idle-low byte, or as bit 0 of the
-  /// register downstream (of the byte chip 0 sent last, for chip 0) after a clock-idle-high one.
-  enum class LatchAt : std::uint8_t { stored, register_msb, previous_bit0 };
+  /// Where each chip's SDO latch is to be found: stored in latch_, or (no chip in standby) as the
+  /// top bit of its register after a clock-idle-low byte, or as bit 0 of the register downstream
+  /// (of the byte chip 0 sent last, for chip 0) after a clock-idle-high one; after the CS rising
+  /// edge the same in received_, the registers as they were before the chips decoded them.
+  enum class LatchAt : std::uint8_t { stored, register_msb, previous_bit0, received_msb, received_bit0 };
+  void exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire);
   std::uint8_t wire_byte(std::uint8_t host_byte, const WireSettings& wire);
   void apply_stale_latches();
   void store_latches();

@@ -3,6 +3,7 @@
 // first stays on the byte path (chain.cpp). Does not model CS polarity (the front's) or clocks
 // that stop inside a byte.
 #include <algorithm>
+#include <cstring>
 
 #include "daisychain/chain.hpp"
 
@@ -23,6 +24,8 @@ std::uint8_t Chain::latch_at(std::size_t i) const {
     case LatchAt::stored: return i < latch_.size() ? latch_[i] : 0;
     case LatchAt::register_msb: return shift_register(i) >> 7;
     case LatchAt::previous_bit0: return (i == 0 ? last_out0_ : shift_register(i - 1)) & 1u;
+    case LatchAt::received_msb: return received_[i] >> 7;
+    case LatchAt::received_bit0: return (i == 0 ? last_out0_ : received_[i - 1]) & 1u;
   }
   return 0;
 }
@@ -35,6 +38,8 @@ std::uint8_t Chain::sdo_latch(std::size_t i) const {
 void Chain::store_latches() {
   if (latch_.size() != chips_.size()) latch_.assign(chips_.size(), 0);
   if (latch_at_ == LatchAt::stored) return;
+  if (latch_at_ == LatchAt::received_msb || latch_at_ == LatchAt::received_bit0)
+    received_.resize(chips_.size());  // (sized by the deselect_wire that chose these)
   // Chip 0 first: previous_bit0 reads the register downstream, which stays as it is.
   for (std::size_t i = 0; i < chips_.size(); ++i) latch_[i] = latch_at(i);
   latch_at_ = LatchAt::stored;
@@ -57,7 +62,9 @@ std::uint8_t Chain::wire_byte(std::uint8_t host_byte, const WireSettings& wire) 
   const std::uint8_t w = wire.lsb_first ? reverse_bits(host_byte) : host_byte;  // in the order it goes out
   if (bytes_in_frame_ == 0) {
     mosi_level_ = kMosiIdleLevel;
-    if (latch_at_ != LatchAt::stored) store_latches();  // the frame before ended with a plain deselect()
+    // After a deselect_wire the latches are in received_; after a plain deselect() the
+    // registers hold answers now, so this is the best that can be said.
+    if (latch_at_ == LatchAt::register_msb || latch_at_ == LatchAt::previous_bit0) store_latches();
   }
   if (fx.stale_first_bit && latch_at_ != LatchAt::register_msb) apply_stale_latches();
   const std::uint8_t latch0 = fx.miso_one_bit_late ? latch_at(0) : 0;
@@ -82,7 +89,7 @@ std::uint8_t Chain::wire_byte(std::uint8_t host_byte, const WireSettings& wire) 
   return wire.lsb_first ? reverse_bits(miso) : miso;
 }
 
-void Chain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) {
+void Chain::exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) {
   if (!selected_) {
     // CS high: SDO is high impedance and the chips ignore the clock (their latches included).
     std::fill(rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()), std::uint8_t{0});
@@ -90,8 +97,12 @@ void Chain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8
   }
   if (tx.empty()) return;
   if (wire.mode == 3 && !wire.lsb_first && !standby_in_frame_) {
-    if (bytes_in_frame_ == 0 && latch_at_ != LatchAt::stored) store_latches();
-    exchange(tx, rx);  // the byte path
+    // The byte path. A clock-idle-high byte leaves every latch where previous_bit0 finds it,
+    // whatever the frame's earlier bytes left.
+    if (tx.size() == 1)
+      rx[0] = exchange(tx[0]);
+    else
+      exchange(tx, rx);
     last_out0_ = rx[tx.size() - 1];
     mosi_level_ = tx[tx.size() - 1] & 1u;
     latch_at_ = LatchAt::previous_bit0;
@@ -104,10 +115,23 @@ void Chain::deselect_wire() {
   if (!selected_) return;
   answers_loaded_ = bytes_in_frame_ > 0;
   if (answers_loaded_) {
-    store_latches();
-    const std::size_t n = chips_.size();
-    received_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) received_[i] = shift_register(i);
+    // The registers before the chips decode them: where the latches are, and what a deselect
+    // shorter than t_disCS leaves in them. One copy, in chip order.
+    const std::size_t n = ring_.size();
+    if (received_.size() != n) {
+      if (latch_at_ == LatchAt::received_msb || latch_at_ == LatchAt::received_bit0) store_latches();
+      received_.resize(n);
+    }
+    if (n <= 16) {
+      for (std::size_t i = 0, slot = head_; i < n; ++i, slot = slot + 1 == n ? 0 : slot + 1) received_[i] = ring_[slot];
+    } else {
+      std::memcpy(received_.data(), ring_.data() + head_, n - head_);
+      std::memcpy(received_.data() + (n - head_), ring_.data(), head_);
+    }
+    if (latch_at_ == LatchAt::register_msb)
+      latch_at_ = LatchAt::received_msb;
+    else if (latch_at_ == LatchAt::previous_bit0)
+      latch_at_ = LatchAt::received_bit0;
   }
   deselect_tick_ = now_;
   deselect();

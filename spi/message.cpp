@@ -23,26 +23,18 @@ void run_message(SpiDevice& dev, std::span<const SpiTransfer> transfers, const B
     wire.speed_hz = speed;
     wire.bits_per_word = t.bits_per_word ? t.bits_per_word : timing.wire.bits_per_word;
     const Tick per_byte = transfer_ticks(1, speed);
-    if (t.tx.empty() && t.rx.empty()) {
-      // No buffers (the kernel allows up to INT_MAX bytes of them): zeros out, MISO dropped,
-      // a block at a time; the bytes carry no time of their own inside a frame, so the block's
-      // time passes first.
-      static constexpr std::uint8_t kZeros[4096] = {};
-      std::uint8_t sink[sizeof kZeros];
-      for (std::uint32_t k = 0; k < t.len;) {
-        const std::uint32_t block = std::min<std::uint32_t>(t.len - k, sizeof kZeros);
-        dev.advance_to(dev.now() + per_byte * block);
-        dev.exchange_wire(std::span<const std::uint8_t>(kZeros, block), std::span<std::uint8_t>(sink, block), wire);
-        k += block;
-      }
-    } else {
-      for (std::uint32_t k = 0; k < t.len; ++k) {
-        const std::uint8_t out = t.tx.empty() ? 0 : t.tx[k];
-        std::uint8_t in = 0;
-        dev.advance_to(dev.now() + per_byte);
-        dev.exchange_wire(std::span<const std::uint8_t>(&out, 1), std::span<std::uint8_t>(&in, 1), wire);
-        if (!t.rx.empty()) t.rx[k] = in;
-      }
+    // A block of bytes at a time (a whole transfer, up to 4096 bytes): the bytes carry no time
+    // of their own inside a frame (the chips decode at the CS rising edge), so the block's time
+    // passes first. Without a tx buffer zeros go out; without an rx buffer MISO is dropped (the
+    // kernel allows up to INT_MAX bytes of a bufferless transfer).
+    static constexpr std::uint8_t kZeros[4096] = {};
+    std::uint8_t sink[sizeof kZeros];
+    for (std::uint32_t k = 0; k < t.len;) {
+      const std::uint32_t block = std::min<std::uint32_t>(t.len - k, sizeof kZeros);
+      dev.advance_to(dev.now() + per_byte * block);
+      dev.exchange_wire(t.tx.empty() ? std::span<const std::uint8_t>(kZeros, block) : t.tx.subspan(k, block),
+                        t.rx.empty() ? std::span<std::uint8_t>(sink, block) : t.rx.subspan(k, block), wire);
+      k += block;
     }
     if (t.gap_ticks) dev.advance_to(dev.now() + t.gap_ticks);
     if (t.delay_usecs) dev.advance_to(dev.now() + ticks_from_us(t.delay_usecs));

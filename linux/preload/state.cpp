@@ -133,6 +133,9 @@ Backend* backend() {
                                                              : make_remote_backend(g_config->socket, g_config->log);
     if (!g_config->socket.empty() && !g_config->trace.empty())
       log_line("trace= / L6470EMU_TRACE is ignored with a daemon: record with `serve --record` or `ctl trace start`");
+    if (!g_config->socket.empty() && (std::getenv("L6470EMU_CHECK") || std::getenv("L6470EMU_CHECK_ALLOW")))
+      log_line("L6470EMU_CHECK / L6470EMU_CHECK_ALLOW are ignored with a daemon: its board checks as its description "
+               "says (serve --chain \"... check=error\")");
     b = made.release();
   } catch (const std::exception& e) {
     log_line(std::string("cannot start the emulator: ") + e.what());

@@ -103,7 +103,7 @@ void bind_chain(py::module_& m) {
   py::class_<ChainDiagnostic>(m, "Diagnostic", "A host mistake a chip noticed (it sets WRONG_CMD / NOTPERF_CMD as the chip would).")
       .def_readonly("tick", &ChainDiagnostic::tick, "when, in 250 ns ticks")
       .def_readonly("chip", &ChainDiagnostic::chip, "which chip")
-      .def_readonly("kind", &ChainDiagnostic::kind, "\"wrong_cmd\", \"notperf_cmd\", \"unused_bits\", \"answer_lost\" or \"ignored\"")
+      .def_readonly("kind", &ChainDiagnostic::kind, "\"wrong_cmd\", \"notperf_cmd\" or \"ignored\"")
       .def_readonly("message", &ChainDiagnostic::message, "what happened, in words")
       .def("__repr__", [](const ChainDiagnostic& d) {
         return "Diagnostic(chip " + std::to_string(d.chip) + ", " + d.kind + ": " + d.message + ")";

@@ -20,7 +20,7 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
   checker_ = std::make_unique<ChainChecker>(*sanitizer_, *chain_, "Chain");
   for (std::size_t k = 0; k < chain_->size(); ++k) {
     chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), checker = checker_.get(), k](const Diagnostic& d) {
-      static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored", "unused_bits", "answer_lost"};
+      static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored"};
       if (store->kept.size() == kMaxDiagnostics) {
         store->kept.pop_front();
         ++store->dropped;
@@ -37,7 +37,7 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
     memory_ = std::make_shared<Trace>();
     rec_ = std::make_unique<RecordingChain>(*chain_, *memory_);
   }
-  bus_ = std::make_unique<ChainBus>(rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_, *checker_);
+  bus_ = std::make_unique<ChainBus>(rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_, *chain_, *checker_);
   bus_->set_untimed();  // time moves only when Python says so
   host_ = std::make_unique<ChainHost>(*chain_, *bus_, frame_gap_);
 }
