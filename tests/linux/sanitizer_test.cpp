@@ -144,6 +144,17 @@ TEST(SanitizerDaemon, TheClientEndsWithTheReportAndTheDaemonServesTheNextOne) {
       << stopped.err << stopped.out;
 }
 
+TEST(SanitizerDaemon, ServeCheckOverridesTheDescription) {
+  const std::string why = missing_prerequisites();
+  if (!why.empty()) GTEST_SKIP() << why;
+  ServeDaemon daemon("bus=0 cs=0 chips=L6470 check=off", {"--virtual-time", "--check", "error"});
+  ASSERT_TRUE(daemon.ready()) << daemon.process().out();
+  const RunResult r = run_program({system_python(), "-c", std::string(kPrelude) + "b(0xE5)\nprint('ran to the end')\n"},
+                                  daemon.env());
+  EXPECT_EQ(r.status, kSanitizerExitStatus) << r.out << r.err;
+  EXPECT_NE(r.err.find("driver sanitizer: WRONG_CMD on spidev0.0, chip 0, frame 1, byte 0"), std::string::npos) << r.err;
+}
+
 TEST(SanitizerDaemon, AWarnDaemonLogsAndServes) {
   const std::string why = missing_prerequisites();
   if (!why.empty()) GTEST_SKIP() << why;
