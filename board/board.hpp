@@ -35,6 +35,16 @@ struct PinEdge {
   Tick tick = 0;          ///< when it changed
 };
 
+/// How a controller clocks a bus for one use (a firmware front's SPI settings). Mode 3, MSB
+/// first is what the chips expect; other settings reach them as the wire gives them
+/// (docs/spi-interface.md) and the sanitizer names them.
+struct BusSettings {
+  std::uint32_t speed_hz = 5'000'000;  ///< SCK; each byte takes transfer_ticks(1, speed_hz)
+  std::uint8_t mode = 3;               ///< SPI mode: CPOL × 2 + CPHA
+  bool lsb_first = false;              ///< the bit order on the wire
+  std::uint8_t bits_per_word = 8;      ///< the controller's word size (words reach the bus as bytes, in wire order)
+};
+
 /// Where the board reports the edges of watched pins (called inside the board's operations).
 using EdgeSink = std::function<void(const PinEdge&)>;
 
@@ -109,6 +119,27 @@ class Board {
   /// Under check=error: the report of the first broken rule since the last call, taken. A front
   /// ends its host's run with it (the preload: exit status kSanitizerExitStatus).
   std::optional<std::string> take_check_failure() { return sanitizer_.take_failure(); }
+
+  // ---- SPI with the chip select on a pin: a firmware front drives CS and clocks bytes itself ----
+
+  /// Drives the chip select of chain `chain` now, as a microcontroller pin does: `selected`
+  /// (low) starts a frame, a rise ends it and the chips decode (recorded, edges reported). The
+  /// edges are timed: a CS low less than t_disCS after the last rise finds the chips' answers
+  /// not loaded, and the sanitizer says so.
+  void drive_chip_select(std::size_t chain, bool selected);
+  /// Whether chain `chain`'s chip select is low.
+  bool chip_selected(std::size_t chain) const;
+  /// Clocks `tx` on a bus whose chains are `chains`: every one of them whose chip select is low
+  /// receives the bytes; `rx` (as long as `tx`) gets MISO (0x00 when none is selected; several
+  /// selected chains drive MISO together, read as the AND of their bytes). The bytes start at
+  /// the board's time, or when the bus's last use ended if later, and each takes the bus time of
+  /// `settings.speed_hz`. Mode 3, MSB first takes the chains' byte path; any other mode or bit
+  /// order is clocked at bit level (Chain::exchange_wire: a mode-0 host reads each chip's stale
+  /// SDO latch as the first bit after CS falls, LSB first arrives bit-reversed). The chains'
+  /// sanitizer checks the settings, t_setCS and the frames (take_check_failure). Returns the end
+  /// tick (the front moves the board's time there).
+  Tick clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                   const BusSettings& settings);
 
   // ---- pins ---------------------------------------------------------------------
 

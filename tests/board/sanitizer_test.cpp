@@ -4,6 +4,8 @@
 // chips' diagnostics, and the levels: off, warn (rate-limited lines), error (one report).
 #include <gtest/gtest.h>
 
+#include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -277,6 +279,71 @@ TEST(SanitizerBoard, TheReportHasEverythingOnItsLinesAndTheRuleTableIsComplete) 
     EXPECT_FALSE(r.about.empty());
     EXPECT_FALSE(r.datasheet.empty());
   }
+}
+
+/// The firmware fronts' own path: CS on a pin (Board::drive_chip_select) and bytes clocked on a
+/// bus with a controller's settings (Board::clock_bytes), as SPI.transfer and HAL_SPI_* do.
+struct PinFront {
+  Board& board;
+  BusSettings settings;
+  std::array<std::size_t, 1> bus{0};
+  void cs(bool low) { board.drive_chip_select(0, low); }
+  std::uint8_t transfer(std::uint8_t mosi) {
+    std::uint8_t miso = 0;
+    board.advance_to(board.clock_bytes(bus, std::span(&mosi, 1), std::span(&miso, 1), settings));
+    return miso;
+  }
+  std::uint8_t frame(std::uint8_t mosi, Tick high = 4, Tick setup = 2) {
+    cs(true);
+    board.advance(setup);
+    const std::uint8_t miso = transfer(mosi);
+    cs(false);
+    board.advance(high);
+    return miso;
+  }
+};
+
+TEST(SanitizerPinFront, AMode0ControllerReadsTheStaleLatchAndIsNamed) {
+  VirtualBoard v("chips=L6470 check=warn");
+  PinFront f{v.board, BusSettings{4'000'000, 0, false}};
+  f.frame(0x00);
+  f.frame(0x38);
+  EXPECT_EQ(f.frame(0x00) << 8 | f.frame(0x00), 0x2E08) << "CONFIG 0x2E88 as a mode-0 host reads it on silicon";
+  ASSERT_EQ(v.log.size(), 1u);
+  EXPECT_EQ(v.log[0].rfind("spidev0.0: chip 0: SPI_MODE: the host clocks in SPI mode 0 (CPOL=0, CPHA=0)", 0), 0u)
+      << v.log[0];
+  // Mode 3 on the same path: the register as it is, and nothing said.
+  f.settings.mode = 3;
+  f.frame(0x38);
+  EXPECT_EQ(f.frame(0x00) << 8 | f.frame(0x00), 0x2E88);
+  EXPECT_EQ(v.log.size(), 1u);
+}
+
+TEST(SanitizerPinFront, ACsPulseShorterThanTDisCSEchoesTheByteAndEndsACheckErrorRun) {
+  VirtualBoard v("chips=L6470 check=error");
+  PinFront f{v.board, BusSettings{4'000'000, 3, false}};
+  f.frame(0x38, /*high=*/2);       // GetParam(CONFIG), then CS high for 500 ns
+  EXPECT_EQ(f.frame(0x00), 0x38);  // no answer load: the opcode comes back
+  const std::string report = v.failure();
+  EXPECT_NE(report.find("driver sanitizer: CS_DESELECT_TIME on spidev0.0, chip 0, frame 2"), std::string::npos) << report;
+  EXPECT_NE(report.find("CS was high for 500 ns before this frame"), std::string::npos) << report;
+  f.frame(0x00, 4, /*setup=*/1);   // a first clock 250 ns after CS fell
+  const std::string setup = v.failure();
+  EXPECT_NE(setup.find("CS_SETUP_TIME on spidev0.0, chip 0, frame 3, byte 0"), std::string::npos) << setup;
+}
+
+TEST(SanitizerPinFront, SixteenBitWordsLsbFirstAndAFastClockAreNamedOnceEach) {
+  VirtualBoard v("chips=L6470 check=warn");
+  PinFront f{v.board, BusSettings{10'000'000, 3, true, 16}};
+  f.frame(0x1C);  // 0x38 bit-reversed: GetParam(CONFIG) on the wire
+  EXPECT_EQ(f.frame(0x00), 0x74);  // 0x2E bit-reversed
+  EXPECT_EQ(f.frame(0x00), 0x11);  // 0x88 bit-reversed
+  std::string all;
+  for (const std::string& l : v.log) all += l + "\n";
+  EXPECT_EQ(v.log.size(), 3u) << all;
+  EXPECT_NE(all.find("LSB_FIRST"), std::string::npos) << all;
+  EXPECT_NE(all.find("WORD_SIZE: the host clocks 16-bit words"), std::string::npos) << all;
+  EXPECT_NE(all.find("SCK_SPEED: SCK is 10 MHz"), std::string::npos) << all;
 }
 
 }  // namespace
