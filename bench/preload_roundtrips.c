@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   if (argc != 3) { fprintf(stderr, "usage: %s /dev/spidevB.C COUNT\n", argv[0]); return 2; }
   const int fd = open(argv[1], O_RDWR);
   if (fd < 0) { perror("open"); return 1; }
+  const uint8_t mode = SPI_MODE_3;  /* what the chip needs (spidev nodes start in mode 0) */
+  if (ioctl(fd, SPI_IOC_WR_MODE, &mode) < 0) { perror("SPI_IOC_WR_MODE"); return 1; }
   long n = strtol(argv[2], 0, 0);
   uint8_t tx = 0, rx = 0xff;
   struct spi_ioc_transfer x; memset(&x, 0, sizeof x);

@@ -8,11 +8,8 @@
 
 namespace l6470emu {
 
-/// How often each kind of chip diagnostic is logged in full per chip.
-constexpr std::uint64_t kDiagnosticRepeats = 10;
-
 Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
-    : log_(std::move(log)), time_(config.time, host), numbering_(config.numbering) {
+    : log_(std::move(log)), sanitizer_(config.check, log_), time_(config.time, host), numbering_(config.numbering) {
   for (const ChainConfig& cc : config.chains) {
     std::vector<Chip> chips;
     chips.reserve(cc.chips.size());
@@ -29,24 +26,13 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     initial[static_cast<unsigned>(Pin::STCK)] = false;  // SW open (pulled up), STBY_RST high (running), STCK low
     cs->wire.assign(cs->chain.size(), initial);
     cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
+    cs->checker = std::make_unique<ChainChecker>(sanitizer_, cs->chain, cs->name, numbering_);
+    cs->bus = std::make_unique<ChainBus>(cs->chain, cs->chain, *cs->checker);
+    // The chips' diagnostics (WRONG_CMD, NOTPERF_CMD, dropped bits and answers) are rules the
+    // sanitizer names: logged (rate-limited) under check=warn, the run's end under check=error.
     for (std::size_t k = 0; k < cs->chain.size(); ++k) {
-      const std::string where = cs->name + ": " + ChipNumbering(numbering_, cs->chain.size()).label(k) + ": ";
-      // A driver looping on a bad command must not flood the log: each kind is shown
-      // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
-      cs->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {
-        const std::size_t i = d.kind == DiagnosticKind::wrong_cmd ? 0 : d.kind == DiagnosticKind::notperf_cmd ? 1 : 2;
-        const char* kind = i == 0 ? "WRONG_CMD" : i == 1 ? "NOTPERF_CMD" : "ignored";
-        const std::uint64_t n = ++seen[i];
-        if (n < kDiagnosticRepeats) {
-          log_(where + kind + ": " + d.message);
-        } else if (n == kDiagnosticRepeats) {
-          log_(where + kind + ": " + d.message + "  (further ones of this kind are counted, not shown)");
-        } else {
-          std::uint64_t p = kDiagnosticRepeats;
-          while (p < n && p <= UINT64_MAX / 10) p *= 10;
-          if (p == n) log_(where + kind + ": " + std::to_string(n) + " so far");
-        }
-      });
+      ChainChecker* checker = cs->checker.get();
+      cs->chain.chip(k).set_diagnostic_sink([checker, k](const Diagnostic& d) { checker->chip_diagnostic(k, d); });
     }
     chains_.push_back(std::move(cs));
   }
@@ -95,7 +81,7 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
 
 // ---------------------------------------------------------------- SPI
 
-SpiDevice& Board::begin_transfer(std::size_t chain) {
+SpiDevice& Board::begin_transfer(std::size_t chain, const WireSettings& wire) {
   ChainState& c = state(chain);
   c.prediction_valid = false;
   // The use starts when the bus is free: now, or when the use before it on this bus ends.
@@ -104,18 +90,24 @@ SpiDevice& Board::begin_transfer(std::size_t chain) {
   record_outputs(c);
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
-    if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) spi_of(*other).deselect();
-  return spi_of(c);
+    if (other.get() != &c && other->config.bus == c.config.bus && other->bus->selected()) {
+      other->bus->set_device(spi_of(*other));
+      other->bus->deselect_wire();
+    }
+  c.bus->set_device(spi_of(c));
+  c.bus->begin(wire);
+  return *c.bus;
 }
 
 Tick Board::end_transfer(std::size_t chain) {
   ChainState& c = state(chain);
+  c.bus->end();
   if (!c.watched.empty()) emit_changes(c, c.chain.now());
   return bus_free_[c.config.bus] = c.chain.now();
 }
 
 Tick Board::transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing) {
-  run_message(begin_transfer(chain), transfers, timing);
+  run_message(begin_transfer(chain, timing.wire), transfers, timing);
   return end_transfer(chain);
 }
 
@@ -123,23 +115,17 @@ void Board::drive_chip_select(std::size_t chain, bool selected) {
   ChainState& c = state(chain);
   catch_up(c);
   c.prediction_valid = false;
-  SpiDevice& dev = spi_of(c);
+  // Through the chain's bus, as a host's CS edge: t_disCS (a CS low too soon after a rise
+  // misses the chips' answer load) and the sanitizer's frame checks apply.
+  c.bus->set_device(spi_of(c));
   if (selected)
-    dev.select();
+    c.bus->select_wire();
   else
-    dev.deselect();
+    c.bus->deselect_wire();
   emit_changes(c, c.chain.now());
 }
 
 bool Board::chip_selected(std::size_t chain) const { return state(chain).chain.selected(); }
-
-namespace {
-std::uint8_t reversed(std::uint8_t b) {
-  b = static_cast<std::uint8_t>((b & 0xF0) >> 4 | (b & 0x0F) << 4);
-  b = static_cast<std::uint8_t>((b & 0xCC) >> 2 | (b & 0x33) << 2);
-  return static_cast<std::uint8_t>((b & 0xAA) >> 1 | (b & 0x55) << 1);
-}
-}  // namespace
 
 Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                         const BusSettings& settings) {
@@ -147,6 +133,15 @@ Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std
   for (const std::size_t i : chains) start = std::max(start, bus_free_[state(i).config.bus]);
   const Tick per_byte = transfer_ticks(1, settings.speed_hz);
   const Tick end = start + per_byte * tx.size();
+  // The host's settings as the wire sees them: mode 3, MSB first takes the chain's byte path,
+  // anything else the bit-level one (spi/wire.hpp). The front drives CS itself, so its ticks
+  // are the real CS-to-clock time (t_setCS is checked).
+  WireSettings wire;
+  wire.mode = static_cast<std::uint8_t>(settings.mode & 3u);
+  wire.lsb_first = settings.lsb_first;
+  wire.speed_hz = settings.speed_hz;
+  wire.bits_per_word = settings.bits_per_word;
+  wire.cs_setup_timed = true;
   bool any = false;
   for (const std::size_t i : chains) {
     ChainState& c = state(i);
@@ -154,11 +149,12 @@ Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std
     c.prediction_valid = false;
     if (start > c.chain.now()) advance_chain(c, start);
     record_outputs(c);
-    SpiDevice& dev = spi_of(c);
+    ChainBus& bus = *c.bus;
+    bus.set_device(spi_of(c));
     for (std::size_t k = 0; k < tx.size(); ++k) {
-      dev.advance_to(dev.now() + per_byte);
-      std::uint8_t in = dev.exchange(settings.lsb_first ? reversed(tx[k]) : tx[k]);
-      if (settings.lsb_first) in = reversed(in);
+      bus.advance_to(bus.now() + per_byte);
+      std::uint8_t in = 0;
+      bus.exchange_wire(tx.subspan(k, 1), std::span<std::uint8_t>(&in, 1), wire);
       rx[k] = any ? static_cast<std::uint8_t>(rx[k] & in) : in;
     }
     any = true;

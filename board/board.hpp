@@ -16,6 +16,8 @@
 
 #include "board/board_config.hpp"
 #include "board/board_time.hpp"
+#include "board/chain_bus.hpp"
+#include "board/sanitizer.hpp"
 #include "board/pins.hpp"
 #include "daisychain/chain.hpp"
 #include "daisychain/chip_numbering.hpp"
@@ -34,15 +36,15 @@ struct PinEdge {
 };
 
 /// How a controller clocks a bus for one use (a firmware front's SPI settings). Mode 3, MSB
-/// first is what the chips expect; docs/firmware.md says what reaches them otherwise.
+/// first is what the chips expect; other settings reach them as the wire gives them
+/// (docs/spi-interface.md) and the sanitizer names them.
 struct BusSettings {
   std::uint32_t speed_hz = 5'000'000;  ///< SCK; each byte takes transfer_ticks(1, speed_hz)
   std::uint8_t mode = 3;               ///< SPI mode: CPOL × 2 + CPHA
   bool lsb_first = false;              ///< the bit order on the wire
+  std::uint8_t bits_per_word = 8;      ///< the controller's word size (words reach the bus as bytes, in wire order)
 };
 
-/// Where the board's diagnostics go: one line per call, without "l6470emu: " or a newline.
-using LineSink = std::function<void(std::string_view)>;
 /// Where the board reports the edges of watched pins (called inside the board's operations).
 using EdgeSink = std::function<void(const PinEdge&)>;
 
@@ -57,9 +59,10 @@ using EdgeSink = std::function<void(const PinEdge&)>;
 /// work at the chain's own tick, so that a front can compose them into one step.
 class Board {
  public:
-  /// Builds the chains of `config` (variants, axes, numbering) on a clock read from `host`
-  /// (which must outlive the board). Chip diagnostics go to `log`, each kind shown ten times
-  /// per chip and then counted, with a tally at every power of ten.
+  /// Builds the chains of `config` (variants, axes, numbering, check=) on a clock read from
+  /// `host` (which must outlive the board). The sanitizer's lines (chip diagnostics, broken
+  /// rules of the interface) go to `log`, each rule shown ten times per chip and then counted,
+  /// with a tally at every power of ten.
   Board(const BoardConfig& config, LineSink log, HostClock& host);
   ~Board();
   Board(const Board&) = delete;
@@ -90,25 +93,39 @@ class Board {
 
   // ---- SPI: a front clocks bytes on a chain between begin_transfer and end_transfer --------
 
-  /// Starts a use of the bus of chain `chain` and returns the device to clock on (the chain,
-  /// or its recording while it is recorded). The use starts when the bus is free: at the
-  /// board's time, or when the use before it on the same bus ended, if later (its caller may
-  /// still be waiting for that end); the chain is brought there. One controller drives a bus:
-  /// another chain of the bus left selected is deselected first. Between begin and end the
-  /// front selects, exchanges (advancing the device's clock by each byte's bus time, as
-  /// run_message does) and deselects as its host would; nothing else may touch the board.
-  SpiDevice& begin_transfer(std::size_t chain);
+  /// Starts a use of the bus of chain `chain` by a host that drives it with `wire` (SPI mode,
+  /// bit order, CS polarity, word size, SCK: what Arduino's SPISettings and STM32 HAL's
+  /// CLKPolarity/CLKPhase/FirstBit say) and returns the device to clock on: the chain (or its
+  /// recording while it is recorded) as such a host sees it, watched by the sanitizer. The use
+  /// starts when the bus is free: at the board's time, or when the use before it on the same
+  /// bus ended, if later (its caller may still be waiting for that end); the chain is brought
+  /// there. One controller drives a bus: another chain of the bus left selected is deselected
+  /// first. Between begin and end the front selects, exchanges (advancing the device's clock by
+  /// each byte's bus time, as run_message does) and deselects as its host would; nothing else
+  /// may touch the board.
+  SpiDevice& begin_transfer(std::size_t chain, const WireSettings& wire = {});
   /// Ends the use begun by begin_transfer: reports the edges of watched pins at the chain's
   /// tick and frees the bus from then. Returns that tick: the use's end, which the front's
   /// host reaches by waiting (advance_to in virtual time).
   Tick end_transfer(std::size_t chain);
-  /// begin_transfer, run_message(transfers, timing), end_transfer. Returns the end tick.
+  /// begin_transfer(chain, timing.wire), run_message(transfers, timing), end_transfer. Returns the end tick.
   Tick transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing = {});
+
+  // ---- the sanitizer ----------------------------------------------------------------
+
+  /// The board's checks (check= and check.allow= of the description; a front may change them).
+  Sanitizer& sanitizer() { return sanitizer_; }
+  const Sanitizer& sanitizer() const { return sanitizer_; }
+  /// Under check=error: the report of the first broken rule since the last call, taken. A front
+  /// ends its host's run with it (the preload: exit status kSanitizerExitStatus).
+  std::optional<std::string> take_check_failure() { return sanitizer_.take_failure(); }
 
   // ---- SPI with the chip select on a pin: a firmware front drives CS and clocks bytes itself ----
 
   /// Drives the chip select of chain `chain` now, as a microcontroller pin does: `selected`
-  /// (low) starts a frame, a rise ends it and the chips decode (recorded, edges reported).
+  /// (low) starts a frame, a rise ends it and the chips decode (recorded, edges reported). The
+  /// edges are timed: a CS low less than t_disCS after the last rise finds the chips' answers
+  /// not loaded, and the sanitizer says so.
   void drive_chip_select(std::size_t chain, bool selected);
   /// Whether chain `chain`'s chip select is low.
   bool chip_selected(std::size_t chain) const;
@@ -116,9 +133,11 @@ class Board {
   /// receives the bytes; `rx` (as long as `tx`) gets MISO (0x00 when none is selected; several
   /// selected chains drive MISO together, read as the AND of their bytes). The bytes start at
   /// the board's time, or when the bus's last use ended if later, and each takes the bus time of
-  /// `settings.speed_hz`; LSB first reverses each byte on the wire. Returns the end tick (the
-  /// front moves the board's time there). The chips read the bytes as mode 3 whatever
-  /// `settings.mode` says (the front reports other modes).
+  /// `settings.speed_hz`. Mode 3, MSB first takes the chains' byte path; any other mode or bit
+  /// order is clocked at bit level (Chain::exchange_wire: a mode-0 host reads each chip's stale
+  /// SDO latch as the first bit after CS falls, LSB first arrives bit-reversed). The chains'
+  /// sanitizer checks the settings, t_setCS and the frames (take_check_failure). Returns the end
+  /// tick (the front moves the board's time there).
   Tick clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                    const BusSettings& settings);
 
@@ -208,6 +227,7 @@ class Board {
   bool level_of(const ChainState& c, std::size_t chip, Pin pin) const;
 
   LineSink log_;
+  Sanitizer sanitizer_;
   EdgeSink edge_sink_;
   BoardTime time_;
   NumberFrom numbering_ = NumberFrom::miso;

@@ -3,6 +3,7 @@
 #include "board/board_config.hpp"
 
 #include "board/axis_config.hpp"
+#include "board/suggest.hpp"
 
 #include <algorithm>
 #include <array>
@@ -32,7 +33,7 @@ struct KeySpec {
 };
 
 // Every key, in the order the docs table lists them.
-constexpr std::array<KeySpec, 26> kKeys{{
+constexpr std::array<KeySpec, 28> kKeys{{
     {"chips", Scope::chain, "chips=2xL6470,L6480"},
     {"bus", Scope::chain, "bus=0"},
     {"cs", Scope::chain, "cs=1"},
@@ -55,6 +56,8 @@ constexpr std::array<KeySpec, 26> kKeys{{
     {"socket", Scope::board, "socket=/tmp/l6470emu.sock"},
     {"trace", Scope::board, "trace=run.trace"},
     {"numbering", Scope::board, "numbering=mosi"},
+    {"check", Scope::board, "check=error"},
+    {"check.allow", Scope::board, "check.allow=SPI_MODE,FRAME_LENGTH"},
     {"call_time", Scope::board, "call_time=1us"},
     {"loop_time", Scope::board, "loop_time=10us"},
     {"limit", Scope::board, "limit=120s"},
@@ -111,41 +114,6 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-// Levenshtein distance, case-insensitive; only for the short words suggestions are made for.
-std::size_t edit_distance(std::string_view a_in, std::string_view b_in) {
-  const std::string a = lower(a_in), b = lower(b_in);
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// The candidates closest to `word` (at most 2 edits, and fewer than the word's length), as
-// "A" or "A or B"; "" when nothing is close.
-std::string closest(std::string_view word, const std::vector<std::string>& candidates) {
-  if (word.empty() || word.size() > 32) return "";
-  std::size_t best = 3;
-  std::vector<std::string> hits;
-  for (const auto& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d >= word.size() || d > best) continue;
-    if (d < best) hits.clear();
-    best = d;
-    hits.push_back(c);
-  }
-  std::string out;
-  for (std::size_t i = 0; i < hits.size(); ++i) out += (i == 0 ? "" : i + 1 == hits.size() ? " or " : ", ") + hits[i];
-  return out;
-}
-
 std::vector<std::string> variant_names() {
   std::vector<std::string> names;
   for (const Variant* v : all_variants()) names.emplace_back(v->name);
@@ -169,6 +137,8 @@ std::string_view key_alias(std::string_view key) {
       {"reset_pin", "stby_rst_pin"}, {"rst_pin", "stby_rst_pin"}, {"stbyrst_pin", "stby_rst_pin"},
       {"spi_bus", "spi"},      {"controller", "spi"}, {"call_cost", "call_time"}, {"loop_cost", "loop_time"},
       {"time_limit", "limit"}, {"run_limit", "limit"}, {"apb", "apb_clock"},  {"pclk", "apb_clock"},
+      {"sanitize", "check"},   {"sanitizer", "check"}, {"allow", "check.allow"}, {"check_allow", "check.allow"},
+      {"check-allow", "check.allow"},
   };
   const std::string k = lower(key);
   for (const auto& [alias, real] : kAliases)
@@ -412,6 +382,16 @@ struct Parser {
     } else if (k == "trace") {
       if (value.back() == '/') return fail("trace " + q + " names a directory; give a file");
       cfg.trace = std::string(value);
+    } else if (k == "check") {
+      std::string why;
+      const auto level = parse_check_level(value, why);
+      if (!level) return fail("check " + why);
+      cfg.check.level = *level;
+    } else if (k == "check.allow") {
+      std::string why;
+      const auto rules = parse_rule_list(value, why);
+      if (!rules) return fail("check.allow " + why);
+      cfg.check.allowed = *rules;
     } else if (k == "numbering") {
       const auto from = number_from_named(value);
       if (!from)
@@ -839,6 +819,8 @@ std::string describe_board_config(const BoardConfig& config) {
   if (!config.socket.empty()) o << "socket=" << config.socket << "\n";
   if (!config.trace.empty()) o << "trace=" << config.trace << "\n";
   if (config.numbering != NumberFrom::miso) o << "numbering=" << to_string(config.numbering) << "\n";
+  if (config.check.level != CheckLevel::warn) o << "check=" << to_string(config.check.level) << "\n";
+  if (!config.check.allowed.empty()) o << "check.allow=" << rule_list(config.check.allowed) << "\n";
   const FirmwareTiming fw_defaults;
   const FirmwareTiming& fw = config.firmware;
   std::string firmware;

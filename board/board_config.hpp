@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "board/check_rules.hpp"
 #include "board/pin_map.hpp"
 #include "core/axis_spec.hpp"
 #include "core/tick.hpp"
@@ -61,6 +62,7 @@ struct BoardConfig {
   std::string socket;          ///< daemon socket (preload: forward to it instead of emulating in process)
   std::string trace;           ///< record every chain into this native trace file ("" = no recording)
   NumberFrom numbering = NumberFrom::miso;  ///< how diagnostics and `ctl` number the chips (numbering=)
+  CheckConfig check;                        ///< the driver sanitizer: check= and check.allow=
   FirmwareTiming firmware;                  ///< call_time=, loop_time=, limit=, apb_clock= (firmware runs)
 };
 
@@ -79,7 +81,8 @@ struct ConfigError {
 /// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
 /// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual
 /// time), log=stderr|off|FILE, socket=PATH, trace=FILE, numbering=miso|mosi (which end chip 0
-/// is at in diagnostics and `ctl`; chips= always lists the MISO end first), and for firmware runs
+/// is at in diagnostics and `ctl`; chips= always lists the MISO end first), check=off|warn|error
+/// and check.allow=RULE,... (the driver sanitizer, board/check_rules.hpp), and for firmware runs
 /// call_time=, loop_time=, limit= (durations: 250ns, 1us, 10ms, 60s) and apb_clock=HZ. Every value is checked against its
 /// range; docs/linux.md has the table. `origin` names the source in error messages
 /// ("L6470EMU_CHAIN", a file name). Returns the config, or the first error, on one line:
@@ -105,7 +108,8 @@ std::string shown_text(std::string_view text, std::size_t max_chars = kQuotedTex
 std::string quoted_text(std::string_view text);
 
 /// The config text of a board, as parse_board_config reads it back (for `serve` to print):
-/// scale= in wall time, idle= in virtual time when not the default 1 s, log/socket/trace when set.
+/// scale= in wall time, idle= in virtual time when not the default 1 s, log/socket/trace when set,
+/// check= when not warn, check.allow= when it allows any rule.
 std::string describe_board_config(const BoardConfig& config);
 
 /// The variant called `name` (case-insensitive), or nullptr.

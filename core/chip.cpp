@@ -94,7 +94,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
     case Command::SetParam:
       if (table_->at_address(op.param)->access == Access::R &&
           quirks_.read_only_write == ReadOnlyWrite::wrong_cmd_at_command_byte) {
-        wrong_command(byte, "SetParam of a read-only register");
+        wrong_command(byte, "SetParam of a read-only register", DiagnosticDetail::read_only_write);
         break;
       }
       [[fallthrough]];
@@ -234,7 +234,7 @@ void Chip::exec_set_param(std::uint8_t address, std::uint32_t value) {
   if (r.access == Access::R) {
     std::string why = "SetParam of read-only ";
     why += r.name;
-    return not_performable(why.c_str());
+    return not_performable(why.c_str(), DiagnosticDetail::read_only_write);
   }
   value &= r.mask();
   Access access = r.access;
@@ -346,16 +346,16 @@ void Chip::clear_latches() {
   if (!condition_.ocd) ocd_shutdown_ = false;
 }
 
-void Chip::wrong_command(std::uint8_t byte, const char* why) {
+void Chip::wrong_command(std::uint8_t byte, const char* why, DiagnosticDetail detail) {
   latched_.wrong_cmd = true;
   latched_changed();
-  if (sink_) sink_({now_, DiagnosticKind::wrong_cmd, "byte " + hex(byte, 2) + ": " + why});
+  if (sink_) sink_({now_, DiagnosticKind::wrong_cmd, "byte " + hex(byte, 2) + ": " + why, detail});
 }
 
-void Chip::not_performable(const char* what) {
+void Chip::not_performable(const char* what, DiagnosticDetail detail) {
   latched_.notperf_cmd = true;
   latched_changed();
-  if (sink_) sink_({now_, DiagnosticKind::notperf_cmd, what});
+  if (sink_) sink_({now_, DiagnosticKind::notperf_cmd, what, detail});
 }
 
 // ---------------------------------------------------------------- time

@@ -51,6 +51,15 @@ class Chip {
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
   bool collecting_arguments() const { return collecting_; }
+  /// While collecting_arguments(): the command being collected (its opcode's decoding), how many
+  /// argument bytes it still needs and the ones it has, MSB first (for the sanitizer, board/).
+  Command collecting_command() const { return collecting_ ? pending_.command : Command::NOP; }
+  const Opcode& collecting_opcode() const { return pending_; }
+  std::uint8_t arguments_missing() const { return collecting_ ? static_cast<std::uint8_t>(pending_.arg_bytes - args_seen_) : 0; }
+  std::uint32_t arguments_so_far() const { return collecting_ ? arg_ : 0; }
+  /// Bytes of the GetParam/GetStatus answer not yet loaded into the shift register (a new
+  /// GetParam or GetStatus drops them).
+  std::uint8_t answer_bytes_pending() const { return response_left_; }
 
   /// Whether the chip takes part in SPI (false while STBY/RST is held low).
   bool spi_enabled() const { return stby_level_; }
@@ -173,8 +182,8 @@ class Chip {
   void drive_sw(bool level);
   void switch_turn_on_event();
   void switch_release_event();
-  void wrong_command(std::uint8_t byte, const char* why);
-  void not_performable(const char* what);
+  void wrong_command(std::uint8_t byte, const char* why, DiagnosticDetail detail = DiagnosticDetail::none);
+  void not_performable(const char* what, DiagnosticDetail detail = DiagnosticDetail::none);
   AlarmFlags live_alarms() const;
   LiveStatus live_status() const;
   bool motion_command_allowed(const char* what);

@@ -17,11 +17,18 @@ enum class DiagnosticKind : std::uint8_t {
   ignored,      ///< a byte or pin change the chip ignored (standby, ...)
 };
 
+/// More about a wrong_cmd or notperf_cmd diagnostic.
+enum class DiagnosticDetail : std::uint8_t {
+  none,
+  read_only_write,  ///< SetParam of a read-only register
+};
+
 /// One diagnostic, stamped with the tick at which the chip noticed it.
 struct Diagnostic {
   Tick tick = 0;
   DiagnosticKind kind = DiagnosticKind::wrong_cmd;
   std::string message;
+  DiagnosticDetail detail = DiagnosticDetail::none;
 };
 
 /// Receives diagnostics; may be empty.

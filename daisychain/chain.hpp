@@ -64,6 +64,46 @@ class Chain final : public SpiDevice {
   /// chip will decode at the CS rising edge; between frames, the byte it will shift out next.
   std::uint8_t shift_register(std::size_t i) const { return ring_[(head_ + i) % ring_.size()]; }
 
+  // ---- the bit-level interface: hosts with any SPI settings (daisychain/chain_wire.cpp) -------
+  // Each chip also has an SDO latch: the bit its SDO drives, set from the top of its shift
+  // register at every falling CK edge and kept across CS edges. Mode 3, MSB first, takes the
+  // byte path above; other settings go bit-exact through the edge rules of spi/wire.hpp.
+  // (WireSettings::cs_active_high is the front's business: the chain sees CS only through
+  // select and deselect.)
+
+  /// CS falling edge (SpiDevice::select_wire): after a deselect_wire() less than t_disCS ago the
+  /// chips had no time to load their answers, so each register still holds the byte it received.
+  void select_wire() override;
+  /// Clocks `tx` as a host with `wire` settings does; rx gets what the host reads.
+  void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override {
+    if (tx.size() == 1 && selected_ && wire.mode == 3 && !wire.lsb_first && !standby_in_frame_) {
+      // One byte on the byte path (a clock-idle-high byte: the latches are where previous_bit0 says).
+      rx[0] = last_out0_ = exchange(tx[0]);
+      mosi_level_ = tx[0] & 1u;
+      latch_at_ = LatchAt::previous_bit0;
+      return;
+    }
+    exchange_wire_bytes(tx, rx, wire);
+  }
+  /// CS rising edge: as deselect(), keeping each chip's SDO latch for the next frame.
+  void deselect_wire() override;
+  /// One CS frame of a host with `wire` settings: select_wire, exchange_wire, deselect_wire.
+  void frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire);
+  /// Chip `i`'s SDO latch (0 or 1) as of now: the bit its SDO shows until the next falling CK edge.
+  std::uint8_t sdo_latch(std::size_t i) const;
+  /// Whether some chip was in standby at the last CS falling edge (its bytes are lost).
+  bool standby_in_frame() const { return standby_in_frame_; }
+  /// Calls f(i, chip i, the byte in its register) for every chip, chip 0 first, as they stand:
+  /// no side effects (the sanitizer looks at what the chips are about to decode).
+  template <typename F>
+  void for_each_register(F&& f) const {
+    const std::size_t n = ring_.size();
+    for (std::size_t i = 0, slot = head_; i < n; ++i, slot = slot + 1 == n ? 0 : slot + 1) f(i, chips_[i], ring_[slot]);
+  }
+  /// Chip `i` as it stands, without bringing it up to the chain's time or any other side effect
+  /// (for looking at what does not depend on time: its decoder, its STBY level).
+  const Chip& peek_chip(std::size_t i) const { return chips_.at(i); }
+
  private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
@@ -81,6 +121,25 @@ class Chain final : public SpiDevice {
   bool any_standby_ = false;
   std::uint64_t bytes_in_frame_ = 0;
   Tick now_ = 0;
+
+  // ---- the bit-level interface's state (chain_wire.cpp) ----
+  /// Where each chip's SDO latch is to be found: stored in latch_, or (no chip in standby) as the
+  /// top bit of its register after a clock-idle-low byte, or as bit 0 of the register downstream
+  /// (of the byte chip 0 sent last, for chip 0) after a clock-idle-high one; after the CS rising
+  /// edge the same in received_, the registers as they were before the chips decoded them.
+  enum class LatchAt : std::uint8_t { stored, register_msb, previous_bit0, received_msb, received_bit0 };
+  void exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire);
+  std::uint8_t wire_byte(std::uint8_t host_byte, const WireSettings& wire);
+  void apply_stale_latches();
+  void store_latches();
+  std::uint8_t latch_at(std::size_t i) const;
+  std::vector<std::uint8_t> latch_;     // per chip, while latch_at_ == stored (sized on first use)
+  std::vector<std::uint8_t> received_;  // the registers before the last deselect_wire decoded them
+  LatchAt latch_at_ = LatchAt::stored;
+  std::uint8_t last_out0_ = 0;   // the byte chip 0 shifted out last
+  std::uint8_t mosi_level_ = 0;  // MOSI as the last byte left it (a mode-1 chip samples it first)
+  bool answers_loaded_ = false;  // the last deselect_wire decoded bytes and loaded answers
+  Tick deselect_tick_ = 0;       // when it did
 };
 
 }  // namespace l6470emu

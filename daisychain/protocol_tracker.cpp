@@ -126,11 +126,15 @@ void ProtocolTracker::finish_answer(std::size_t k, AnswerEnd why) {
   report(std::move(e));
 }
 
+std::optional<std::size_t> mosi_byte_decoded_by(std::size_t frame_len, std::size_t chain_len, std::size_t chip) {
+  if (frame_len >= chain_len) return frame_len - chain_len + chip;
+  if (chip >= chain_len - frame_len) return chip - (chain_len - frame_len);
+  return std::nullopt;
+}
+
 std::string ProtocolTracker::host_byte_for(std::size_t k) const {
-  const std::size_t n = chain_.size(), len = frame_.mosi.size();
-  if (len >= n) return byte_hex(frame_.mosi[len - n + k]);
-  if (k >= n - len) return byte_hex(frame_.mosi[k - (n - len)]);
-  return "its byte";
+  const auto b = mosi_byte_decoded_by(frame_.mosi.size(), chain_.size(), k);
+  return b ? byte_hex(frame_.mosi[*b]) : "its byte";
 }
 
 std::string ProtocolTracker::chip_range(std::size_t first, std::size_t last) const {
@@ -140,9 +144,8 @@ std::string ProtocolTracker::chip_range(std::size_t first, std::size_t last) con
 }
 
 std::string ProtocolTracker::origin_of(std::size_t k) const {
-  const std::size_t n = chain_.size(), len = frame_.mosi.size();
-  if (len >= n) return "MOSI byte " + std::to_string(len - n + k);
-  if (k >= n - len) return "MOSI byte " + std::to_string(k - (n - len));
+  const std::size_t len = frame_.mosi.size();
+  if (const auto b = mosi_byte_decoded_by(len, chain_.size(), k)) return "MOSI byte " + std::to_string(*b);
   return "the byte " + numbering_.label(k + len) + " left in the chain";
 }
 

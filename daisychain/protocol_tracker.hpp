@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -167,6 +168,11 @@ class ProtocolTracker {
   TraceEvent frame_;
   std::uint64_t frame_no_ = 0;
 };
+
+/// The MOSI byte of a frame of `frame_len` bytes that chip `chip` of a chain of `chain_len`
+/// decodes at the CS rising edge (byte k of an N-byte frame goes to chip k; a longer frame's
+/// first bytes pass through), or nothing when the chip decodes a byte left in the chain.
+std::optional<std::size_t> mosi_byte_decoded_by(std::size_t frame_len, std::size_t chain_len, std::size_t chip);
 
 /// Seconds to show for an event: the capture's own time when it has one, else the tick's.
 double display_seconds(Tick tick, double source_time);

@@ -22,10 +22,20 @@ void RecordingChain::emit(const TraceEvent& e) { sink_.write(e); }
 
 void RecordingChain::select() {
   if (chain_.selected()) return;
+  start_frame();
+  chain_.select();
+}
+
+void RecordingChain::select_wire() {
+  if (chain_.selected()) return;
+  start_frame();
+  chain_.select_wire();
+}
+
+void RecordingChain::start_frame() {
   frame_start_ = chain_.now();
   tx_.clear();
   rx_.clear();
-  chain_.select();
 }
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
@@ -45,9 +55,28 @@ void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::u
   }
 }
 
+void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                                   const WireSettings& wire) {
+  chain_.exchange_wire(tx, rx, wire);
+  if (chain_.selected()) {
+    tx_.insert(tx_.end(), tx.begin(), tx.end());
+    rx_.insert(rx_.end(), rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()));
+  }
+}
+
 void RecordingChain::deselect() {
   if (!chain_.selected()) return;
   chain_.deselect();
+  finish_frame();
+}
+
+void RecordingChain::deselect_wire() {
+  if (!chain_.selected()) return;
+  chain_.deselect_wire();
+  finish_frame();
+}
+
+void RecordingChain::finish_frame() {
   TraceEvent e;
   e.kind = TraceEventKind::frame;
   e.tick = frame_start_;

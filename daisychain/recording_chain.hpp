@@ -35,6 +35,10 @@ class RecordingChain final : public SpiDevice {
   void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override;
   void deselect() override;
   bool selected() const override { return chain_.selected(); }
+  // The bit-level face: frames record the bytes as the host sent and read them.
+  void select_wire() override;
+  void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override;
+  void deselect_wire() override;
   Tick now() const override { return chain_.now(); }
   void advance_to(Tick tick) override { chain_.advance_to(tick); }
 
@@ -58,6 +62,8 @@ class RecordingChain final : public SpiDevice {
   std::uint64_t frames_recorded() const { return frames_; }
 
  private:
+  void start_frame();
+  void finish_frame();
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
   void emit(const TraceEvent& e);
 

@@ -311,6 +311,7 @@ void FirmwareRuntime::apply_drive(Line& l) {
     if (selected != board_->chip_selected(chain)) {
       board_->drive_chip_select(chain, selected);
       dirty();
+      check_rules();
     }
     return;
   }
@@ -513,15 +514,8 @@ void FirmwareRuntime::report_once(const std::string& key, const std::string& tex
 void FirmwareRuntime::transfer(int controller, const BusSettings& settings, std::span<const std::uint8_t> tx,
                                std::span<std::uint8_t> rx) {
   const Controller& ctl = controllers_.at(static_cast<std::size_t>(controller));
-  if (settings.mode != 3)
-    report_once(ctl.name + " mode",
-                ctl.name + ": SPI mode " + std::to_string(settings.mode) +
-                    ": the chips need mode 3 (CPOL 1, CPHA 1); the bytes are served as if in mode 3");
-  if (settings.lsb_first)
-    report_once(ctl.name + " lsb", ctl.name + ": LSB first: the chips shift MSB first, so each byte reaches them bit-reversed");
-  if (settings.speed_hz > 5'000'000)
-    report_once(ctl.name + " speed", ctl.name + ": SCK " + std::to_string(settings.speed_hz) +
-                                         " Hz is above the chips' 5 MHz (served as if it worked)");
+  // A mode other than 3, LSB first, words other than 8 bits, SCK above 5 MHz: the board clocks
+  // them as the wire gives them and its sanitizer names them (check=).
   std::size_t selected = 0;
   for (const std::size_t c : ctl.chains) selected += board_->chip_selected(c) ? 1 : 0;
   if (selected == 0)
@@ -531,6 +525,7 @@ void FirmwareRuntime::transfer(int controller, const BusSettings& settings, std:
     report_once(ctl.name + " two", ctl.name + ": bytes clocked with " + std::to_string(selected) +
                                         " chip selects low: every selected chain takes them and they drive MISO together");
   const Tick end = board_->clock_bytes(ctl.chains, tx, rx, settings);
+  check_rules();
   set_now(std::max(now_, end));
   if (board_watches_) dirty();
   process_edges();
@@ -555,6 +550,24 @@ void FirmwareRuntime::stop(int status, const std::string& why) {
   finish();
   std::fflush(nullptr);
   std::exit(status);
+}
+
+void FirmwareRuntime::check_rules() {
+  if (!board_->sanitizer().failed()) return;
+  const std::optional<std::string> report = board_->take_check_failure();
+  if (!report) return;
+  // As a sanitizer: the report on standard error whatever log= says, the run's first line in
+  // the log too when it is elsewhere; recordings finished; the sanitizer's exit status.
+  std::fflush(stdout);
+  std::fputs(report->c_str(), stderr);
+  if (report->empty() || report->back() != '\n') std::fputc('\n', stderr);
+  std::fflush(stderr);
+  if (config_.log != "stderr") {
+    const std::string first = report->substr(0, report->find('\n'));
+    log(first.substr(std::min(first.size(), first.find("driver sanitizer"))) + " (the run ends with exit status " +
+        std::to_string(kSanitizerExitStatus) + ")");
+  }
+  stop(kSanitizerExitStatus, "");
 }
 
 void FirmwareRuntime::stop_at_limit() {
@@ -651,6 +664,25 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
   BoardConfig config = std::move(*parsed.config);
   if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) config.log = log;
   if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) config.trace = trace;
+  // The driver sanitizer, as the preload reads it.
+  if (const char* check = std::getenv("L6470EMU_CHECK"); check && *check) {
+    std::string why;
+    const auto level = parse_check_level(check, why);
+    if (!level) {
+      error = "l6470emu: L6470EMU_CHECK " + why;
+      return nullptr;
+    }
+    config.check.level = *level;
+  }
+  if (const char* allow = std::getenv("L6470EMU_CHECK_ALLOW"); allow && *allow) {
+    std::string why;
+    const auto rules = parse_rule_list(allow, why);
+    if (!rules) {
+      error = "l6470emu: L6470EMU_CHECK_ALLOW " + why;
+      return nullptr;
+    }
+    config.check.allowed = *rules;
+  }
   std::unique_ptr<FirmwareRuntime> runtime;
   try {
     runtime = std::make_unique<FirmwareRuntime>(config, front, make_log(config.log));

@@ -127,8 +127,9 @@ class FirmwareRuntime {
   /// Names of the controllers, in bus order.
   std::vector<std::string> controller_names() const;
   /// Clocks `tx` on controller `controller` (bytes to every chain whose chip select is low;
-  /// `rx` gets MISO) and lets the bytes' bus time pass. Settings the chips cannot read as sent
-  /// (a mode other than 3, LSB first, SCK above 5 MHz) are reported once each.
+  /// `rx` gets MISO) and lets the bytes' bus time pass. Settings other than mode 3, MSB first
+  /// reach the chips as the wire gives them (Board::clock_bytes); the board's sanitizer names
+  /// them and every other broken rule as check= says (check=error ends the run: check_rules).
   void transfer(int controller, const BusSettings& settings, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
   // ---- the run ------------------------------------------------------------------------------
@@ -175,6 +176,9 @@ class FirmwareRuntime {
   [[noreturn]] void stop_at_limit();
   void dirty() { next_edge_ = 0; }
   void report_once(const std::string& key, const std::string& line);
+  /// Under check=error, after the board has seen a broken rule: the sanitizer's report on
+  /// stderr, recordings finished, exit status kSanitizerExitStatus (86), as under the preload.
+  void check_rules();
 
   FirmwareFront front_;
   BoardConfig config_;
@@ -203,7 +207,8 @@ class FirmwareRuntime {
 /// The program's runtime, made at its first use: from L6470EMU_CHAIN (a description), else
 /// L6470EMU_CONFIG (a file), else the description the program was built with
 /// (l6470emu_default_board / l6470emu_default_board_file, set by l6470emu_add_sketch's BOARD),
-/// else one L6470 (docs/firmware.md); L6470EMU_TRACE and L6470EMU_LOG override trace= and log=.
+/// else one L6470 (docs/firmware.md); L6470EMU_TRACE, L6470EMU_LOG, L6470EMU_CHECK and
+/// L6470EMU_CHECK_ALLOW override trace=, log=, check= and check.allow=.
 /// A description that cannot run ends the program with one line on stderr and status 2. The
 /// first use decides the front; the runtime lives until the program ends and closes its
 /// recordings at exit.

@@ -151,12 +151,22 @@ void DeviceBoard::release(Handle& h) {
 // ---------------------------------------------------------------- spidev
 
 long DeviceBoard::spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
-                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                              std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, std::string* check_report,
                               const std::function<bool()>& caller_alive) {
   Tick end = 0;
-  const long r = run_spi_message(handle, xfers, tx, rx, end, caller_alive);
+  const long r = run_spi_message(handle, xfers, tx, rx, end, check_report, caller_alive);
   if (r >= 0) wait_for(end);  // the call takes the message's bus time, as a kernel transfer does
   return r;
+}
+
+CheckConfig DeviceBoard::check_config() {
+  std::lock_guard lock(m_);
+  return board_.sanitizer().config();
+}
+
+void DeviceBoard::set_check_config(const CheckConfig& config) {
+  std::lock_guard lock(m_);
+  board_.sanitizer().set_config(config);
 }
 
 void DeviceBoard::wait_for(Tick tick) {
@@ -175,7 +185,7 @@ void DeviceBoard::wait_for_bus(std::unique_lock<std::mutex>& lock, unsigned bus)
 
 long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers,
                                   std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick& end,
-                                  const std::function<bool()>& caller_alive) {
+                                  std::string* check_report, const std::function<bool()>& caller_alive) {
   std::unique_lock lock(m_);
   Handle* h = find(handle, HandleKind::spidev);
   if (!h) return -EBADF;
@@ -185,13 +195,6 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
   const long total = validate_spidev_message(c.spi, xfers);
   if (total < 0) return total;
   if (tx.size() != spidev_tx_bytes(xfers) || rx.size() != spidev_rx_bytes(xfers)) return -EFAULT;
-  // Settings the chip cannot work with are reported once each (cheap test first: the usual case is clean).
-  bool suspicious = (c.spi.mode & (SPI_CPOL | SPI_CPHA | SPI_LSB_FIRST | SPI_CS_HIGH)) != SPI_MODE_3 ||
-                    c.spi.speed_hz > kChipMaxSpeedHz || c.spi.bits_per_word != 8;
-  for (const auto& x : xfers)
-    if (x.speed_hz > kChipMaxSpeedHz || (x.bits_per_word != 0 && x.bits_per_word != 8)) suspicious = true;
-  if (suspicious)
-    check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
   // The settings as they are now: the message keeps them even if they change while it is sliced.
   const SpidevSettings settings = c.spi;
   const unsigned bus = board_.chain_config(chain).bus;
@@ -199,15 +202,17 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
   thread_local SpidevWireMessage message;  // its buffers keep their capacity from one message to the next
   message.prepare(settings, xfers, tx);
   // The message starts when the bus is free: now, or when the message before it on this bus ends
-  // (its caller may still be waiting for that end). The board runs the bus; spidev says what to clock.
+  // (its caller may still be waiting for that end). The board runs the bus as a host with the
+  // node's settings drives it (its sanitizer names what the chip cannot work with); spidev says
+  // what to clock.
+  const WireSettings wire = spidev_wire_settings(settings);
   const bool sliced = caller_alive && !time().is_virtual() && message.bus_ticks() > kBusSliceTicks;
   if (!sliced) {
-    message.run(board_.begin_transfer(chain), kNever);
+    message.run(board_.begin_transfer(chain, wire), kNever);
     end = board_.end_transfer(chain);
     message.finish(rx);
     if (board_.has_watched_pins(chain)) wake_pump();
-    if (observer_) observer_(chain, xfers, tx, rx, end);
-    return total;
+    return finish_spi_message(chain, xfers, tx, rx, end, total, check_report);
   }
   // A long message of a caller that may die: the bus is the message's until it ends or is given
   // up; a slice at a time, the caller sleeping until half a slice before each slice's end (so the
@@ -225,7 +230,7 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
       b.bus_released_.notify_all();
     }
   } owner{*this, lock, bus};
-  for (SpiDevice* dev = &board_.begin_transfer(chain);;) {
+  for (SpiDevice* dev = &board_.begin_transfer(chain, wire);;) {
     const bool done = message.run(*dev, kBusSliceTicks);
     end = board_.end_transfer(chain);
     if (board_.has_watched_pins(chain)) wake_pump();
@@ -234,7 +239,7 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
     wait_for(end > kBusSliceTicks / 2 ? end - kBusSliceTicks / 2 : 0);
     const bool alive = caller_alive();
     lock.lock();
-    dev = &board_.begin_transfer(chain);
+    dev = &board_.begin_transfer(chain, wire);
     if (!alive) {
       // Given up: CS rises now (the board's time when it was noticed), the bus is free from now.
       message.abandon(*dev);
@@ -243,11 +248,30 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
     }
   }
   message.finish(rx);
+  return finish_spi_message(chain, xfers, tx, rx, end, total, check_report);
+}
+
+long DeviceBoard::finish_spi_message(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
+                                     std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick end,
+                                     long total, std::string* check_report) {
   if (observer_) observer_(chain, xfers, tx, rx, end);
+  if (board_.sanitizer().failed()) {
+    // check=error: the run ends here. The message happened (the chips took it as they would);
+    // the caller gets the report instead of its result.
+    std::optional<std::string> report = board_.take_check_failure();
+    if (check_report == nullptr) {
+      // Nobody to end (a kernel node's caller): the report goes to the log, the call fails.
+      log_.line(report->substr(report->find("driver sanitizer")));
+      return -EIO;
+    }
+    *check_report = std::move(*report);
+    return kCheckFailed;
+  }
   return total;
 }
 
-long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive) {
+long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, std::string* check_report,
+                           const std::function<bool()>& caller_alive) {
   spi_ioc_transfer x{};
   x.rx_buf = 1;
   x.len = static_cast<std::uint32_t>(rx.size());
@@ -257,10 +281,10 @@ long DeviceBoard::spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, con
     if (!h) return -EBADF;
     if (rx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx, caller_alive);
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), {}, rx, check_report, caller_alive);
 }
 
-long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx,
+long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, std::string* check_report,
                             const std::function<bool()>& caller_alive) {
   spi_ioc_transfer x{};
   x.tx_buf = 1;
@@ -271,7 +295,7 @@ long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> 
     if (!h) return -EBADF;
     if (tx.size() > chains_[h->dev]->spi.bufsiz) return -EMSGSIZE;
   }
-  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {}, caller_alive);
+  return spi_message(handle, std::span<const spi_ioc_transfer>(&x, 1), tx, {}, check_report, caller_alive);
 }
 
 long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {
@@ -290,11 +314,8 @@ long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::
     if (_IOC_TYPE(cmd) != SPI_IOC_MAGIC) return -ENOTTY;
     const long r = spidev_settings_ioctl(c.spi, cmd, v);
     if (r < 0) return r;
-    if (_IOC_DIR(cmd) & _IOC_READ) {
+    if (_IOC_DIR(cmd) & _IOC_READ)
       for (std::size_t i = 0; i < n; ++i) arg[i] = static_cast<std::uint8_t>(v >> (8 * i));
-    } else {
-      c.reported = 0;  // new settings: report their problems afresh
-    }
     return r;
   }
   if (h->kind == HandleKind::gpiochip) return gpiochip_ioctl(*h, cmd, arg, created);

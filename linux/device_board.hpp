@@ -60,6 +60,11 @@ struct NewFile {
   HandleKind kind = HandleKind::spidev;
 };
 
+/// What spi_message, spi_read and spi_write return when the message broke a rule of the chip
+/// under check=error (board/sanitizer.hpp): the caller ends its host program's run with the
+/// report (the preload: exit status kSanitizerExitStatus). Not an errno value.
+inline constexpr long kCheckFailed = -0x5A17;
+
 /// Called after every SPI message with the chain index, the message and the bytes (for
 /// observers of the traffic; native traces are recorded by start_recording instead).
 using MessageObserver = std::function<void(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
@@ -97,6 +102,10 @@ class DeviceBoard {
   /// the bus is free (now, or when the message before it on the same bus ends) and the call
   /// returns when the board's time reaches its end (a sleep in wall mode, a wait in virtual mode).
   ///
+  /// Under check=error, a message that breaks a rule of the chip still runs as the chip would
+  /// take it; then the call returns kCheckFailed with the sanitizer's report in `check_report`
+  /// (without one, -EIO: the report is in the log).
+  ///
   /// `caller_alive` (a daemon's client, which may die while its message is on the bus): on the
   /// wall clock, a message longer than kBusSliceTicks is clocked a slice at a time, the caller
   /// sleeping out each slice's bus time and `caller_alive` asked between slices. When it says no,
@@ -104,13 +113,26 @@ class DeviceBoard {
   /// live client never waits out a dead one's bus time. Others on the bus wait for the message
   /// as they wait for any (the bus is its until it ends).
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                   std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive = {});
-  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno.
-  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, const std::function<bool()>& caller_alive = {});
-  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, const std::function<bool()>& caller_alive = {});
+                   std::span<std::uint8_t> rx, std::string* check_report = nullptr,
+                   const std::function<bool()>& caller_alive = {});
+  /// read()/write() on a spidev: one rx-only / tx-only transfer. Returns the count or -errno
+  /// (kCheckFailed as spi_message).
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx, std::string* check_report = nullptr,
+                const std::function<bool()>& caller_alive = {});
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, std::string* check_report = nullptr,
+                 const std::function<bool()>& caller_alive = {});
 
   /// Bus time of one slice of a long message whose caller may die (10 ms).
   static constexpr Tick kBusSliceTicks = 10 * 1000 * kTicksPerMicrosecond;
+
+  // ---- the driver sanitizer -------------------------------------------------------
+
+  /// Where the board's diagnostics go.
+  DiagnosticLog& log() { return log_; }
+  /// The board's check settings (check=, check.allow=).
+  CheckConfig check_config();
+  /// Changes them (L6470EMU_CHECK over the description's check=).
+  void set_check_config(const CheckConfig& config);
 
   // ---- the physical world (ctl, tests) ----------------------------------------
 
@@ -198,7 +220,12 @@ class DeviceBoard {
 
   // time and edges
   long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
-                       std::span<std::uint8_t> rx, Tick& end, const std::function<bool()>& caller_alive);
+                       std::span<std::uint8_t> rx, Tick& end, std::string* check_report,
+                       const std::function<bool()>& caller_alive);
+  /// A clocked message's end: the observer, then the sanitizer's verdict (kCheckFailed / -EIO
+  /// under check=error) or `total`.
+  long finish_spi_message(std::size_t chain, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
+                          std::span<std::uint8_t> rx, Tick end, long total, std::string* check_report);
   /// Waits (the lock held by `lock`) until no sliced message owns `bus`.
   void wait_for_bus(std::unique_lock<std::mutex>& lock, unsigned bus);
   void wait_for(Tick tick);

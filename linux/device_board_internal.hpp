@@ -14,7 +14,6 @@ struct DeviceBoard::ChainDev {
   std::string name;               // "spidev0.0"
   SpidevSettings spi;
   unsigned users = 0;             // open files (spidev resets speed_hz at the last close)
-  std::uint32_t reported = 0;     // setting problems already reported since the last settings change
   int gpio = -1;                  // index into gpios_, -1 = no gpiochip
 };
 

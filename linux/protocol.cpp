@@ -7,8 +7,8 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <sstream>
 
@@ -128,6 +128,19 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
   }
 }
 
+namespace {
+
+// check=error: the client's run ends with the report (its preload exits); the daemon says so in
+// its own log and goes on serving the others.
+void failed_check(DeviceBoard& board, const std::string& report, std::vector<std::uint8_t>& out) {
+  const std::string first = report.substr(0, report.find('\n'));
+  board.log().line(first.substr(std::min(first.size(), first.find("driver sanitizer"))) +
+                   " [check=error: the client's run ends]");
+  out.assign(report.begin(), report.end());
+}
+
+}  // namespace
+
 void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet, ReplyHeader& reply,
                    std::vector<std::uint8_t>& out, int& pass_fd, const std::function<bool()>& client_alive) {
   reply = {};
@@ -193,8 +206,10 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(rx_len), 0);
-      reply.result = board.spi_message(req.handle, xfers, tx, out, client_alive);
+      std::string report;
+      reply.result = board.spi_message(req.handle, xfers, tx, out, &report, client_alive);
       if (reply.result < 0) out.clear();
+      if (reply.result == kCheckFailed) failed_check(board, report, out);  // the client ends with it
       return;
     }
     case Op::spi_read: {
@@ -203,13 +218,18 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
         return;
       }
       out.assign(static_cast<std::size_t>(req.arg), 0);
-      reply.result = board.spi_read(req.handle, out, client_alive);
+      std::string report;
+      reply.result = board.spi_read(req.handle, out, &report, client_alive);
       if (reply.result < 0) out.clear();
+      if (reply.result == kCheckFailed) failed_check(board, report, out);
       return;
     }
-    case Op::spi_write:
-      reply.result = board.spi_write(req.handle, payload, client_alive);
+    case Op::spi_write: {
+      std::string report;
+      reply.result = board.spi_write(req.handle, payload, &report, client_alive);
+      if (reply.result == kCheckFailed) failed_check(board, report, out);
       return;
+    }
     case Op::control: {
       std::string text;
       const std::string command(payload.begin(), payload.end());

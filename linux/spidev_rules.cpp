@@ -25,31 +25,18 @@ IoctlResult spi_setup_mode(std::uint32_t& mode) {
   return bad ? -EINVAL : 0;
 }
 
-std::uint8_t reverse_bits(std::uint8_t b) {
-  b = static_cast<std::uint8_t>((b & 0xF0) >> 4 | (b & 0x0F) << 4);
-  b = static_cast<std::uint8_t>((b & 0xCC) >> 2 | (b & 0x33) << 2);
-  b = static_cast<std::uint8_t>((b & 0xAA) >> 1 | (b & 0x55) << 1);
-  return b;
-}
-
 unsigned word_bytes(unsigned bits) { return bits <= 8 ? 1 : bits <= 16 ? 2 : 4; }
 
-// Host memory (words in little-endian order) -> bytes in wire order, and back.
+// Host memory (words in little-endian order) -> bytes in the order the controller shifts them,
+// and back: MSB first, a word goes out from its most significant byte; LSB first, from its least
+// significant one (each byte's bit order is the bus's business).
 void to_wire(const std::uint8_t* host, std::uint8_t* wire, std::size_t len, unsigned w, bool lsb_first) {
   for (std::size_t i = 0; i < len; i += w)
-    for (unsigned k = 0; k < w; ++k) {
-      const std::uint8_t b = lsb_first ? reverse_bits(host[i + k]) : host[i + (w - 1 - k)];
-      wire[i + k] = b;
-    }
+    for (unsigned k = 0; k < w; ++k) wire[i + k] = lsb_first ? host[i + k] : host[i + (w - 1 - k)];
 }
 void from_wire(const std::uint8_t* wire, std::uint8_t* host, std::size_t len, unsigned w, bool lsb_first) {
   for (std::size_t i = 0; i < len; i += w)
-    for (unsigned k = 0; k < w; ++k) {
-      if (lsb_first)
-        host[i + k] = reverse_bits(wire[i + k]);
-      else
-        host[i + (w - 1 - k)] = wire[i + k];
-    }
+    for (unsigned k = 0; k < w; ++k) (lsb_first ? host[i + k] : host[i + (w - 1 - k)]) = wire[i + k];
 }
 
 }  // namespace
@@ -202,6 +189,7 @@ void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc
   timing_ = {};
   timing_.default_speed_hz = s.speed_hz ? s.speed_hz : s.max_speed_hz;
   timing_.cs_high_ticks = ticks_from_us(10);  // spi.c's default cs_change delay
+  timing_.wire = spidev_wire_settings(s);
   auto speed_of = [&](const spi_ioc_transfer& x) {
     std::uint32_t hz = x.speed_hz ? x.speed_hz : s.speed_hz;
     if (hz == 0) hz = s.max_speed_hz;
@@ -214,13 +202,7 @@ void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc
   done_in_next_ = 0;
   cs_high_left_ = 0;
   bus_ticks_ = 0;
-  cs_high_mode_ = (s.mode & SPI_CS_HIGH) != 0;
-  if (cs_high_mode_) {
-    // The chip's CS input is active low: an active-high CS never selects it. Time still passes.
-    for (const auto& x : xfers) cs_high_left_ += transfer_ticks(x.len, speed_of(x)) + ticks_from_us(x.delay_usecs);
-    bus_ticks_ = cs_high_left_;
-    return;
-  }
+  cs_high_mode_ = false;  // an active-high CS is the wire's to model (ChainBus): it selects no chip
   off = 0;
   for (const auto& x : xfers) {
     const std::uint32_t hz = speed_of(x);
@@ -230,6 +212,7 @@ void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc
       SpiTransfer t;
       t.len = x.len;
       t.speed_hz = hz;
+      t.bits_per_word = x.bits_per_word;
       t.delay_usecs = x.delay_usecs;
       t.cs_change = x.cs_change != 0;
       if (x.word_delay_usecs && x.len > w) t.gap_ticks = ((x.len + w - 1) / w - 1) * ticks_from_us(x.word_delay_usecs);
@@ -245,6 +228,7 @@ void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc
         t.rx = std::span<std::uint8_t>(wire_rx_.data() + off + k, w);
         t.len = w;
         t.speed_hz = hz;
+        t.bits_per_word = x.bits_per_word;
         t.delay_usecs = last_word ? x.delay_usecs : x.word_delay_usecs;
         t.cs_change = last_word && x.cs_change;
         transfers_.push_back(t);
@@ -255,6 +239,7 @@ void SpidevWireMessage::prepare(const SpidevSettings& s, std::span<const spi_ioc
       t.rx = std::span<std::uint8_t>(wire_rx_.data() + off, x.len);
       t.len = x.len;
       t.speed_hz = hz;
+      t.bits_per_word = x.bits_per_word;
       t.delay_usecs = x.delay_usecs;
       t.cs_change = x.cs_change != 0;
       transfers_.push_back(t);
@@ -365,37 +350,16 @@ void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const
   message.finish(rx);
 }
 
-void check_spidev_settings_for_chip(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
-                                    std::uint32_t& already, const std::function<void(const std::string&)>& report) {
-  auto once = [&](std::uint32_t bit, const std::string& text) {
-    if (already & bit) return;
-    already |= bit;
-    report(text);
-  };
-  const unsigned mode = s.mode & 3;
-  if (mode != 3)
-    once(1u << mode, "SPI mode " + std::to_string(mode) +
-                         ": the L6470 family needs mode 3 (CPOL=1, CPHA=1); real chips may misread these bytes "
-                         "(served as if in mode 3)");
-  if (s.mode & SPI_LSB_FIRST)
-    once(1u << 4, "LSB first: the chip shifts MSB first, so it sees every byte bit-reversed");
-  if (s.mode & SPI_CS_HIGH)
-    once(1u << 5, "CS active high: the chip's CS is active low, so it never sees a frame (MISO reads 0x00)");
-  std::uint32_t fastest = 0;
-  for (const auto& x : xfers) {
-    std::uint32_t hz = x.speed_hz ? x.speed_hz : s.speed_hz;
-    if (hz > kControllerMaxSpeedHz) hz = kControllerMaxSpeedHz;
-    if (hz > fastest) fastest = hz;
-  }
-  if (fastest > kChipMaxSpeedHz)
-    once(1u << 6, "SCK " + std::to_string(fastest) + " Hz is above the chip's 5 MHz maximum (served as if it worked)");
-  for (const auto& x : xfers) {
-    const unsigned bits = x.bits_per_word ? x.bits_per_word : s.bits_per_word;
-    if (bits != 8) {
-      once(1u << 7, std::to_string(bits) + "-bit words: the chip frames 8-bit bytes; words go out most significant byte first");
-      break;
-    }
-  }
+WireSettings spidev_wire_settings(const SpidevSettings& s) {
+  WireSettings w;
+  w.mode = static_cast<std::uint8_t>(s.mode & (SPI_CPOL | SPI_CPHA));
+  w.lsb_first = (s.mode & SPI_LSB_FIRST) != 0;
+  w.cs_active_high = (s.mode & SPI_CS_HIGH) != 0;
+  w.bits_per_word = s.bits_per_word;
+  std::uint32_t hz = s.speed_hz ? s.speed_hz : s.max_speed_hz;
+  w.speed_hz = hz > kControllerMaxSpeedHz ? kControllerMaxSpeedHz : hz;
+  w.cs_setup_timed = false;  // the controller's own CS-to-clock delay is not known
+  return w;
 }
 
 }  // namespace l6470emu

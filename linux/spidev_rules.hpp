@@ -15,6 +15,7 @@
 #include "core/tick.hpp"
 #include "spi/message.hpp"
 #include "spi/spi_device.hpp"
+#include "spi/wire.hpp"
 
 namespace l6470emu {
 
@@ -41,9 +42,6 @@ inline constexpr std::uint32_t kControllerMaxSpeedHz = 125'000'000;
 /// the emulator, whatever the setting's source: SPI_IOC_WR_MAX_SPEED_HZ (which spidev accepts),
 /// a transfer's speed_hz or the description's speed=.
 inline constexpr std::uint32_t kControllerMinSpeedHz = 3815;
-
-/// Fastest SCK the L6470 family accepts (datasheet: 5 MHz).
-inline constexpr std::uint32_t kChipMaxSpeedHz = 5'000'000;
 
 /// The settings the kernel keeps per spidev device (shared by every open file).
 struct SpidevSettings {
@@ -89,12 +87,16 @@ std::size_t spidev_tx_bytes(std::span<const spi_ioc_transfer> xfers);
 /// Bytes of rx data a message produces (sum of len over transfers with an rx_buf).
 std::size_t spidev_rx_bytes(std::span<const spi_ioc_transfer> xfers);
 
+/// The wire settings of `s` (mode, bit order, CS polarity, word size, speed) as the bus sees them.
+WireSettings spidev_wire_settings(const SpidevSettings& s);
+
 /// Runs a validated message on `dev` with spi_sync's chip-select rules (run_message), charging
 /// word_delay_usecs, delay_usecs and a 10 us CS-high time between cs_change transfers like the
 /// kernel. `tx` holds the tx data of the transfers that have a tx_buf, concatenated; `rx`
-/// receives the rx data of those with an rx_buf. Word order (bits_per_word 16/32, little-endian
-/// host) and LSB-first bit order are turned into the bytes the chip sees on the wire. With
-/// SPI_CS_HIGH the chip's active-low CS never selects it: nothing reaches it and MISO reads 0.
+/// receives the rx data of those with an rx_buf. Words (bits_per_word 16/32, little-endian host)
+/// go to the bus as bytes in the order the controller shifts them; the mode, the bit order and
+/// the CS polarity are the bus's business (spidev_wire_settings, BusTiming::wire): `dev` is the
+/// board's bus begun with the same settings.
 void run_spidev_message(SpiDevice& dev, const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
                         std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
@@ -133,11 +135,5 @@ class SpidevWireMessage {
   Tick cs_high_left_ = 0;            // SPI_CS_HIGH: bus time still to pass
   Tick bus_ticks_ = 0;               // SPI_CS_HIGH: the whole message's
 };
-
-/// Settings of `s` (and of the transfers) the chip cannot work with, as one line each:
-/// SPI mode other than 3, LSB first, CS active high, SCK above 5 MHz. `report` is called once
-/// per distinct problem; `already` is a bit set of the problems reported before (updated).
-void check_spidev_settings_for_chip(const SpidevSettings& s, std::span<const spi_ioc_transfer> xfers,
-                                    std::uint32_t& already, const std::function<void(const std::string&)>& report);
 
 }  // namespace l6470emu

@@ -7,10 +7,13 @@
 #include <span>
 
 #include "core/tick.hpp"
+#include "spi/wire.hpp"
 
 namespace l6470emu {
 
-/// A SPI slave (or a daisy chain of them) behind one chip-select, SPI mode 3, MSB first.
+/// A SPI slave (or a daisy chain of them) behind one chip-select. select/exchange/deselect are
+/// the byte path: SPI mode 3, MSB first, bytes as the chip expects them. The *_wire functions
+/// serve a host with any settings (spi/wire.hpp); use one face or the other for a whole frame.
 class SpiDevice {
  public:
   virtual ~SpiDevice() = default;
@@ -28,6 +31,22 @@ class SpiDevice {
   virtual void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
     for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
   }
+
+  // ---- hosts with any wire settings (spi/wire.hpp) ----------------------------------------
+  /// CS falling edge of a host whose bytes go through exchange_wire(): as select(). A device that
+  /// models the wire also applies t_disCS: after a deselect_wire() less than kDeselectMinTicks ago
+  /// its chips had no time to load their answers.
+  virtual void select_wire() { select(); }
+  /// Clocks `tx` as a host with `wire` settings does (mode, bit order): each chip receives, and
+  /// `rx` gets, the bits the chip's edge rules give. The default knows only the byte path and
+  /// serves every setting as mode 3, MSB first.
+  virtual void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) {
+    (void)wire;
+    exchange(tx, rx);
+  }
+  /// CS rising edge after exchange_wire(): as deselect(); a device that models the wire keeps
+  /// each chip's SDO latch for the next frame.
+  virtual void deselect_wire() { deselect(); }
 
   /// Virtual time of the device.
   virtual Tick now() const = 0;

@@ -33,6 +33,11 @@ ServeCommands::ServeCommands(CLI::App& app) {
   serve_->add_option("--number-from", serve_number_from_,
                      "which end chip 0 is at in diagnostics and ctl: miso (chip 0 drives MISO) or mosi (chip 0 reads "
                      "the host's MOSI); default the board's numbering=, else miso");
+  serve_->add_option("--check", check_,
+                     "the driver sanitizer: off, warn (a log line per broken rule of the chip) or error (a client that "
+                     "breaks one exits with status 86 and the report); default the board's check=, else warn");
+  serve_->add_option("--check-allow", check_allow_,
+                     "rules the sanitizer lets pass, comma separated; default the board's check.allow=");
   serve_->add_flag("--cuse", cuse_,
                    "also serve each chain as a real character device /dev/spidevB.C through CUSE "
                    "(root; modprobe cuse), for every program, static or not");
@@ -89,6 +94,26 @@ std::optional<int> ServeCommands::run() {
         return 2;
       }
       config.numbering = *from;
+    }
+    // The sanitizer: --check and --check-allow over the description's check= and check.allow=.
+    const std::string& level = check_;
+    const std::string& allow = check_allow_;
+    std::string why;
+    if (!level.empty()) {
+      const auto l = parse_check_level(level, why);
+      if (!l) {
+        std::cerr << "l6470emu serve: --check " << why << "\n";
+        return 2;
+      }
+      config.check.level = *l;
+    }
+    if (!allow.empty()) {
+      const auto rules = parse_rule_list(allow, why);
+      if (!rules) {
+        std::cerr << "l6470emu serve: --check-allow " << why << "\n";
+        return 2;
+      }
+      config.check.allowed = *rules;
     }
     const std::string socket = !socket_.empty() ? socket_ : !config.socket.empty() ? config.socket : default_socket_path();
     FrontEnds front_ends;

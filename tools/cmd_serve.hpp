@@ -33,6 +33,8 @@ class ServeCommands {
   std::string node_group_ = "root";
   std::string node_mode_ = "0660";
   std::string serve_number_from_;  // serve --number-from (overrides numbering=)
+  std::string check_;              // serve --check (overrides check=)
+  std::string check_allow_;        // serve --check-allow (overrides check.allow=)
   std::string ctl_number_from_;    // ctl --number-from before the command word
   std::string command_word_;  // the ctl command; its arguments come from remaining()
 };

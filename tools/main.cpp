@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   auto* tables = app.add_subcommand("tables", "print the tables the model uses, as Markdown");
   tables->add_option("--table", table, "which table")
       ->check(CLI::IsMember({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
-                             "variant-differences"}));
+                             "variant-differences", "sanitizer-rules"}));
   tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
 
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl

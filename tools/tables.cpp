@@ -1,6 +1,8 @@
 // Markdown rendering of the register, STATUS and command tables.
 #include "tools/tables.hpp"
 
+#include "board/check_rules.hpp"
+
 #include <array>
 #include <cstdio>
 #include <string>
@@ -258,7 +260,15 @@ std::string variant_differences_markdown() {
   return out;
 }
 
+std::string sanitizer_rules_markdown() {
+  std::string out = "| rule (check.allow=) | what it is about | datasheet |\n|---|---|---|\n";
+  for (const RuleInfo& r : rule_table())
+    out += "| `" + std::string(r.name) + "` | " + std::string(r.about) + " | " + std::string(r.datasheet) + " |\n";
+  return out;
+}
+
 std::string generated_block(std::string_view name) {
+  if (name == "sanitizer-rules") return sanitizer_rules_markdown();
   if (name == "variant-registers") return variant_registers_markdown();
   if (name == "variant-status") return variant_status_markdown();
   if (name == "variant-differences") return variant_differences_markdown();

@@ -29,8 +29,12 @@ std::string variant_status_markdown();
 /// UNCONFIRMED choice, per variant.
 std::string variant_differences_markdown();
 
+/// The driver sanitizer's rules (board/check_rules.hpp): name, what it is about, where the
+/// datasheet states it.
+std::string sanitizer_rules_markdown();
+
 /// The generated block called `name` ("l6470-registers", "l6470-status", "commands", "variant-registers",
-/// "variant-status", "variant-differences"), or "" if unknown.
+/// "variant-status", "variant-differences", "sanitizer-rules"), or "" if unknown.
 std::string generated_block(std::string_view name);
 
 /// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of

@@ -143,6 +143,7 @@ SpiSettings settings_of(const SPI_HandleTypeDef* h) {
                                          (h->Init.CLKPhase == SPI_PHASE_2EDGE ? 1 : 0));
   s.bus.lsb_first = h->Init.FirstBit == SPI_FIRSTBIT_LSB;
   s.sixteen = h->Init.DataSize == SPI_DATASIZE_16BIT || h->Init.DataSize == 0x00000800U;  // F1/F4 write DFF as 0x800
+  s.bus.bits_per_word = s.sixteen ? 16 : 8;
   return s;
 }
 

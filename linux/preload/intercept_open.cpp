@@ -15,6 +15,7 @@
 
 #include "linux/log.hpp"
 #include "linux/preload/node_path.hpp"
+#include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
@@ -63,6 +64,7 @@ bool try_open(int dirfd, const char* path, int flags, int& fd) {
       return true;
     }
     if (walk == NodeWalk::not_ours) {
+      note_missing_node(path);  // a /dev/spidev or gpiochip path the board lacks: said once
       if (std::strncmp(path, "/sys/", 5) != 0) return false;
       const VirtualPath v = lookup_virtual(path, true);
       if (v.type == VirtualPath::Type::file) {

@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "linux/preload/backend.hpp"
+#include "linux/preload/check_exit.hpp"
 #include "linux/preload/virtual_time.hpp"
 
 namespace l6470emu::preload {
@@ -31,12 +32,20 @@ class LocalBackend final : public Backend {
   long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created, bool) override {
     return board_.ioctl(handle, cmd, arg, created);
   }
+  // check=error: a message that broke a rule of the chip ends the run with the report.
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                    std::span<std::uint8_t> rx) override {
-    return board_.spi_message(handle, xfers, tx, rx);
+    std::string report;
+    return checked(board_.spi_message(handle, xfers, tx, rx, &report), report);
   }
-  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override { return board_.spi_read(handle, rx); }
-  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override { return board_.spi_write(handle, tx); }
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
+    std::string report;
+    return checked(board_.spi_read(handle, rx, &report), report);
+  }
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
+    std::string report;
+    return checked(board_.spi_write(handle, tx, &report), report);
+  }
   // The scheduler's lock before the board's: the scheduler moves the board while holding it.
   void before_fork() override {
     if (virtual_time_) virtual_time_->before_fork();
@@ -55,6 +64,11 @@ class LocalBackend final : public Backend {
   }
 
  private:
+  static long checked(long result, const std::string& report) {
+    if (result == kCheckFailed) end_run_for_check(report);
+    return result;
+  }
+
   void start_trace() {
     if (trace_.empty()) return;
     if (const std::string error = board_.start_recording_all(trace_); !error.empty())

@@ -13,6 +13,7 @@
 #include <mutex>
 
 #include "linux/preload/backend.hpp"
+#include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/protocol.hpp"
@@ -106,7 +107,7 @@ class RemoteBackend final : public Backend {
     if (!roundtrip_locked(req, {reinterpret_cast<const std::uint8_t*>(xfers.data()), head}, tx, rep, scratch_, fd, true))
       return -ENODEV;
     if (rep.result >= 0) std::memcpy(rx.data(), scratch_.data(), std::min(rx.size(), scratch_.size()));
-    return static_cast<long>(rep.result);
+    return checked(rep.result);
   }
 
   long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
@@ -116,7 +117,7 @@ class RemoteBackend final : public Backend {
     std::lock_guard lock(m_);
     if (!roundtrip_locked(req, {}, {}, rep, scratch_, fd, true)) return -ENODEV;
     if (rep.result >= 0) std::memcpy(rx.data(), scratch_.data(), std::min(rx.size(), scratch_.size()));
-    return static_cast<long>(rep.result);
+    return checked(rep.result);
   }
 
   long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
@@ -125,7 +126,14 @@ class RemoteBackend final : public Backend {
     int fd = -1;
     std::lock_guard lock(m_);
     if (!roundtrip_locked(req, tx, {}, rep, scratch_, fd, true)) return -ENODEV;
-    return static_cast<long>(rep.result);
+    return checked(rep.result);
+  }
+
+  // check=error on the daemon's board: the reply carries the sanitizer's report instead of the
+  // data, and this program's run ends with it (the daemon goes on serving the others).
+  long checked(std::int64_t result) {
+    if (result == kCheckFailed) end_run_for_check(std::string(scratch_.begin(), scratch_.end()));
+    return static_cast<long>(result);
   }
 
   void before_fork() override { m_.lock(); }

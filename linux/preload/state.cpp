@@ -14,6 +14,7 @@
 #include "linux/board_config_file.hpp"
 #include "linux/device_paths.hpp"
 #include "linux/log.hpp"
+#include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
 
 namespace l6470emu::preload {
@@ -51,9 +52,18 @@ void atfork_child() {
   if (Backend* b = g_backend.load()) b->after_fork_child();
 }
 
-// Runs when the library is loaded: a malformed config stops the program with one line.
+[[noreturn]] void config_error(const std::string& message) {
+  const std::string line = message + "\n";
+  raw_write_all(2, line.data(), line.size());
+  _exit(2);
+}
+
+// Runs when the library is loaded: a malformed config stops the program with one line; a
+// mistyped L6470EMU_* variable gets a warning even when it leaves nothing configured.
 __attribute__((constructor)) void load_config() {
   Guard guard;
+  if (const std::string unknown = unknown_environment_variables(environ); !unknown.empty())
+    raw_write_all(2, unknown.data(), unknown.size());
   const char* socket = std::getenv("L6470EMU_SOCKET");
   const char* chain = std::getenv("L6470EMU_CHAIN");
   const char* file = std::getenv("L6470EMU_CONFIG");
@@ -72,15 +82,29 @@ __attribute__((constructor)) void load_config() {
   }
   // A node path this machine already uses for something else would be taken over: refused too.
   if (parsed.config) parsed.error.message = check_device_paths(*parsed.config, origin);
-  if (!parsed.config || !parsed.error.message.empty()) {
-    std::string line = parsed.error.message + "\n";
-    raw_write_all(2, line.data(), line.size());
-    _exit(2);
-  }
+  if (!parsed.config || !parsed.error.message.empty()) config_error(parsed.error.message);
   g_config = new BoardConfig(std::move(*parsed.config));
   if (socket && *socket) g_config->socket = socket;
   if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) g_config->log = log;
   if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) g_config->trace = trace;
+  if (const char* check = std::getenv("L6470EMU_CHECK"); check && *check) {
+    std::string why;
+    const auto level = parse_check_level(check, why);
+    if (!level) config_error("l6470emu: L6470EMU_CHECK " + why);
+    g_config->check.level = *level;
+  }
+  if (const char* allow = std::getenv("L6470EMU_CHECK_ALLOW"); allow && *allow) {
+    std::string why;
+    const auto rules = parse_rule_list(allow, why);
+    if (!rules) config_error("l6470emu: L6470EMU_CHECK_ALLOW " + why);
+    g_config->check.allowed = *rules;
+  }
+  // Virtual host time is in process only: with a daemon the program's clock stays real.
+  if (g_config->time.virtual_time && !g_config->socket.empty())
+    config_error(std::string("l6470emu: time=virtual runs the board inside the program, but ") +
+                 (socket && *socket ? "L6470EMU_SOCKET" : "socket=") + " sends it to the daemon at " +
+                 g_config->socket +
+                 ": drop one (the daemon's clock is virtual with `serve --virtual-time`, moved by bus time and `ctl advance`)");
   g_log = new DiagnosticLog(g_config->log);
   g_pid.store(getpid(), std::memory_order_release);
   pthread_atfork(atfork_prepare, atfork_parent, atfork_child);
@@ -115,6 +139,9 @@ Backend* backend() {
                                                              : make_remote_backend(g_config->socket, g_config->log);
     if (!g_config->socket.empty() && !g_config->trace.empty())
       log_line("trace= / L6470EMU_TRACE is ignored with a daemon: record with `serve --record` or `ctl trace start`");
+    if (!g_config->socket.empty() && (std::getenv("L6470EMU_CHECK") || std::getenv("L6470EMU_CHECK_ALLOW")))
+      log_line("L6470EMU_CHECK / L6470EMU_CHECK_ALLOW are ignored with a daemon: its board checks as its description "
+               "says (serve --chain \"... check=error\")");
     b = made.release();
   } catch (const std::exception& e) {
     log_line(std::string("cannot start the emulator: ") + e.what());

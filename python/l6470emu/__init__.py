@@ -2,6 +2,8 @@
 
 Chain(["L6470", "L6480"]) is a daisy chain of emulated chips in virtual time: byte-level
 frames (Chain.frame), the reference host's commands (get_status, move, ...), pins and faults,
+a driver sanitizer (check="error" by default: the first broken rule of the chip raises
+SanitizerError with its report; check_rules() lists the rules),
 STATUS decoded (Status), and recording into native traces that replay() and decode() read;
 motion() samples what each chip did over a trace, and l6470emu.plot draws it (matplotlib).
 The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spidev_board
@@ -23,11 +25,15 @@ from ._l6470emu import (
     Reg,
     RegisterInfo,
     ReplayResult,
+    SANITIZER_EXIT_STATUS,
+    SanitizerError,
+    SanitizerWarning,
     Thermal,
     Trace,
     TraceError,
     TraceEvent,
     __version__,
+    check_rules,
     decode,
     motion,
     register_table,
@@ -53,12 +59,16 @@ __all__ = [
     "Motion",
     "RegisterInfo",
     "ReplayResult",
+    "SANITIZER_EXIT_STATUS",
+    "SanitizerError",
+    "SanitizerWarning",
     "Status",
     "Thermal",
     "Trace",
     "TraceError",
     "TraceEvent",
     "__version__",
+    "check_rules",
     "decode",
     "motion",
     "preload_library",

@@ -2,12 +2,13 @@
 # checks that every name here exists in the module and the other way round.
 import enum
 import os
-from typing import Callable, Iterator, List, Optional, Sequence, Union, overload
+from typing import Callable, Iterator, List, Optional, Sequence, Tuple, Union, overload
 
 from ._status import Status
 
 __version__: str
 TICKS_PER_SECOND: int
+SANITIZER_EXIT_STATUS: int
 DEFAULT_MAX_FRAMES: int  # the most frames a trace file may hold unless max_frames= says otherwise
 MAX_MOTION_POINTS: int   # the most samples per chip motion() takes (max_points=)
 
@@ -110,9 +111,16 @@ class Diagnostic:
     @property
     def message(self) -> str: ...
 
+class SanitizerError(AssertionError): ...
+class SanitizerWarning(UserWarning): ...
+
+def check_rules() -> List[Tuple[str, str, str]]: ...
+
 class Chain:
     def __init__(self, chips: _Chips = "L6470", *, record: Union[_Path, bool, None] = None,
-                 frame_gap_ticks: int = 8) -> None: ...
+                 frame_gap_ticks: int = 8, check: str = "error", check_allow: Sequence[str] = ()) -> None: ...
+    check: str
+    check_allow: List[str]
     def __len__(self) -> int: ...
     def __enter__(self) -> Chain: ...
     def __exit__(self, *args: object) -> None: ...

@@ -8,6 +8,12 @@ Fixtures:
 The chips come from the l6470_chain marker, chip 0 (the MISO end) first; default one L6470:
   @pytest.mark.l6470_chain("L6470", "2xL6480")
 
+Both fixtures run the driver sanitizer at check="error": the first broken rule of the chip's
+interface (SPI mode, frame length, an unknown or refused command, an answer never read, ...)
+fails the test with the sanitizer's report (l6470emu.SanitizerError in process; exit status
+l6470emu.SANITIZER_EXIT_STATUS under the preload). The marker's keywords change that:
+  @pytest.mark.l6470_chain("L6470", check="warn", check_allow=["FRAME_LENGTH"])
+
 Installed, the plugin is registered through its pytest11 entry point; from a build tree, put
 `pytest_plugins = ["l6470emu.pytest_plugin"]` in the top conftest.py (with the build's python/
 directory on PYTHONPATH).
@@ -27,8 +33,22 @@ _DEFAULT_CHIPS = ("L6470",)
 def pytest_configure(config):
     config.addinivalue_line(
         "markers",
-        f"{_MARKER}(*chips): the chips of the l6470_chain and spidev_board fixtures, chip 0 "
-        "(the MISO end) first, e.g. \"L6470\", \"2xL6480\" (default: one L6470)")
+        f"{_MARKER}(*chips, check=\"error\", check_allow=()): the chips of the l6470_chain and spidev_board "
+        "fixtures, chip 0 (the MISO end) first, e.g. \"L6470\", \"2xL6480\" (default: one L6470), and the "
+        "driver sanitizer's level and allowed rules")
+
+
+def _check(request):
+    """The marker's check= and check_allow= (default "error", none allowed)."""
+    marker = request.node.get_closest_marker(_MARKER)
+    kwargs = dict(marker.kwargs) if marker is not None else {}
+    check = kwargs.pop("check", "error")
+    allow = kwargs.pop("check_allow", ())
+    if kwargs:
+        raise pytest.UsageError(f"@pytest.mark.{_MARKER}: unknown keyword(s) {sorted(kwargs)} (check=, check_allow=)")
+    if isinstance(allow, str):
+        raise pytest.UsageError(f"@pytest.mark.{_MARKER}: check_allow is a list of rule names, not {allow!r}")
+    return check, list(allow)
 
 
 def _chips(request) -> List[str]:
@@ -46,7 +66,8 @@ def l6470_chain(request):
     """An l6470emu.Chain of the marker's chips (default one L6470), fresh from power-up."""
     import l6470emu
 
-    chain = l6470emu.Chain(_chips(request))
+    check, allow = _check(request)
+    chain = l6470emu.Chain(_chips(request), check=check, check_allow=allow)
     yield chain
     chain.close()
 
@@ -61,8 +82,14 @@ class SpidevBoard:
     its traffic into trace_path, which trace(), decode() and replay() read.
     """
 
-    def __init__(self, chips: Sequence[str], directory: Path):
+    def __init__(self, chips: Sequence[str], directory: Path, check: str = "error",
+                 check_allow: Sequence[str] = ()):
         self.chips: List[str] = list(chips)
+        #: the driver sanitizer: "error" (a broken rule of the chip ends the program with exit status
+        #: l6470emu.SANITIZER_EXIT_STATUS and fails the test with the report), "warn" (log lines) or "off"
+        self.check: str = check
+        #: rules the sanitizer lets pass (names as in l6470emu.check_rules())
+        self.check_allow: List[str] = list(check_allow)
         #: B of /dev/spidevB.C
         self.bus: int = 0
         #: C of /dev/spidevB.C
@@ -87,7 +114,10 @@ class SpidevBoard:
     @property
     def description(self) -> str:
         """The board description given as L6470EMU_CHAIN."""
-        words = [f"bus={self.bus}", f"cs={self.cs}", "chips=" + ",".join(self.chips), f"time={self.time}"]
+        words = [f"bus={self.bus}", f"cs={self.cs}", "chips=" + ",".join(self.chips), f"time={self.time}",
+                 f"check={self.check}"]
+        if self.check_allow:
+            words.append("check.allow=" + ",".join(self.check_allow))
         if self.options:
             words.append(self.options)
         return " ".join(words)
@@ -100,7 +130,7 @@ class SpidevBoard:
     def env(self, base: Optional[Dict[str, str]] = None) -> Dict[str, str]:
         """The environment a program runs in: `base` (default os.environ) plus the preload."""
         env = dict(os.environ if base is None else base)
-        for name in ("L6470EMU_SOCKET", "L6470EMU_CONFIG", "L6470EMU_TRACE"):
+        for name in ("L6470EMU_SOCKET", "L6470EMU_CONFIG", "L6470EMU_TRACE", "L6470EMU_CHECK", "L6470EMU_CHECK_ALLOW"):
             env.pop(name, None)  # this board, in process, nothing inherited
         preload = self.preload
         env["LD_PRELOAD"] = preload + (":" + env["LD_PRELOAD"] if env.get("LD_PRELOAD") else "")
@@ -116,13 +146,21 @@ class SpidevBoard:
         """Runs args under the board; returns the CompletedProcess (text stdout and stderr).
 
         A trace left by an earlier run is removed first. With check (the default), a
-        non-zero exit fails the test with the program's output and the board's log."""
+        non-zero exit fails the test with the program's output and the board's log; an exit by
+        the driver sanitizer (status l6470emu.SANITIZER_EXIT_STATUS) fails it with the report."""
         if self.trace_path is not None and self.trace_path.exists():
             self.trace_path.unlink()
         argv = [os.fspath(a) for a in args]
         result = subprocess.run(argv, env=self.env(env), cwd=cwd, input=input, capture_output=True, text=True,
                                 timeout=timeout)
         if check and result.returncode != 0:
+            import l6470emu
+
+            if result.returncode == l6470emu.SANITIZER_EXIT_STATUS:
+                report = result.stderr[result.stderr.find("l6470emu: driver sanitizer:"):]
+                pytest.fail(
+                    f"{' '.join(argv)} broke a rule of the chip on board '{self.description}':\n{report}"
+                    f"--- stdout\n{result.stdout}", pytrace=False)
             pytest.fail(
                 f"{' '.join(argv)} exited with {result.returncode} on board '{self.description}'\n"
                 f"--- stdout\n{result.stdout}--- stderr\n{result.stderr}--- board log\n{self.log()}",
@@ -164,4 +202,5 @@ class SpidevBoard:
 @pytest.fixture
 def spidev_board(request, tmp_path):
     """A SpidevBoard of the marker's chips (default one L6470) for running programs under the preload."""
-    return SpidevBoard(_chips(request), tmp_path)
+    check, allow = _check(request)
+    return SpidevBoard(_chips(request), tmp_path, check=check, check_allow=allow)

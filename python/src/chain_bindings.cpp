@@ -30,6 +30,37 @@ std::size_t chip_arg(const PyChain& c, py::handle k) {
   throw py::type_error("chip: an int index is needed (0 drives MISO)");
 }
 
+/// A check=error failure on its way to Python (translated into l6470emu.SanitizerError).
+struct SanitizerFailure : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+PyObject* sanitizer_warning() {
+  static PyObject* w = PyErr_NewExceptionWithDoc(
+      "l6470emu._l6470emu.SanitizerWarning",
+      "A broken rule of the chip's interface under check=\"warn\" (the sanitizer's report line).", PyExc_UserWarning,
+      nullptr);
+  return w;
+}
+
+CheckConfig check_config_from(py::object level, py::object allow) {
+  CheckConfig cc;
+  if (!py::isinstance<py::str>(level)) throw py::type_error("check: \"off\", \"warn\" or \"error\"");
+  std::string why;
+  const auto l = parse_check_level(std::string(py::str(level)), why);
+  if (!l) throw py::value_error("check " + why);
+  cc.level = *l;
+  if (py::isinstance<py::str>(allow)) throw py::type_error("check_allow: a list of rule names, not one string");
+  for (py::handle item : allow) {
+    if (!py::isinstance<py::str>(item)) throw py::type_error("check_allow: rule names are strings");
+    const auto rules = parse_rule_list(std::string(py::str(item)), why);
+    if (!rules) throw py::value_error("check_allow " + why);
+    for (const RuleInfo& r : rule_table())
+      if (rules->contains(r.rule)) cc.allowed.insert(r.rule);
+  }
+  return cc;
+}
+
 py::object make_status(const Chip& chip, std::uint16_t value) {
   return py::module_::import("l6470emu._status")
       .attr("Status")(value, describe_status(chip.status_layout(), value), std::string(chip.variant().name));
@@ -40,6 +71,14 @@ std::int32_t position_arg(py::handle v, const char* what) {
   return static_cast<std::int32_t>(int_in_range(v, what, -(1LL << 21), kMax22));
 }
 
+/// The sanitizer after SPI traffic: check=warn lines become l6470emu.SanitizerWarning warnings,
+/// a check=error failure raises l6470emu.SanitizerError with the report.
+void after_spi(PyChain& p) {
+  for (const std::string& line : p.take_check_lines())
+    if (PyErr_WarnEx(sanitizer_warning(), line.c_str(), 1) != 0) throw py::error_already_set();
+  if (auto report = p.take_check_failure()) throw SanitizerFailure(*report);
+}
+
 std::uint8_t level_arg(py::handle v, const char* what) {
   if (PyBool_Check(v.ptr())) return v.ptr() == Py_True ? 1 : 0;
   return static_cast<std::uint8_t>(int_in_range(v, what, 0, 1));
@@ -48,6 +87,19 @@ std::uint8_t level_arg(py::handle v, const char* what) {
 }  // namespace
 
 void bind_chain(py::module_& m) {
+  static py::exception<SanitizerFailure> error = py::register_exception<SanitizerFailure>(m, "SanitizerError", PyExc_AssertionError);
+  error.attr("__doc__") = "A broken rule of the chip's interface under check=\"error\": the sanitizer's report.";
+  m.attr("SanitizerWarning") = py::handle(sanitizer_warning());
+  m.def(
+      "check_rules",
+      [] {
+        std::vector<std::tuple<std::string, std::string, std::string>> out;
+        for (const RuleInfo& r : rule_table()) out.emplace_back(r.name, r.about, r.datasheet);
+        return out;
+      },
+      "The driver sanitizer's rules as (name, what it is about, where the datasheet states it).");
+  m.attr("SANITIZER_EXIT_STATUS") = kSanitizerExitStatus;
+
   py::class_<ChainDiagnostic>(m, "Diagnostic", "A host mistake a chip noticed (it sets WRONG_CMD / NOTPERF_CMD as the chip would).")
       .def_readonly("tick", &ChainDiagnostic::tick, "when, in 250 ns ticks")
       .def_readonly("chip", &ChainDiagnostic::chip, "which chip")
@@ -64,9 +116,13 @@ for chip k and MISO byte k is chip k's answer. Nothing moves until time is advan
 
 chips: variant names, chip 0 first ("L6470", "2xL6480", "3*L6470"), as a list or one
 comma-separated string, or a number of L6470s. record: a path to record a native trace into (flushed frame by
-frame), True to record into memory (Chain.trace), or None.)");
+frame), True to record into memory (Chain.trace), or None. check: the driver sanitizer,
+"error" (default: the first broken rule of the chip, such as an unknown opcode, a refused
+command, a frame that is not the chain's length or an answer never read, raises
+l6470emu.SanitizerError with its report), "warn" (an l6470emu.SanitizerWarning each) or "off";
+check_allow: rule names it lets pass (l6470emu.check_rules()).)");
 
-  c.def(py::init([](py::object chips, py::object record, py::object frame_gap_ticks) {
+  c.def(py::init([](py::object chips, py::object record, py::object frame_gap_ticks, py::object check, py::object check_allow) {
           const std::string spec = chain_spec_from(chips);
           std::vector<const Variant*> variants;
           try {
@@ -80,13 +136,38 @@ frame), True to record into memory (Chain.trace), or None.)");
           else if (!record.is_none())
             to.path = path_from(record, "record");
           const auto gap = static_cast<Tick>(int_in_range(frame_gap_ticks, "frame_gap_ticks", 1, 1LL << 32));
+          const CheckConfig cc = check_config_from(check, check_allow);
           try {
-            return std::make_unique<PyChain>(variants, to, gap);
+            return std::make_unique<PyChain>(variants, to, gap, cc);
           } catch (const std::runtime_error& e) {
             throw std::runtime_error(std::string("record: ") + e.what());
           }
         }),
-        py::arg("chips") = "L6470", py::kw_only(), py::arg("record") = py::none(), py::arg("frame_gap_ticks") = 8);
+        py::arg("chips") = "L6470", py::kw_only(), py::arg("record") = py::none(), py::arg("frame_gap_ticks") = 8,
+        py::arg("check") = "error", py::arg("check_allow") = py::tuple());
+  c.def_property(
+       "check", [](const PyChain& p) { return std::string(to_string(p.check().level)); },
+       [](PyChain& p, py::object level) {
+         CheckConfig cc = p.check();
+         cc.level = check_config_from(level, py::tuple()).level;
+         p.set_check(cc);
+       },
+       "The driver sanitizer's level: \"error\" (the default: the first broken rule of the chip raises "
+       "SanitizerError with its report), \"warn\" (a SanitizerWarning each) or \"off\".")
+      .def_property(
+          "check_allow",
+          [](const PyChain& p) {
+            std::vector<std::string> out;
+            for (const RuleInfo& r : rule_table())
+              if (p.check().allowed.contains(r.rule)) out.emplace_back(r.name);
+            return out;
+          },
+          [](PyChain& p, py::object rules) {
+            CheckConfig cc = p.check();
+            cc.allowed = check_config_from(py::str("error"), rules).allowed;
+            p.set_check(cc);
+          },
+          "The rules the sanitizer lets pass (names as in l6470emu.check_rules()).");
 
   c.def("__len__", [](const PyChain& p) { return p.chain().size(); }, "Number of chips.")
       .def_property_readonly(
@@ -114,9 +195,11 @@ frame), True to record into memory (Chain.trace), or None.)");
            bytes_into(out, rx, "out");
            p.frame(tx, rx);
            bytes_into(out, rx, "out");
+           after_spi(p);
            return out;
          }
          p.frame(tx, rx);
+         after_spi(p);
          return py::bytes(reinterpret_cast<const char*>(rx.data()), rx.size());
        },
        py::arg("data"), py::arg("out") = py::none(),
@@ -131,11 +214,12 @@ Time does not advance by itself: call advance() between frames as a bus would ta
             const std::size_t k = chip_arg(p, chip);
             const auto tx = bytes_from(data, "data");
             const auto rx = p.host().send(k, tx);
+            after_spi(p);
             return py::bytes(reinterpret_cast<const char*>(rx.data()), rx.size());
           },
           py::arg("chip"), py::arg("data"),
           "Sends bytes to one chip, one frame per byte (NOP to the others); returns that chip's MISO byte of each frame.")
-      .def("nop", [](PyChain& p, py::handle chip) { p.host().nop(chip_arg(p, chip)); }, py::arg("chip"),
+      .def("nop", [](PyChain& p, py::handle chip) { p.host().nop(chip_arg(p, chip)); after_spi(p); }, py::arg("chip"),
            "A NOP frame for the chip.");
 
   // ---- the reference host's commands -------------------------------------------
@@ -144,6 +228,7 @@ Time does not advance by itself: call advance() between frames as a bus would ta
        [](PyChain& p, py::handle chip) {
          const std::size_t k = chip_arg(p, chip);
          const std::uint16_t s = p.host().get_status(k);
+         after_spi(p);
          return make_status(p.chain().chip(k), s);
        },
        py::arg("chip"), "GetStatus: the STATUS answer (an int with its flags decoded); clears the latched flags.")
@@ -151,7 +236,9 @@ Time does not advance by itself: call advance() between frames as a bus would ta
           "get_param",
           [](PyChain& p, py::handle chip, py::handle reg) {
             const std::size_t k = chip_arg(p, chip);
-            return p.host().get_param(k, register_from(p.chain().chip(k), k, reg).id);
+            const std::uint32_t v = p.host().get_param(k, register_from(p.chain().chip(k), k, reg).id);
+            after_spi(p);
+            return v;
           },
           py::arg("chip"), py::arg("reg"),
           "GetParam: the register's value as the chip answers it (raw bits; ABS_POS/MARK unsigned 22-bit). "
@@ -166,6 +253,7 @@ Time does not advance by itself: call advance() between frames as a bus would ta
                                        r.is_signed() ? -(1LL << (r.bits - 1)) : 0, max);
             if (v < 0) v &= (1LL << r.bits) - 1;
             p.host().set_param(k, r.id, static_cast<std::uint32_t>(v));
+            after_spi(p);
           },
           py::arg("chip"), py::arg("reg"), py::arg("value"),
           "SetParam: value in the register's SPI bytes (bits above its width are ignored by the chip, as on "
@@ -174,28 +262,31 @@ Time does not advance by itself: call advance() between frames as a bus would ta
           "run",
           [](PyChain& p, py::handle chip, bool forward, py::handle speed) {
             p.host().run(chip_arg(p, chip), forward, static_cast<std::uint32_t>(int_in_range(speed, "speed", 0, kMax20)));
+            after_spi(p);
           },
           py::arg("chip"), py::arg("forward"), py::arg("speed"), "Run at speed (SPEED units, 2^-28 step/tick).")
-      .def("step_clock", [](PyChain& p, py::handle chip, bool forward) { p.host().step_clock(chip_arg(p, chip), forward); },
+      .def("step_clock", [](PyChain& p, py::handle chip, bool forward) { p.host().step_clock(chip_arg(p, chip), forward); after_spi(p); },
            py::arg("chip"), py::arg("forward"), "StepClock: step-clock mode (STCK rising edges make microsteps).")
       .def(
           "move",
           [](PyChain& p, py::handle chip, bool forward, py::handle n_step) {
             p.host().move(chip_arg(p, chip), forward, static_cast<std::uint32_t>(int_in_range(n_step, "n_step", 0, kMax22)));
+            after_spi(p);
           },
           py::arg("chip"), py::arg("forward"), py::arg("n_step"), "Move n_step microsteps (0..2^22-1).")
       .def(
           "go_to",
-          [](PyChain& p, py::handle chip, py::handle abs_pos) { p.host().go_to(chip_arg(p, chip), position_arg(abs_pos, "abs_pos")); },
+          [](PyChain& p, py::handle chip, py::handle abs_pos) { p.host().go_to(chip_arg(p, chip), position_arg(abs_pos, "abs_pos")); after_spi(p); },
           py::arg("chip"), py::arg("abs_pos"), "GoTo abs_pos the shortest way (22-bit position; negative allowed).")
       .def(
           "goto",
-          [](PyChain& p, py::handle chip, py::handle abs_pos) { p.host().go_to(chip_arg(p, chip), position_arg(abs_pos, "abs_pos")); },
+          [](PyChain& p, py::handle chip, py::handle abs_pos) { p.host().go_to(chip_arg(p, chip), position_arg(abs_pos, "abs_pos")); after_spi(p); },
           py::arg("chip"), py::arg("abs_pos"), "Same as go_to().")
       .def(
           "go_to_dir",
           [](PyChain& p, py::handle chip, bool forward, py::handle abs_pos) {
             p.host().go_to_dir(chip_arg(p, chip), forward, position_arg(abs_pos, "abs_pos"));
+            after_spi(p);
           },
           py::arg("chip"), py::arg("forward"), py::arg("abs_pos"), "GoTo_DIR: to abs_pos in the given direction.")
       .def(
@@ -203,6 +294,7 @@ Time does not advance by itself: call advance() between frames as a bus would ta
           [](PyChain& p, py::handle chip, bool copy_to_mark, bool forward, py::handle speed) {
             p.host().go_until(chip_arg(p, chip), copy_to_mark, forward,
                               static_cast<std::uint32_t>(int_in_range(speed, "speed", 0, kMax20)));
+            after_spi(p);
           },
           py::arg("chip"), py::arg("copy_to_mark"), py::arg("forward"), py::arg("speed"),
           "GoUntil: run at speed until SW closes; copy_to_mark (ACT) copies ABS_POS to MARK instead of resetting it.")
@@ -210,6 +302,7 @@ Time does not advance by itself: call advance() between frames as a bus would ta
           "release_sw",
           [](PyChain& p, py::handle chip, bool copy_to_mark, bool forward) {
             p.host().release_sw(chip_arg(p, chip), copy_to_mark, forward);
+            after_spi(p);
           },
           py::arg("chip"), py::arg("copy_to_mark"), py::arg("forward"), "ReleaseSW: at minimum speed until SW opens.");
 
@@ -224,7 +317,7 @@ Time does not advance by itself: call advance() between frames as a bus would ta
                                "HardHiZ: bridges off at once."};
   for (std::size_t i = 0; i < std::size(simple); ++i) {
     const auto fn = simple[i].second;
-    c.def(simple[i].first, [fn](PyChain& p, py::handle chip) { (p.host().*fn)(chip_arg(p, chip)); }, py::arg("chip"),
+    c.def(simple[i].first, [fn](PyChain& p, py::handle chip) { (p.host().*fn)(chip_arg(p, chip)); after_spi(p); }, py::arg("chip"),
           simple_docs[i]);
   }
 

@@ -7,18 +7,26 @@
 
 namespace l6470emu::python {
 
-PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap)
+PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap,
+                 const CheckConfig& check)
     : chain_(std::make_unique<Chain>(make_chain(variants))),
       diagnostics_(std::make_unique<DiagnosticStore>()),
       frame_gap_(frame_gap) {
+  check_lines_ = std::make_unique<std::vector<std::string>>();
+  sanitizer_ = std::make_unique<Sanitizer>(
+      check, [lines = check_lines_.get()](std::string_view line) {
+        if (lines->size() < kMaxDiagnostics) lines->emplace_back(line);
+      });
+  checker_ = std::make_unique<ChainChecker>(*sanitizer_, *chain_, "Chain");
   for (std::size_t k = 0; k < chain_->size(); ++k) {
-    chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), k](const Diagnostic& d) {
+    chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), checker = checker_.get(), k](const Diagnostic& d) {
       static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored"};
       if (store->kept.size() == kMaxDiagnostics) {
         store->kept.pop_front();
         ++store->dropped;
       }
       store->kept.push_back({d.tick, k, kKinds[static_cast<int>(d.kind)], d.message});
+      checker->chip_diagnostic(k, d);
     });
   }
   if (!record.path.empty()) {
@@ -29,16 +37,19 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
     memory_ = std::make_shared<Trace>();
     rec_ = std::make_unique<RecordingChain>(*chain_, *memory_);
   }
-  host_ = std::make_unique<ChainHost>(*chain_, bus(), frame_gap_);
+  bus_ = std::make_unique<ChainBus>(rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_, *chain_, *checker_);
+  bus_->set_untimed();  // time moves only when Python says so
+  host_ = std::make_unique<ChainHost>(*chain_, *bus_, frame_gap_);
 }
 
 PyChain::~PyChain() = default;
 
 void PyChain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  SpiDevice& b = bus();
-  b.select();
-  b.exchange(tx, rx);
-  b.deselect();
+  bus_->begin({});
+  bus_->select();
+  bus_->exchange(tx, rx);
+  bus_->deselect();
+  bus_->end();
 }
 
 void PyChain::advance_to(Tick tick) {
@@ -88,7 +99,7 @@ void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
 void PyChain::close() {
   if (!rec_) return;
   rec_->observe_outputs();
-  host_ = std::make_unique<ChainHost>(*chain_, frame_gap_);
+  bus_->set_device(*chain_);
   rec_.reset();
   file_.reset();
 }

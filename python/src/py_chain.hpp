@@ -1,7 +1,8 @@
 // The state behind l6470emu.Chain: a daisy chain, the reference host driving it, and, when
 // asked, a RecordingChain in front of it so that every frame, pin and fault goes into a
-// native trace (a file flushed event by event, or a Trace in memory). Diagnostics the chips
-// raise are kept for Python to take. No Python types here; chain_bindings.cpp wraps it.
+// native trace (a file flushed event by event, or a Trace in memory). Frames go through the
+// board's ChainBus, watched by the driver sanitizer (check=). Diagnostics the chips raise are
+// kept for Python to take. No Python types here; chain_bindings.cpp wraps it.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "board/chain_bus.hpp"
+#include "board/sanitizer.hpp"
 #include "daisychain/chain.hpp"
 #include "daisychain/host.hpp"
 #include "daisychain/recording_chain.hpp"
@@ -38,15 +41,17 @@ class PyChain {
   /// Diagnostics kept at most (older ones are dropped and counted).
   static constexpr std::size_t kMaxDiagnostics = 10000;
 
-  PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap);
+  PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap,
+          const CheckConfig& check = {CheckLevel::error, {}});
   ~PyChain();
   PyChain(const PyChain&) = delete;
   PyChain& operator=(const PyChain&) = delete;
 
   Chain& chain() { return *chain_; }
   const Chain& chain() const { return *chain_; }
-  /// What frames go through: the recorder when recording, else the chain.
-  SpiDevice& bus() { return rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_; }
+  /// What frames go through: the sanitizer's bus in front of the recorder when recording, else
+  /// in front of the chain.
+  SpiDevice& bus() { return *bus_; }
   ChainHost& host() { return *host_; }
 
   /// One CS frame through the bus.
@@ -73,6 +78,18 @@ class PyChain {
   /// Takes the diagnostics kept so far; `dropped` gets how many were not kept.
   std::vector<ChainDiagnostic> take_diagnostics(std::uint64_t& dropped);
 
+  /// The sanitizer's settings (check=, check_allow=).
+  const CheckConfig& check() const { return sanitizer_->config(); }
+  void set_check(const CheckConfig& c) { sanitizer_->set_config(c); }
+  /// Lines check=warn logged since the last call.
+  std::vector<std::string> take_check_lines() {
+    std::vector<std::string> out;
+    out.swap(*check_lines_);
+    return out;
+  }
+  /// Under check=error: the report of the first broken rule, taken.
+  std::optional<std::string> take_check_failure() { return sanitizer_->take_failure(); }
+
  private:
   struct DiagnosticStore {
     std::deque<ChainDiagnostic> kept;
@@ -85,6 +102,10 @@ class PyChain {
   std::shared_ptr<Trace> memory_;
   std::unique_ptr<TraceSink> file_;
   std::unique_ptr<RecordingChain> rec_;
+  std::unique_ptr<std::vector<std::string>> check_lines_;
+  std::unique_ptr<Sanitizer> sanitizer_;
+  std::unique_ptr<ChainChecker> checker_;
+  std::unique_ptr<ChainBus> bus_;
   std::unique_ptr<ChainHost> host_;
   std::string record_path_;
   Tick frame_gap_;

@@ -69,13 +69,15 @@ TEST(BoardSpi, AFrontDrivingItsOwnChipSelectClocksOneByteAtATimeAndEachByteTakes
     front.chip_select(true);
     miso[i] = front.transfer(mosi[i]);
     front.chip_select(false);
+    v.board.advance(4);  // the host keeps CS high for 1 µs (t_disCS is 800 ns)
   }
   EXPECT_EQ(miso[1], 0x2E);
   EXPECT_EQ(miso[2], 0x88);  // CONFIG's reset value
   // 8 bits at 5 MHz are 1.6 µs: 7 whole ticks a byte; the chip-select edges take no bus time.
   EXPECT_EQ(transfer_ticks(1, 5'000'000), Tick{7});
-  EXPECT_EQ(v.board.time().now(), Tick{3 * 7});
-  EXPECT_EQ(v.board.now(0), Tick{3 * 7});
+  EXPECT_EQ(v.board.time().now(), Tick{3 * (7 + 4)});
+  EXPECT_EQ(v.board.now(0), Tick{3 * (7 + 4)});
+  EXPECT_TRUE(v.log.empty()) << v.log.front();
   EXPECT_FALSE(v.board.chain(0).selected());
 }
 
@@ -190,12 +192,14 @@ TEST(BoardPinChipSelect, LsbFirstReachesTheChipBitReversedAndTwoSelectedChainsSh
   BusSettings lsb;
   lsb.lsb_first = true;
   // 0x1C sent LSB first is 0x38 on the wire: GetParam(CONFIG). The answer comes back reversed too.
+  // CS stays high 1 us between frames (t_disCS is 800 ns: sooner, the chip has not loaded its answer).
   std::array<std::uint8_t, 1> mosi{0x1C}, miso{};
   v.board.drive_chip_select(0, true);
-  v.board.clock_bytes(bus, mosi, miso, lsb);
+  v.board.advance_to(v.board.clock_bytes(bus, mosi, miso, lsb));
   v.board.drive_chip_select(0, false);
   std::array<std::uint8_t, 2> answer{};
   for (std::uint8_t& b : answer) {
+    v.board.advance_to(v.board.time().now() + ticks_from_us(1));
     v.board.drive_chip_select(0, true);
     const std::uint8_t nop = 0;
     v.board.advance_to(v.board.clock_bytes(bus, std::span(&nop, 1), std::span(&b, 1), lsb));

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -271,6 +272,27 @@ TEST(FirmwareRunDeathTest, TheRunEndsAtItsLimitWithOneLineAndStatusZero) {
               "firmware run stopped at its time limit: 0.002 s of virtual time \\(limit=2ms\\); loop\\(\\) had run 0 times");
   EXPECT_EXIT(run_until_the_limit("chips=L6470 limit=5ms", true), testing::ExitedWithCode(0),
               "at its time limit: 0.005 s of virtual time \\(limit=5ms\\)");
+}
+
+void clock_a_mode0_byte(const char* description) {
+  Rig r(description);
+  BusSettings mode0;
+  mode0.mode = 0;
+  std::uint8_t b = 0x00, in = 0;
+  r.rt.set_pin_mode(r.pin("10"), McuPinMode::output);
+  r.rt.write_pin(r.pin("10"), false);
+  r.rt.call();
+  r.rt.transfer(0, mode0, std::span(&b, 1), std::span(&in, 1));
+  std::fprintf(stderr, "ran on\n");
+  std::exit(0);
+}
+
+TEST(FirmwareSanitizerDeathTest, UnderCheckErrorTheFirstBrokenRuleEndsTheRunWithStatus86AndTheReport) {
+  EXPECT_EXIT(clock_a_mode0_byte("chips=L6470 cs_pin=10 check=error"), testing::ExitedWithCode(86),
+              "driver sanitizer: SPI_MODE on spidev0.0, chip 0, frame 1, byte 0");
+  EXPECT_EXIT(clock_a_mode0_byte("chips=L6470 cs_pin=10 check=warn"), testing::ExitedWithCode(0), "ran on");
+  EXPECT_EXIT(clock_a_mode0_byte("chips=L6470 cs_pin=10 check=error check.allow=SPI_MODE"), testing::ExitedWithCode(0),
+              "ran on");
 }
 
 }  // namespace

@@ -57,5 +57,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace && a.firmware == b.firmware,
              "time or trace reads back differently from the description:\n%.300s", description.c_str());
+  FUZZ_CHECK(a.check == b.check && a.numbering == b.numbering,
+             "check=, check.allow= or numbering= read back differently from the description:\n%.300s",
+             description.c_str());
   return 0;
 }

@@ -1,5 +1,6 @@
 // libFuzzer harness of the SPI face: the input picks a chain (1-8 chips, any variants and
-// quirks), then CS frames, pin changes, backdoor faults and time advances, run in lockstep
+// quirks), then CS frames (on the byte path, and on the bit-level face in any SPI mode and bit
+// order, with deselects shorter than t_disCS), pin changes, backdoor faults and time advances, run in lockstep
 // on two chains (fast and reference motion engines). Checked at every step: ABS_POS stays
 // 22-bit, a GetStatus leaves exactly the conditions that persist latched, both engines agree
 // (MISO, STATUS, pins, motion state), a frame's MISO is as long as its MOSI. No oracle for
@@ -77,7 +78,7 @@ class Harness {
   void run() {
     check_all();
     while (in_.remaining_bytes() > 0) {
-      switch (in_.ConsumeIntegralInRange<int>(0, 9)) {
+      switch (in_.ConsumeIntegralInRange<int>(0, 10)) {
         case 0:
         case 1:
         case 2: raw_frame(); break;
@@ -88,6 +89,7 @@ class Harness {
         case 7: fault(); break;
         case 8: poll_status(); break;
         case 9: split_frame(); break;
+        case 10: wire_frame(); break;
       }
       if (compare_every_step_) check_all();
     }
@@ -185,6 +187,39 @@ class Harness {
     }
     exchange_both(in_.ConsumeBytes<std::uint8_t>(in_.ConsumeIntegralInRange<std::size_t>(0, 2 * size())), 0);
     deselect_both();
+  }
+
+  /// A frame from a host with any wire settings (mode, bit order), in up to two runs of bytes
+  /// that may differ in mode, after a CS-high time that may be shorter than t_disCS.
+  void wire_frame() {
+    auto settings = [this] {
+      WireSettings w;
+      w.mode = in_.ConsumeIntegralInRange<std::uint8_t>(0, 3);
+      w.lsb_first = in_.ConsumeBool();
+      return w;
+    };
+    advance_by(in_.ConsumeIntegralInRange<Tick>(0, 6));
+    fast_->select_wire();
+    ref_->select_wire();
+    for (int run = in_.ConsumeIntegralInRange<int>(1, 2); run > 0; --run) {
+      const WireSettings w = settings();
+      const std::vector<std::uint8_t> tx = in_.ConsumeBytes<std::uint8_t>(in_.ConsumeIntegralInRange<std::size_t>(0, 2 * size() + 1));
+      std::vector<std::uint8_t> rf(tx.size(), 0xEE), rr(tx.size(), 0xEE);
+      fast_->exchange_wire(tx, rf, w);
+      ref_->exchange_wire(tx, rr, w);
+      FUZZ_CHECK(rf == rr, "MISO differs between the fast and the reference chain (mode %u)", unsigned{w.mode});
+    }
+    const std::vector<std::uint8_t> gs = get_status_decoders(*fast_);
+    FUZZ_CHECK(gs == get_status_decoders(*ref_), "the chains disagree on which chips decode GetStatus");
+    fast_->deselect_wire();
+    ref_->deselect_wire();
+    for (std::size_t i = 0; i < size(); ++i) {
+      FUZZ_CHECK(fast_->sdo_latch(i) == ref_->sdo_latch(i), "chip %zu's SDO latch differs between the chains", i);
+      if (gs[i]) {
+        check_status_after_get_status(fast_->chip(i), i, "fast");
+        check_status_after_get_status(ref_->chip(i), i, "reference");
+      }
+    }
   }
 
   /// A well-formed command for one chip, sent as one frame per byte with NOPs for the others.

@@ -255,7 +255,7 @@ TEST(BoardConfig, ACommentRunsToTheEndOfTheLineEvenPastASemicolon) {
                                                                  "path, gpiochip, speed, mode, bufsiz, cs_pin, "
                                                                  "busy/flag/sw/stck/stby_rst_pin, spi; board-wide: "
                                                                  "time, scale, idle, log, socket, trace, numbering, "
-                                                                 "call_time, loop_time, limit, apb_clock)");
+                                                                 "check, check.allow, call_time, loop_time, limit, apb_clock)");
 }
 
 TEST(BoardConfig, DefaultGpiochipsAvoidTheNumbersOtherChainsAskFor) {
@@ -501,6 +501,53 @@ TEST(SpidevRules, MessageLimitsAreTheBounceBuffers) {
   EXPECT_EQ(validate_spidev_message(s, std::span(x, 2)), -EMSGSIZE);
   x[0].len = 4088;  // 4088 + align8(1) = 4096: fits
   EXPECT_EQ(validate_spidev_message(s, std::span(x, 2)), 4089);
+}
+
+}  // namespace
+}  // namespace l6470emu
+
+namespace l6470emu {
+namespace {
+
+TEST(BoardConfigCheck, CheckAndCheckAllowSetTheSanitizerAndReadBackFromTheDescription) {
+  auto r = parse_board_config("chips=L6470", "T");
+  ASSERT_TRUE(r.config);
+  EXPECT_EQ(r.config->check.level, CheckLevel::warn);  // plain programs: today's log lines
+  EXPECT_TRUE(r.config->check.allowed.empty());
+  EXPECT_EQ(describe_board_config(*r.config).find("check"), std::string::npos);
+  r = parse_board_config("chips=2xL6470 check=error; check.allow=frame_length,SPI_MODE", "T");
+  ASSERT_TRUE(r.config) << r.error.message;
+  EXPECT_EQ(r.config->check.level, CheckLevel::error);
+  EXPECT_TRUE(r.config->check.allowed.contains(Rule::FRAME_LENGTH));
+  EXPECT_TRUE(r.config->check.allowed.contains(Rule::SPI_MODE));
+  EXPECT_FALSE(r.config->check.allowed.contains(Rule::WRONG_CMD));
+  const std::string described = describe_board_config(*r.config);
+  EXPECT_NE(described.find("check=error\ncheck.allow=SPI_MODE,FRAME_LENGTH\n"), std::string::npos) << described;
+  const auto again = parse_board_config(described, "described");
+  ASSERT_TRUE(again.config) << again.error.message;
+  EXPECT_EQ(again.config->check, r.config->check);
+  r = parse_board_config("chips=L6470 check=off", "T");
+  ASSERT_TRUE(r.config);
+  EXPECT_NE(describe_board_config(*r.config).find("check=off\n"), std::string::npos);
+}
+
+TEST(BoardConfigCheck, MistakesGetOneLineWithASuggestion) {
+  auto error_of = [](const char* text) { return parse_board_config(text, "T").error.message; };
+  EXPECT_EQ(error_of("chips=L6470 check=eror"),
+            "l6470emu: config T, clause 1: check must be off, warn or error, not 'eror' (did you mean error?)");
+  EXPECT_EQ(error_of("chips=L6470 check.allow=SPI_MODE,FRAME_LENGHT"),
+            "l6470emu: config T, clause 1: check.allow names no rule 'FRAME_LENGHT' (did you mean FRAME_LENGTH? rules: " +
+                all_rule_names() + ")");
+  EXPECT_EQ(error_of("chips=L6470 check.allow=SPI_MODE,,WRONG_CMD"),
+            "l6470emu: config T, clause 1: check.allow has an empty rule name in 'SPI_MODE,,WRONG_CMD' (write e.g. "
+            "SPI_MODE,FRAME_LENGTH)");
+  EXPECT_EQ(error_of("chips=L6470 sanitizer=error"),
+            "l6470emu: config T, clause 1: unknown key 'sanitizer': did you mean check=? (chain keys: chips, bus, cs, "
+            "path, gpiochip, speed, mode, bufsiz, cs_pin, busy/flag/sw/stck/stby_rst_pin, spi; board-wide: time, "
+            "scale, idle, log, socket, trace, numbering, check, check.allow, call_time, loop_time, limit, apb_clock)");
+  EXPECT_EQ(error_of("chips=L6470 check=warn; check=error"),
+            "l6470emu: config T, clause 2: check= is given twice: clause 1 says 'warn', clause 2 says 'error' (a "
+            "board-wide key is given once)");
 }
 
 }  // namespace

@@ -34,8 +34,9 @@ TEST(BoardDiagnostics, ADriverLoopingOnABadCommandGetsTenLinesAndATallyAtEachPow
   std::string all;
   for (const auto& l : lines) all += l + "\n";
   ASSERT_EQ(lines.size(), 13u) << all;
-  EXPECT_EQ(lines[0], "l6470emu: spidev0.0: chip 0: WRONG_CMD: byte 0xEB: reserved opcode");
-  EXPECT_EQ(lines[9], lines[0] + "  (further ones of this kind are counted, not shown)");
+  EXPECT_EQ(lines[0], "l6470emu: spidev0.0: chip 0: WRONG_CMD: byte 0xEB: reserved opcode (frame 1, byte 0)");
+  EXPECT_EQ(lines[9], "l6470emu: spidev0.0: chip 0: WRONG_CMD: byte 0xEB: reserved opcode (frame 10, byte 0)"
+                      "  (further ones of this kind are counted, not shown)");
   EXPECT_EQ(lines[10], "l6470emu: spidev0.0: chip 0: WRONG_CMD: 100 so far");
   EXPECT_EQ(lines[12], "l6470emu: spidev0.0: chip 0: WRONG_CMD: 10000 so far");
 }
@@ -59,7 +60,7 @@ TEST(BoardDiagnostics, NameTheChipAsTheBoardsNumberingCountsIt) {
   std::string first;
   std::getline(in, first);
   unlink(path.c_str());
-  EXPECT_EQ(first, "l6470emu: spidev0.0: chip 1: WRONG_CMD: byte 0xEB: reserved opcode");
+  EXPECT_EQ(first, "l6470emu: spidev0.0: chip 1: WRONG_CMD: byte 0xEB: reserved opcode (frame 1, byte 0)");
 }
 
 }  // namespace

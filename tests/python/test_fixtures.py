@@ -31,7 +31,7 @@ def test_l6470_chain_takes_its_chips_from_the_marker(l6470_chain):
 def test_spidev_board_runs_a_program_against_the_markers_chips(spidev_board, tmp_path):
     script = tmp_path / "status.py"
     script.write_text(SPIDEV_SCRIPT.format(bus=0, cs=0, chips=3))
-    assert spidev_board.description == "bus=0 cs=0 chips=L6470,2xL6480 time=virtual"
+    assert spidev_board.description == "bus=0 cs=0 chips=L6470,2xL6480 time=virtual check=error"
     result = spidev_board.python(script)
     assert result.stdout.split() == ["7C03", "E403", "E403"]
     assert spidev_board.trace().chain == "L6470,2*L6480"

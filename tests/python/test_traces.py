@@ -51,10 +51,11 @@ def test_a_recording_into_a_file_is_complete_as_it_goes(tmp_path):
 
 
 def test_decode_explains_every_command_per_chip():
-    chain = l6470emu.Chain(2, record=True)
+    chain = l6470emu.Chain(2, record=True, check="warn")
     chain.get_status(1)
     chain.move(1, False, 3200)
-    chain.frame(b"\xEB\x00")  # a reserved opcode for chip 0
+    with pytest.warns(l6470emu.SanitizerWarning, match="Chain: chip 0: WRONG_CMD: byte 0xEB: reserved opcode"):
+        chain.frame(b"\xEB\x00")  # a reserved opcode for chip 0
     result = l6470emu.decode(chain.trace)
     assert "chip 1   Move(REV, 3200 microsteps)" in result.text
     assert "GetStatus" in str(result)

@@ -23,6 +23,16 @@ TEST(Readme, GeneratedTablesMatchTheModel) {
       << "README tables are stale: run build/l6470emu tables --update-readme README.md";
 }
 
+TEST(Docs, TheLinuxPagesSanitizerRulesMatchTheModel) {
+  std::ifstream in(std::string(L6470EMU_SOURCE_DIR) + "/docs/linux.md");
+  std::stringstream s;
+  s << in.rdbuf();
+  const std::string text = s.str();
+  ASSERT_NE(text.find("<!-- BEGIN generated:sanitizer-rules -->"), std::string::npos);
+  EXPECT_EQ(refresh_generated_blocks(text), text)
+      << "docs/linux.md's rules table is stale: run build/l6470emu tables --update-readme docs/linux.md";
+}
+
 TEST(Readme, HasEveryGeneratedBlock) {
   const std::string text = read_readme();
   for (const char* name : {"l6470-registers", "l6470-status", "commands"})

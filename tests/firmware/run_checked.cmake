@@ -1,0 +1,40 @@
+# A firmware program run under the driver sanitizer: PROGRAM runs with the environment ENV (a
+# list of NAME=VALUE); it must exit with STATUS, its standard error must contain every string of
+# STDERR_HAS (a list) and none of STDERR_LACKS, its standard output every string of STDOUT_HAS
+# and none of STDOUT_LACKS.
+# Lists are joined by | (strings with | in them cannot be checked).
+# Usage: cmake -DPROGRAM=... -DSTATUS=86 "-DENV=L6470EMU_CHECK=error" "-DSTDERR_HAS=a|b" -P run_checked.cmake
+foreach(v ENV STDERR_HAS STDERR_LACKS STDOUT_HAS STDOUT_LACKS)
+  string(REPLACE "|" ";" ${v} "${${v}}")
+endforeach()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env ${ENV} "${PROGRAM}" OUTPUT_VARIABLE out ERROR_VARIABLE err
+                RESULT_VARIABLE rc)
+set(shown "exit ${rc}\n--- stdout:\n${out}--- stderr:\n${err}")
+if(NOT rc EQUAL STATUS)
+  message(FATAL_ERROR "expected exit status ${STATUS}: ${shown}")
+endif()
+foreach(s IN LISTS STDERR_HAS)
+  string(FIND "${err}" "${s}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "stderr lacks '${s}': ${shown}")
+  endif()
+endforeach()
+foreach(s IN LISTS STDERR_LACKS)
+  string(FIND "${err}" "${s}" at)
+  if(NOT at LESS 0)
+    message(FATAL_ERROR "stderr has '${s}': ${shown}")
+  endif()
+endforeach()
+foreach(s IN LISTS STDOUT_HAS)
+  string(FIND "${out}" "${s}" at)
+  if(at LESS 0)
+    message(FATAL_ERROR "stdout lacks '${s}': ${shown}")
+  endif()
+endforeach()
+foreach(s IN LISTS STDOUT_LACKS)
+  string(FIND "${out}" "${s}" at)
+  if(NOT at LESS 0)
+    message(FATAL_ERROR "stdout has '${s}': ${shown}")
+  endif()
+endforeach()
+message(STATUS "exit ${rc} as expected; stderr:\n${err}")
