@@ -68,13 +68,14 @@ void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> r
   std::size_t head = head_;
   if (tx.size() >= n) {
     // At least a whole chain's worth: MISO is the ring's bytes then tx delayed by n, and the
-    // ring keeps tx's last n bytes, wherever the head ends up.
+    // ring keeps tx's last n bytes. Only the logical order of the ring matters, so it restarts
+    // at slot 0: two copies out, one copy in, no division per byte.
     const std::size_t size = tx.size();
-    for (std::size_t i = 0; i < n; ++i) rx[i] = ring[(head + i) % n];
+    std::memcpy(rx.data(), ring + head, n - head);
+    std::memcpy(rx.data() + (n - head), ring, head);
     std::memcpy(rx.data() + n, tx.data(), size - n);
-    const std::size_t new_head = (head + size) % n;
-    for (std::size_t i = 0; i < n; ++i) ring[(new_head + i) % n] = tx[size - n + i];
-    head_ = new_head;
+    std::memcpy(ring, tx.data() + (size - n), n);
+    head_ = 0;
     bytes_in_frame_ += size;
     return;
   }
