@@ -40,11 +40,10 @@ void Chip::reset_logic() {
   motion_ = MotionState{};
   motion_.travel = travel;
   refresh_profile();
-  collecting_ = false;
+  set_collecting(false);
   args_seen_ = 0;
   arg_ = 0;
   response_ = 0;
-  response_left_ = 0;
   ocd_shutdown_ = false;
   switch_act_ = false;
   // Any logic reset forces the UVLO flag active; ongoing faults show at once.
@@ -66,17 +65,12 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
   // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
   // the flags, which cannot have changed, so polling does not work the motion out.
-  if (byte == 0xD0 && !collecting_) {
-    // GetStatus, the polling command, straight through.
-    load_response(status(), 2);
-    clear_status_on_get_status();
-    return next_response_byte();
-  }
+  if (byte == 0xD0 && !collecting_) return get_status(status());  // the polling command, straight through
   sync();
   if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
-      collecting_ = false;
+      set_collecting(false);
       execute(pending_, arg_);
       if (axis_) axis_after_change();
     }
@@ -101,7 +95,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
     default:
       if (op.arg_bytes > 0) {
         pending_ = op;
-        collecting_ = true;
+        set_collecting(true);
         args_seen_ = 0;
         arg_ = 0;
       } else {
@@ -326,7 +320,20 @@ std::uint16_t Chip::status_slow() const {
     live_bits_ = encode_live(layout_, live_status());
     live_bits_known_ = true;
   }
+  status_until_ = status_known_without_sync() ? status_horizon() : 0;
   return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+}
+
+Tick Chip::status_horizon() const {
+  Tick until = kNever;
+  if (motion_active(motion_)) {
+    // Known while now_ - motion_now_ <= run_.left; uniform ticks keep motion_now_ + run_.left.
+    if (run_.left < kNever - 1 - motion_now_) until = motion_now_ + run_.left + 1;
+    if (axis_) until = std::min(until, axis_event_at_);
+  } else if (axis_) {
+    until = axis_->next_time_event();
+  }
+  return until;
 }
 
 void Chip::latched_changed() {
@@ -372,11 +379,11 @@ void Chip::sync() const {
   motion_now_ = now_;
   if (!motion_active(motion_)) return;
   if (engine_ == MotionEngine::reference) {
-    live_bits_known_ = false;
+    forget_live_bits();
     reference_advance(motion_, profile_, left);
     return;
   }
-  if (fast_advance(motion_, profile_, left, run_)) live_bits_known_ = false;
+  if (fast_advance(motion_, profile_, left, run_)) forget_live_bits();
 }
 
 Tick Chip::next_event_tick() const {
@@ -596,7 +603,7 @@ void Chip::attach_axis(const AxisSpec& spec) {
   axis_sw_ = sw_level_;
   axis_stall_ = false;
   axis_ocd_ = false;
-  axis_event_known_ = false;
+  forget_axis_event();
   axis_after_change();
 }
 
@@ -618,7 +625,7 @@ void Chip::set_axis_load(const LoadSpec& load) {
   sync();
   touched();
   axis_->set_load(load);
-  axis_event_known_ = false;
+  forget_axis_event();
   axis_settle(now_);
 }
 
@@ -659,7 +666,7 @@ DriveInputs Chip::drive_inputs() const {
 
 void Chip::axis_after_change() {
   axis_->set_drive(drive_inputs());
-  axis_event_known_ = false;
+  forget_axis_event();
   axis_settle(now_);
 }
 
@@ -667,7 +674,7 @@ void Chip::axis_settle(Tick at) {
   // The axis's outputs are the chip's SW pin, stall and overcurrent inputs; a change of them can
   // change the motion (a switch stops a GoUntil, OC_SD disables the bridges), so settle again.
   for (int round = 0; round < 8; ++round) {
-    if (axis_->settle(motion_, profile_, at)) axis_event_known_ = false;
+    if (axis_->settle(motion_, profile_, at)) forget_axis_event();
     bool drove = false;
     if (axis_->sw_level() != axis_sw_) {
       axis_sw_ = axis_->sw_level();
@@ -689,7 +696,7 @@ void Chip::axis_settle(Tick at) {
       drove = true;
     }
     if (!drove) return;
-    axis_event_known_ = false;
+    forget_axis_event();
   }
 }
 
@@ -709,7 +716,7 @@ void Chip::sync_with_axis() {
       if (e == kNever || e > t + left) break;
       left -= e - t;
       t = e;
-      live_bits_known_ = false;
+      forget_live_bits();
       axis_settle(t);
       continue;
     }
@@ -717,14 +724,14 @@ void Chip::sync_with_axis() {
       reference_tick(motion_, profile_);
       ++t;
       --left;
-      live_bits_known_ = false;
+      forget_live_bits();
       axis_settle(t);
       continue;
     }
     if (!run_.known) {
       run_.left = uniform_ticks(motion_, profile_, kNever - 1);
       run_.known = true;
-      axis_event_known_ = false;
+      forget_axis_event();
     }
     if (!axis_event_known_) {
       axis_event_at_ = t + axis_->first_event(motion_, profile_, std::min(run_.left, kAxisHorizon), t);
@@ -737,8 +744,8 @@ void Chip::sync_with_axis() {
       run_.left -= to_event;
       left -= to_event;
       t += to_event;
-      live_bits_known_ = false;
-      axis_event_known_ = false;
+      forget_live_bits();
+      forget_axis_event();
       axis_settle(t);
       continue;
     }
@@ -751,7 +758,7 @@ void Chip::sync_with_axis() {
     --left;
     ++t;
     run_.known = false;
-    live_bits_known_ = false;
+    forget_live_bits();
     axis_settle(t);
   }
 }

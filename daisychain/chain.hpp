@@ -38,7 +38,10 @@ class Chain final : public SpiDevice {
   // SpiDevice
   void select() override;
   std::uint8_t exchange(std::uint8_t mosi) override;
-  void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override;
+  void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override {
+    if (!selected_ || standby_in_frame_) return exchange_slow(tx, rx);
+    shift_bytes(tx, rx);
+  }
   void deselect() override;
   bool selected() const override { return selected_; }
   Tick now() const override { return now_; }
@@ -67,6 +70,16 @@ class Chain final : public SpiDevice {
  private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
+  /// The CS rising edge of a frame that clocked bytes: every chip decodes its register (SPI
+  /// mode 3, whole bytes) and loads its answer byte into it.
+  void decode_shift_registers();
+  /// The byte fast path (SPI mode 3, whole bytes, CS low, no chip in standby): the ring shifts
+  /// by tx.size() bytes. A frame of a short chain's length is swapped in place; anything else
+  /// goes through shift_runs(), a run of bytes at a time.
+  void shift_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  void shift_runs(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  /// exchange() with CS high or chips in standby.
+  void exchange_slow(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   /// false (nothing done) when no chip is in standby any more.
   bool exchange_through_standby(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
