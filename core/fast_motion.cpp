@@ -125,34 +125,53 @@ Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit) {
   return 0;
 }
 
-void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
-  if (n == 0 || !motion_active(s)) return;
+namespace {
+
+/// The rule of the uniform ticks ahead of `s` (motion active), without the cap (as the
+/// closed forms below use it: an invalid rule, never applied over a tick, reads as constant).
+Rule uniform_rule(const MotionState& s, const Profile& p) {
   const std::uint64_t floor = p.floor_speed();
-  Rule r;
   switch (s.activity) {
     case Activity::stopping:
-      r = ramp(s.speed, floor, p, false);
-      break;
+      return ramp(s.speed, floor, p, false);
     case Activity::run:
     case Activity::go_until:
     case Activity::release_sw:
-      r = s.reversing ? ramp(s.speed, floor, p, false) : ramp(s.speed, constant_speed_target(s, p), p, false);
-      break;
+      return s.reversing ? ramp(s.speed, floor, p, false) : ramp(s.speed, constant_speed_target(s, p), p, false);
     case Activity::position:
-      if (s.reversing)
-        r = ramp(s.speed, floor, p, false);
-      else if (s.braking)
-        r = s.speed > floor ? ramp(s.speed, floor, p, false) : Rule{true, 0, 0, kNever};
-      else
-        r = ramp(s.speed, p.max_speed, p, false);
-      break;
+      if (s.reversing) return ramp(s.speed, floor, p, false);
+      if (s.braking) return s.speed > floor ? ramp(s.speed, floor, p, false) : Rule{true, 0, 0, kNever};
+      return ramp(s.speed, p.max_speed, p, false);
     default:
-      return;
+      return Rule{};
   }
+}
+
+/// Microsteps made by n uniform ticks under `r`, and the fraction of a microstep left.
+struct Steps {
+  u128 steps;
+  std::uint64_t frac;
+};
+Steps steps_after(const MotionState& s, const Profile& p, const Rule& r, Tick n) {
   const u128 total = s.frac + distance_after(s.speed, r, n);
   const unsigned shift = 40u - p.step_sel;  // a microstep is 2^shift
-  const u128 steps = total >> shift;
-  s.frac = static_cast<std::uint64_t>(total) & (p.microstep() - 1);
+  return {total >> shift, static_cast<std::uint64_t>(total) & (p.microstep() - 1)};
+}
+
+/// Travel (1/128 step) of `steps` microsteps in the current direction.
+std::int64_t travel_of(const MotionState& s, const Profile& p, u128 steps) {
+  const std::int64_t moved = static_cast<std::int64_t>(steps) * p.el_increment();
+  return s.dir ? moved : -moved;
+}
+
+}  // namespace
+
+void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return;
+  const Rule r = uniform_rule(s, p);
+  const Steps made = steps_after(s, p, r, n);
+  const u128 steps = made.steps;
+  s.frac = made.frac;
   s.speed = speed_after(s.speed, r, n);
   if (steps == 0) return;
   const std::uint32_t mod22 = static_cast<std::uint32_t>(steps & 0x3FFFFF);
@@ -161,9 +180,18 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
   s.abs_pos = sign_extend(pos & 0x3FFFFF, 22);
   const std::uint32_t el = mod512 * p.el_increment();
   s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? el : 512u * 128u - el)) & 0x1FF);
-  const std::int64_t moved = static_cast<std::int64_t>(steps) * p.el_increment();
-  s.travel += s.dir ? moved : -moved;
+  s.travel += travel_of(s, p, steps);
   if (s.activity == Activity::position && !s.reversing) s.steps_left -= static_cast<std::uint32_t>(steps);
+}
+
+std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return s.speed;
+  return speed_after(s.speed, uniform_rule(s, p), n);
+}
+
+std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return s.travel;
+  return s.travel + travel_of(s, p, steps_after(s, p, uniform_rule(s, p), n).steps);
 }
 
 bool fast_advance(MotionState& s, const Profile& p, Tick ticks, UniformRun& run) {

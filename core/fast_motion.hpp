@@ -24,6 +24,11 @@ Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit);
 /// Applies `n` uniform ticks (n <= uniform_ticks()) in closed form.
 void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n);
 
+/// The speed apply_uniform_ticks(s, p, n) would leave, without working the rest out.
+std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
+/// The travel (1/128 step) apply_uniform_ticks(s, p, n) would leave, without working the rest out.
+std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
+
 /// What the event-driven engine remembers between calls: how many uniform ticks are left
 /// from the current state. Forget it (known = false) whenever the state or the profile is
 /// changed by anything but the passage of time.
