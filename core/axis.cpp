@@ -42,6 +42,7 @@ Axis::Axis(AxisSpec spec, std::int64_t travel)
   switches_.resize(spec_.switches.size());
   for (std::size_t i = 0; i < switches_.size(); ++i) {
     const SwitchSpec& sw = spec_.switches[i];
+    bouncing_ = bouncing_ || (sw.bounce_count > 0 && sw.bounce_ticks > 0);
     switches_[i].actuated = sw.above ? true_pos_ >= sw.position : true_pos_ <= sw.position;
     switches_[i].shown_closed = switches_[i].actuated != sw.normally_closed;
     if (switches_[i].shown_closed) sw_level_ = false;
@@ -179,6 +180,7 @@ bool Axis::settle(const MotionState& s, const Profile& p, Tick now) {
 
 Tick Axis::next_time_event() const {
   Tick next = kNever;
+  if (!bouncing_) return next;
   for (std::size_t i = 0; i < switches_.size(); ++i) {
     const SwitchSpec& sw = spec_.switches[i];
     const SwitchState& st = switches_[i];
@@ -215,16 +217,15 @@ Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now)
   // A change of speed band that changes what settle() would decide.
   const DrivePhase phase = drive_phase(s, p);
   const std::uint32_t b0 = speed_band(s.speed);
-  const std::uint32_t bn = speed_band(speed_after_uniform_ticks(s, p, m));
+  const std::uint64_t vm = speed_after_uniform_ticks(s, p, m);
+  const std::uint32_t bn = speed_band(vm);
   if (bn != b0) {
     const bool up = bn > b0;
     const std::uint32_t b = first_other_band(phase, s.dir, b0, bn);
     if (b != bn + (up ? 1 : -1)) {
-      const Tick k = first_true(1, m, [&](Tick i) {
-        const std::uint32_t bi = speed_band(speed_after_uniform_ticks(s, p, i));
-        return up ? bi >= b : bi <= b;
-      });
-      best = std::min(best, k);
+      // Band b begins at b * 2^22 (2^-40 step/tick); below band b + 1 is speed_band() <= b.
+      const std::uint64_t edge = std::uint64_t{up ? b : b + 1} << 22;
+      best = std::min(best, first_uniform_tick_at_speed(s, p, edge, up, m));
     }
   }
 
@@ -252,7 +253,12 @@ Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now)
         if (!fwd && act) consider(sw.position - sw.hysteresis - 1);
       }
     }
-    if (have) {
+    // The speed through the run lies between s.speed and vm, so in best - 1 ticks the motor
+    // travels at most this far (1/128 step): a goal beyond it is not reached, nothing to search.
+    const unsigned __int128 reach =
+        ((static_cast<unsigned __int128>(s.frac) + static_cast<unsigned __int128>(best - 1) * std::max(s.speed, vm)) >>
+         (40 - p.step_sel)) * p.el_increment();
+    if (have && reach >= static_cast<unsigned __int128>(fwd ? target - u : u - target)) {
       const std::int64_t goal = target - offset_;  // commanded travel at which it happens
       const Tick k = first_true(1, best - 1, [&](Tick i) {
         const std::int64_t t = travel_after_uniform_ticks(s, p, i);

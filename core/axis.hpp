@@ -125,6 +125,7 @@ class Axis {
   std::int64_t true_pos_ = 0;
   bool synced_ = true;
   std::vector<SwitchState> switches_;
+  bool bouncing_ = false;     // some switch bounces (has timed events)
   bool sw_level_ = true;
   bool stall_ = false;
   bool ocd_ = false;

@@ -36,6 +36,7 @@ void Chip::reset_logic() {
   touched();
   table_ = variant_;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
+  drive_stale_ = true;
   const std::int64_t travel = motion_.travel;  // the shaft does not move with a reset
   motion_ = MotionState{};
   motion_.travel = travel;
@@ -270,6 +271,7 @@ void Chip::write_register(const RegisterInfo& r, std::uint32_t value) {
   }
   regs_[r.address] = value;
   refresh_profile();
+  drive_stale_ = true;
 }
 
 void Chip::refresh_profile() {
@@ -320,8 +322,10 @@ std::uint16_t Chip::status_slow() const {
     live_bits_ = encode_live(layout_, live_status());
     live_bits_known_ = true;
   }
-  status_until_ = status_known_without_sync() ? status_horizon() : 0;
-  return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+  status_word_ = static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+  // Cached only with nothing latched to clear, so that a GetStatus from the cache is a read.
+  status_until_ = latched_clean_ && status_known_without_sync() ? status_horizon() : 0;
+  return status_word_;
 }
 
 Tick Chip::status_horizon() const {
@@ -338,7 +342,7 @@ Tick Chip::status_horizon() const {
 
 void Chip::latched_changed() {
   latched_bits_ = encode_latched(layout_, latched_);
-  latched_clean_ = false;
+  latches_dirty();
 }
 
 
@@ -508,7 +512,7 @@ void Chip::set_undervoltage(bool active) {
   sync();
   touched();
   condition_.uvlo = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_) return;
   if (active) latched_.uvlo = true;
   latched_changed();
@@ -518,7 +522,7 @@ void Chip::set_undervoltage(bool active) {
 
 void Chip::set_adc_undervoltage(bool active) {
   condition_.uvlo_adc = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (stby_level_ && active) latched_.uvlo_adc = true;
   latched_changed();
 }
@@ -529,7 +533,7 @@ void Chip::set_thermal(Thermal t) {
   // Shutdown has hysteresis: it only ends once the die is back below the warning level.
   if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
   condition_.thermal = t;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_) return;
   latched_.thermal = std::max(latched_.thermal, t);
   latched_changed();
@@ -541,7 +545,7 @@ void Chip::set_overcurrent(bool active) {
   sync();
   touched();
   condition_.ocd = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_ || !active) return;
   latched_.ocd = true;
   latched_changed();
@@ -551,7 +555,7 @@ void Chip::set_overcurrent(bool active) {
 
 void Chip::set_stall(Bridge bridge, bool active) {
   (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_ || !active) return;
   (bridge == Bridge::A ? latched_.stall_a : latched_.stall_b) = true;
   latched_changed();
@@ -600,6 +604,7 @@ void Chip::attach_axis(const AxisSpec& spec) {
   sync();
   touched();
   axis_ = ValuePtr<Axis>(std::make_unique<Axis>(spec, motion_.travel));
+  drive_stale_ = true;
   axis_sw_ = sw_level_;
   axis_stall_ = false;
   axis_ocd_ = false;
@@ -665,7 +670,10 @@ DriveInputs Chip::drive_inputs() const {
 }
 
 void Chip::axis_after_change() {
-  axis_->set_drive(drive_inputs());
+  if (drive_stale_) {
+    axis_->set_drive(drive_inputs());
+    drive_stale_ = false;
+  }
   forget_axis_event();
   axis_settle(now_);
 }

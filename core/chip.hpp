@@ -60,11 +60,28 @@ class alignas(64) Chip {
       assert(now >= now_);
       now_ = now;
       // GetStatus, the polling command, while its answer is known without working the motion out.
-      if (byte == 0xD0 && now < status_until_) return get_status(cached_status());
+      if (byte == 0xD0 && now < status_until_) {
+        const std::uint16_t status = cached_status();  // nothing latched to clear: a plain read
+        response_ = status & 0xFFu;
+        return static_cast<std::uint8_t>(status >> 8);
+      }
       return decode_byte(byte);
     }
     advance_to(now);
     return decode_byte(byte);
+  }
+
+  /// on_byte_at(now, 0x00), a NOP, that also ORs into `noise` something nonzero unless the chip
+  /// is left quiet: ready for an opcode with no answer byte left, so that further NOPs change
+  /// nothing and shift out 0x00 until some other byte, a pin or a fault reaches it.
+  std::uint8_t on_nop_at(Tick now, std::uint32_t& noise) {
+    if (ready_for_command_) {
+      const std::uint8_t out = next_response_byte();
+      noise |= response_;
+      return out;
+    }
+    noise |= 1;
+    return on_byte_at(now, 0x00);
   }
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
@@ -176,8 +193,8 @@ class alignas(64) Chip {
   std::uint16_t status_slow() const;
   /// STATUS while now_ < status_until_.
   std::uint16_t cached_status() const {
-    assert(status_known_without_sync());
-    return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+    assert(status_known_without_sync() && latched_clean_ && status_word_ == (latched_bits_ | live_bits_));
+    return status_word_;
   }
   /// GetStatus with STATUS = `status`: the answer is loaded, the latches cleared, the MSB returned.
   std::uint8_t get_status(std::uint16_t status) {
@@ -221,9 +238,11 @@ class alignas(64) Chip {
 
   // Fields every SPI byte or GetStatus touches come first, in the chip's first cache line.
   Tick now_ = 0;
-  // STATUS is latched_bits_ | live_bits_ at every now_ < status_until_ (0: not known). Set by
-  // status_slow() from status_known_without_sync(); anything that could shorten it resets it.
+  // STATUS is status_word_ (= latched_bits_ | live_bits_, with nothing latched to clear) at every
+  // now_ < status_until_ (0: not known). Set by status_slow() from status_known_without_sync();
+  // anything that could shorten it, or latch a flag, resets it.
   mutable Tick status_until_ = 0;
+  mutable std::uint16_t status_word_ = 0;
   std::uint32_t response_ = 0;  // answer bytes still to shift out, the next in the low byte (then 0x00s)
   bool collecting_ = false;
   bool stby_level_ = true;
@@ -283,6 +302,11 @@ class alignas(64) Chip {
   }
 
   void latched_changed();
+  /// Something may have latched: the next GetStatus has to look (and the STATUS cache is void).
+  void latches_dirty() {
+    latched_clean_ = false;
+    status_until_ = 0;
+  }
 
   AlarmFlags latched_{};   // what STATUS shows
   AlarmFlags condition_{}; // what is physically going on (events are never conditions)
@@ -300,6 +324,7 @@ class alignas(64) Chip {
   mutable Tick axis_event_at_ = 0;       // absolute tick of the axis's next event in the cached run
   mutable bool axis_event_known_ = false;
   bool axis_sw_ = true, axis_stall_ = false, axis_ocd_ = false;  // what the axis last drove
+  bool drive_stale_ = true;  // the registers drive_inputs() reads changed since the axis got them
   /// sync() with an axis: the same engines, stopping at every mechanical event.
   void sync_with_axis();
   /// Lets the axis apply its rules at tick `at` and passes its outputs to the chip's inputs.

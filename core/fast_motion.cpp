@@ -189,6 +189,24 @@ std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, 
   return speed_after(s.speed, uniform_rule(s, p), n);
 }
 
+Tick first_uniform_tick_at_speed(const MotionState& s, const Profile& p, std::uint64_t speed, bool up, Tick n) {
+  // After i uniform ticks the speed is v + i*delta (sign +1), v - i*delta (sign -1) or v (0),
+  // exactly as speed_after() computes it; solved for the first i in 1..n.
+  const Rule r = motion_active(s) ? uniform_rule(s, p) : Rule{};
+  const std::uint64_t v = s.speed;
+  Tick i = n + 1;  // none
+  if (up) {  // the first i with speed_i >= speed; the speed does not fall
+    if (r.sign < 0 && r.delta != 0) return first_true(1, n, [&](Tick k) { return speed_after(v, r, k) >= speed; });
+    if (v + r.delta >= speed) i = 1;
+    else if (r.delta != 0) i = ceil_div(speed - v, r.delta);
+  } else {  // the first i with speed_i < speed; the speed does not rise
+    if (r.sign > 0 && r.delta != 0) return first_true(1, n, [&](Tick k) { return speed_after(v, r, k) < speed; });
+    if (v - r.delta < speed) i = 1;  // (delta <= v - floor: no wrap)
+    else if (r.delta != 0) i = (v - speed) / r.delta + 1;
+  }
+  return i > n ? n + 1 : i;
+}
+
 std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
   if (n == 0 || !motion_active(s)) return s.travel;
   return s.travel + travel_of(s, p, steps_after(s, p, uniform_rule(s, p), n).steps);

@@ -26,6 +26,10 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n);
 
 /// The speed apply_uniform_ticks(s, p, n) would leave, without working the rest out.
 std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
+/// The first i in 1..n (n <= uniform_ticks()) after which speed_after_uniform_ticks(s, p, i) is
+/// at least `speed` (`up`) or below it (!up), n + 1 when there is none: solved, not searched.
+/// (The speed moves one way through uniform ticks; asked the other way, it is searched.)
+Tick first_uniform_tick_at_speed(const MotionState& s, const Profile& p, std::uint64_t speed, bool up, Tick n);
 /// The travel (1/128 step) apply_uniform_ticks(s, p, n) would leave, without working the rest out.
 std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
 

@@ -87,13 +87,19 @@ inline void copy_bytes(std::uint8_t* dst, const std::uint8_t* src, std::size_t c
 
 void Chain::shift_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
   const std::size_t n = ring_.size();
-  if (tx.size() == n && head_ == 0 && n <= 16) {
-    // A frame of a short chain's length (the usual frame): each register's byte out, tx's in.
+  if (tx.size() == n && head_ == 0) {
+    // A frame of the chain's length from slot 0 (the usual frame): the registers' bytes out,
+    // tx's in; a short chain's byte by byte, a long one's in two copies.
     std::uint8_t* const ring = ring_.data();
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint8_t out = ring[i];
-      ring[i] = tx[i];
-      rx[i] = out;
+    if (n <= 16) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::uint8_t out = ring[i];
+        ring[i] = tx[i];
+        rx[i] = out;
+      }
+    } else {
+      std::memcpy(rx.data(), ring, n);
+      std::memcpy(ring, tx.data(), n);
     }
     bytes_in_frame_ += n;
     return;
@@ -171,6 +177,22 @@ void Chain::decode_shift_registers() {
   const std::size_t n = chips_.size();
   const std::size_t head = head_;
   const Tick now = now_;
+  std::uint8_t any = 0;
+  for (std::size_t i = 0; i < n; ++i) any |= ring[i];
+  if (any == 0) {
+    // A frame of NOPs. On a quiet chain it changes nothing: every chip shifts out 0x00, which
+    // is what its register holds already. Otherwise each chip clocks an answer byte on.
+    if (quiet_) return;
+    std::uint32_t noise = 0;
+    const auto nops = [now, &noise](Chip* chip, std::uint8_t* slot, std::size_t count) {
+      for (std::size_t i = 0; i < count; ++i) slot[i] = chip[i].on_nop_at(now, noise);
+    };
+    nops(chips, ring + head, n - head);
+    if (head != 0) nops(chips + (n - head), ring, head);
+    quiet_ = noise == 0;
+    return;
+  }
+  quiet_ = false;
   const auto decode = [now](Chip* chip, std::uint8_t* slot, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) slot[i] = chip[i].on_byte_at(now, slot[i]);
   };

@@ -31,6 +31,7 @@ class Chain final : public SpiDevice {
   Chip& chip(std::size_t i) const {
     Chip& c = chips_.at(i);
     chips_touched_ = true;
+    quiet_ = false;
     c.advance_to(now_);
     return c;
   }
@@ -71,11 +72,12 @@ class Chain final : public SpiDevice {
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
   /// The CS rising edge of a frame that clocked bytes: every chip decodes its register (SPI
-  /// mode 3, whole bytes) and loads its answer byte into it.
+  /// mode 3, whole bytes) and loads its answer byte into it. A frame of NOPs to a quiet chain
+  /// (see quiet_) is known to change nothing.
   void decode_shift_registers();
   /// The byte fast path (SPI mode 3, whole bytes, CS low, no chip in standby): the ring shifts
-  /// by tx.size() bytes. A frame of a short chain's length is swapped in place; anything else
-  /// goes through shift_runs(), a run of bytes at a time.
+  /// by tx.size() bytes. A frame of the chain's length from slot 0 is swapped whole; anything
+  /// else goes through shift_runs(), a run of bytes at a time.
   void shift_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   void shift_runs(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   /// exchange() with CS high or chips in standby.
@@ -91,6 +93,9 @@ class Chain final : public SpiDevice {
   bool selected_ = false;
   bool standby_in_frame_ = false;  // some chip was in standby at the CS falling edge
   mutable bool chips_touched_ = true;  // chip() handed out a chip since the last look at STBY pins
+  // Every chip is ready for an opcode with no answer byte left (Chip::on_nop_at), as the last
+  // frame of NOPs left them and nothing reached them since: the next frame of NOPs changes nothing.
+  mutable bool quiet_ = false;
   bool any_standby_ = false;
   std::uint64_t bytes_in_frame_ = 0;
   Tick now_ = 0;
