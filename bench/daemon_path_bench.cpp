@@ -1,5 +1,5 @@
 // Where a preload or daemon round trip's time goes (bench/preload_bench.sh measures the whole):
-// the board alone running one SPI_IOC_MESSAGE(1) of one byte (Board::spi_message, the board's
+// the board alone running one SPI_IOC_MESSAGE(1) of one byte (DeviceBoard::spi_message, the board's
 // share of every round trip, the in-process preload's too), the board serving the same as a
 // packet (serve_request), the same through a shared region (serve_shared_request: copy-in,
 // dispatch, reply), and the region's hand-off between two threads with a trivial server (the
@@ -15,7 +15,7 @@
 
 #include <linux/spi/spidev.h>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/shm_channel.hpp"
 
@@ -34,7 +34,7 @@ struct VirtualBoard {
   }
   ~VirtualBoard() { close(file.fd); }
   DiagnosticLog log{"off"};
-  Board board;
+  DeviceBoard board;
   NewFile file;
 };
 
@@ -52,7 +52,7 @@ std::vector<std::uint8_t> nop_packet(std::uint64_t handle) {
 }
 
 /// The board's share of a round trip: one 1-byte message, a NOP or a poll's bytes (0xD0, 0, 0 in
-/// turn, one CS frame each), straight into Board::spi_message.
+/// turn, one CS frame each), straight into DeviceBoard::spi_message.
 void BM_BoardMessage(benchmark::State& state) {
   VirtualBoard b;
   spi_ioc_transfer x{};

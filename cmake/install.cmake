@@ -1,5 +1,5 @@
 # Installation (GNUInstallDirs places): the model's static libraries with their public headers
-# under include/l6470emu/, exported as l6470emu::core/spi/daisychain/linux (find_package) and
+# under include/l6470emu/, exported as l6470emu::core/spi/daisychain/board/linux (find_package) and
 # described in l6470emu.pc (pkg-config); the preload library in lib/l6470emu/; the l6470emu
 # program, its man page and the docs. The Python module installs itself (python/CMakeLists.txt).
 # The locations themselves are set in cmake/install_dirs.cmake (included first).
@@ -8,7 +8,7 @@ include(CMakePackageConfigHelpers)
 # Installed headers keep the in-tree spelling: include/l6470emu/core/chip.hpp is reached as
 # <l6470emu/core/chip.hpp>, and include/l6470emu is on the include path too, so the headers'
 # own "core/x.hpp" includes resolve (as they do from the source tree).
-set(layers core spi daisychain linux)
+set(layers core spi daisychain board linux)
 foreach(layer ${layers})
   set_target_properties(l6470emu_${layer} PROPERTIES EXPORT_NAME ${layer})
 endforeach()
@@ -21,7 +21,7 @@ add_library(l6470emu_all INTERFACE)
 target_link_libraries(l6470emu_all INTERFACE l6470emu_linux)
 set_target_properties(l6470emu_all PROPERTIES EXPORT_NAME l6470emu)
 
-install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_linux l6470emu_all
+install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_board l6470emu_linux l6470emu_all
   EXPORT l6470emuTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})

@@ -1,27 +1,16 @@
 // The lines of an emulated gpiochip: five per chip of the chain (BUSY, FLAG, SW, STCK, STBY_RST),
-// offset = 5 * chip + pin. Pure naming and layout; levels live in Board.
+// offset = 5 * chip + pin. Pure naming and layout; levels live in the board (board/board.hpp).
 #pragma once
 
 #include <cstddef>
 #include <string>
 
+#include "board/pins.hpp"
+
 namespace l6470emu {
 
 /// Character-device major the emulated gpiochips report (dynamic on real systems; 254 is typical).
 inline constexpr unsigned kGpiochipMajor = 254;
-
-/// The chip pins a gpiochip exposes, in line order.
-enum class Pin : unsigned { BUSY = 0, FLAG = 1, SW = 2, STCK = 3, STBY_RST = 4 };
-inline constexpr unsigned kPinsPerChip = 5;
-
-/// Datasheet name of a pin ("BUSY", "FLAG", "SW", "STCK", "STBY_RST").
-inline const char* pin_name(Pin p) {
-  static const char* const names[] = {"BUSY", "FLAG", "SW", "STCK", "STBY_RST"};
-  return names[static_cast<unsigned>(p)];
-}
-
-/// Whether the chip drives the pin (BUSY, FLAG) rather than reads it (SW, STCK, STBY_RST).
-constexpr bool pin_is_chip_output(Pin p) { return p == Pin::BUSY || p == Pin::FLAG; }
 
 /// Line offset of `pin` of chip `k`.
 constexpr unsigned line_offset(std::size_t k, Pin pin) {

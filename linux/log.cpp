@@ -10,7 +10,7 @@
 #include <cstring>
 #include <set>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
 
 namespace l6470emu {
 

@@ -87,7 +87,7 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
   }
 }
 
-void serve_request(Board& board, const ControlHandler& control, std::span<const std::uint8_t> packet, ReplyHeader& reply,
+void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet, ReplyHeader& reply,
                    std::vector<std::uint8_t>& out, int& pass_fd) {
   reply = {};
   out.clear();
@@ -182,7 +182,7 @@ void serve_request(Board& board, const ControlHandler& control, std::span<const 
   reply.result = -EPROTO;
 }
 
-SharedOutcome serve_shared_request(Board& board, const ControlHandler& control, SharedChannel& channel,
+SharedOutcome serve_shared_request(DeviceBoard& board, const ControlHandler& control, SharedChannel& channel,
                                    std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& out,
                                    int& pass_fd) {
   std::uint32_t flags = 0;

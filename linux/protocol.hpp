@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 
 namespace l6470emu {
 
@@ -83,7 +83,7 @@ using ControlHandler = std::function<int(const std::string& command, std::string
 
 /// Serves one request on `board` (the daemon side). Fills `reply` and its payload;
 /// `pass_fd` gets a descriptor to send along (the caller closes its copy after sending).
-void serve_request(Board& board, const ControlHandler& control, std::span<const std::uint8_t> packet,
+void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<const std::uint8_t> packet,
                    ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload, int& pass_fd);
 
 /// What serve_shared_request did with the request posted in a shared channel.
@@ -97,7 +97,7 @@ enum class SharedOutcome {
 /// Serves the request posted in `channel` (the daemon side) exactly as serve_request serves it
 /// from the socket. The region is the client's to scribble on, so the request is first copied
 /// into `scratch` (kShmAreaBytes), its size checked against the area.
-SharedOutcome serve_shared_request(Board& board, const ControlHandler& control, SharedChannel& channel,
+SharedOutcome serve_shared_request(DeviceBoard& board, const ControlHandler& control, SharedChannel& channel,
                                    std::uint8_t* scratch, ReplyHeader& reply, std::vector<std::uint8_t>& reply_payload,
                                    int& pass_fd);
 

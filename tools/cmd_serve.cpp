@@ -5,7 +5,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "linux/config.hpp"
+#include "linux/board_config_file.hpp"
 #include "linux/serve/control.hpp"
 #include "linux/serve/daemon.hpp"
 #include "tools/kernel_nodes.hpp"

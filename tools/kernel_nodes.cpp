@@ -7,7 +7,7 @@
 #include <charconv>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/kernel/uhid_cp2112.hpp"
 
 namespace l6470emu {
@@ -45,7 +45,7 @@ std::string parse_node_access(const std::string& owner, const std::string& group
 }
 
 FrontEnds kernel_front_ends(bool cuse, bool uhid, NodeAccess access) {
-  return [cuse, uhid, access](Board& board, std::ostream& out, std::string& error) -> std::shared_ptr<void> {
+  return [cuse, uhid, access](DeviceBoard& board, std::ostream& out, std::string& error) -> std::shared_ptr<void> {
     struct Kept {
       std::vector<std::unique_ptr<CuseSpidev>> spidevs;
       std::unique_ptr<UhidGpioBridges> bridges;

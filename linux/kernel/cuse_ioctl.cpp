@@ -24,7 +24,7 @@ CuseIoctlStep retry(std::vector<CuseRange> in, std::vector<CuseRange> out) {
   return s;
 }
 
-CuseIoctlStep message(Board& board, std::uint64_t handle, std::uint32_t bufsiz, std::size_t n, std::uint64_t arg,
+CuseIoctlStep message(DeviceBoard& board, std::uint64_t handle, std::uint32_t bufsiz, std::size_t n, std::uint64_t arg,
                       std::span<const std::uint8_t> in, std::size_t out_size, const CuseLimits& limits) {
   if (n == 0) return done(0);  // spidev answers SPI_IOC_MESSAGE(0) without reading anything
   const std::size_t array = n * sizeof(spi_ioc_transfer);
@@ -58,7 +58,7 @@ CuseIoctlStep message(Board& board, std::uint64_t handle, std::uint32_t bufsiz, 
 
 }  // namespace
 
-CuseIoctlStep spidev_cuse_ioctl(Board& board, std::uint64_t handle, std::uint32_t bufsiz, unsigned long cmd,
+CuseIoctlStep spidev_cuse_ioctl(DeviceBoard& board, std::uint64_t handle, std::uint32_t bufsiz, unsigned long cmd,
                                 std::uint64_t arg, std::span<const std::uint8_t> in, std::size_t out_size,
                                 const CuseLimits& limits) {
   if (_IOC_TYPE(cmd) != SPI_IOC_MAGIC) return done(-ENOTTY);

@@ -11,7 +11,7 @@
 #include <span>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 
 namespace l6470emu {
 
@@ -44,7 +44,7 @@ struct CuseLimits {
 /// transfer array → the array and the tx data, run on `board`); the settings ioctls take two;
 /// anything else is answered at once (-ENOTTY, as spidev does). A message the transport cannot
 /// carry in one retry (more than `limits` allow) gets -ENOMEM, as the kernel's fuse path would.
-CuseIoctlStep spidev_cuse_ioctl(Board& board, std::uint64_t handle, std::uint32_t bufsiz, unsigned long cmd,
+CuseIoctlStep spidev_cuse_ioctl(DeviceBoard& board, std::uint64_t handle, std::uint32_t bufsiz, unsigned long cmd,
                                 std::uint64_t arg, std::span<const std::uint8_t> in, std::size_t out_size,
                                 const CuseLimits& limits = {});
 

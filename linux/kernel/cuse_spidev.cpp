@@ -29,7 +29,7 @@ struct OpenFile {
 };
 
 struct CuseSpidev::Impl {
-  Board& board;
+  DeviceBoard& board;
   std::size_t device;
   NodeAccess access;
   std::string devname;  // "DEVNAME=spidev0.0"
@@ -40,7 +40,7 @@ struct CuseSpidev::Impl {
   bool ready = false;
   unsigned major = 0, minor = 0;
 
-  Impl(Board& b, std::size_t d, NodeAccess a) : board(b), device(d), access(a) {}
+  Impl(DeviceBoard& b, std::size_t d, NodeAccess a) : board(b), device(d), access(a) {}
 
   const DeviceNode& node() const { return board.nodes()[device]; }
 };
@@ -149,7 +149,7 @@ const cuse_lowlevel_ops kOps = [] {
 
 }  // namespace
 
-CuseSpidev::CuseSpidev(Board& board, std::size_t device, NodeAccess access)
+CuseSpidev::CuseSpidev(DeviceBoard& board, std::size_t device, NodeAccess access)
     : impl_(std::make_unique<Impl>(board, device, access)) {}
 
 CuseSpidev::~CuseSpidev() {

@@ -1,5 +1,5 @@
 // /dev/spidevB.C served by the kernel: a CUSE character device (libfuse3's cuse_lowlevel) whose
-// open files are handles of a Board, exactly like the preload's, so kernel clients and preload
+// open files are handles of a DeviceBoard, exactly like the preload's, so kernel clients and preload
 // clients share one board, one bus clock and one set of spidev rules. Needs /dev/cuse (root,
 // `modprobe cuse`).
 #pragma once
@@ -10,7 +10,7 @@
 #include <memory>
 #include <string>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 
 namespace l6470emu {
 
@@ -25,7 +25,7 @@ struct NodeAccess {
 class CuseSpidev {
  public:
   /// Prepares node `device` of `board` (a spidev node: "/dev/spidev0.0").
-  CuseSpidev(Board& board, std::size_t device, NodeAccess access);
+  CuseSpidev(DeviceBoard& board, std::size_t device, NodeAccess access);
   ~CuseSpidev();
   CuseSpidev(const CuseSpidev&) = delete;
   CuseSpidev& operator=(const CuseSpidev&) = delete;

@@ -71,7 +71,7 @@ std::string find_gpiochip(const std::string& uniq) {
 }  // namespace
 
 struct UhidGpioBridges::Impl {
-  Board& board;
+  DeviceBoard& board;
   NodeAccess access;
   std::vector<HidBridge> bridges;
   std::vector<BridgeNode> nodes;
@@ -79,7 +79,7 @@ struct UhidGpioBridges::Impl {
   std::thread thread;
   std::atomic<std::size_t> answered{0};
 
-  Impl(Board& b, NodeAccess a) : board(b), access(a) {}
+  Impl(DeviceBoard& b, NodeAccess a) : board(b), access(a) {}
 
   void handle(HidBridge& b) {
     uhid_event ev{};
@@ -139,7 +139,7 @@ struct UhidGpioBridges::Impl {
   }
 };
 
-UhidGpioBridges::UhidGpioBridges(Board& board, NodeAccess access) : impl_(std::make_unique<Impl>(board, access)) {}
+UhidGpioBridges::UhidGpioBridges(DeviceBoard& board, NodeAccess access) : impl_(std::make_unique<Impl>(board, access)) {}
 
 UhidGpioBridges::~UhidGpioBridges() {
   Impl& impl = *impl_;
@@ -177,7 +177,7 @@ std::string UhidGpioBridges::start() {
       }
       b.node = {c, k, ""};
       b.uniq = "l6470emu-" + run + "-" + spidev + "-" + std::to_string(k);
-      Board& board = impl.board;
+      DeviceBoard& board = impl.board;
       Cp2112Pins pins{[&board, c, k](Pin p) { return board.pin_level(c, k, p); },
                       [&board, c, k](Pin p, bool level) { board.drive_pin(c, k, p, level); }};
       // What users read (the HID name, the report label) numbers the chip as the board does;

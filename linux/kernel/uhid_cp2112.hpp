@@ -2,7 +2,7 @@
 // CP2112 USB HID bridge through /dev/uhid; the stock kernel's hid-cp2112 driver binds to it and
 // registers a gpiochip "cp2112_gpio" with 8 lines (0 BUSY, 1 FLAG, 2 SW, 3 STCK, 4 STBY_RST,
 // 5..7 unused). Every get, set or direction change of a host program becomes a HID report
-// answered from the Board; edge events come from the driver polling the levels every 10
+// answered from the DeviceBoard; edge events come from the driver polling the levels every 10
 // jiffies. Needs /dev/uhid (root, `modprobe uhid`) and the hid-cp2112 module.
 #pragma once
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/kernel/cuse_spidev.hpp"
 
 namespace l6470emu {
@@ -26,7 +26,7 @@ struct BridgeNode {
 /// All the bridges of a board, served by one thread until destroyed.
 class UhidGpioBridges {
  public:
-  UhidGpioBridges(Board& board, NodeAccess access);
+  UhidGpioBridges(DeviceBoard& board, NodeAccess access);
   ~UhidGpioBridges();
   UhidGpioBridges(const UhidGpioBridges&) = delete;
   UhidGpioBridges& operator=(const UhidGpioBridges&) = delete;

@@ -1,4 +1,4 @@
-// Where the preload library sends what host programs do to emulated files: a Board inside
+// Where the preload library sends what host programs do to emulated files: a DeviceBoard inside
 // the process (LocalBackend) or `l6470emu serve` over its socket (RemoteBackend).
 #pragma once
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 
 namespace l6470emu::preload {
 

@@ -1,4 +1,4 @@
-// Backend with the Board inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG); with
+// Backend with the DeviceBoard inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG); with
 // time=virtual the board's time becomes the program's own (virtual_time.hpp).
 #include <mutex>
 
@@ -62,7 +62,7 @@ class LocalBackend final : public Backend {
   }
 
   DiagnosticLog log_;
-  Board board_;
+  DeviceBoard board_;
   std::string trace_;
   std::once_flag trace_started_;
   std::unique_ptr<VirtualHostTime> virtual_time_;

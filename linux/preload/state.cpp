@@ -11,7 +11,7 @@
 #include <string>
 #include <unordered_map>
 
-#include "linux/config.hpp"
+#include "linux/board_config_file.hpp"
 #include "linux/log.hpp"
 #include "linux/preload/real.hpp"
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/preload/backend.hpp"
 
 namespace l6470emu::preload {

@@ -39,7 +39,7 @@ int count_threads() {
 // The busy-wait rule's count of looks at time since the calling thread's last covered wait.
 thread_local std::int64_t t_looks = 0;
 
-VirtualScheduler::Hooks scheduler_hooks(Board& board) {
+VirtualScheduler::Hooks scheduler_hooks(DeviceBoard& board) {
   VirtualScheduler::Hooks h;
   h.now = [&board] { return board.time().now(); };
   h.advance_to = [&board](Tick t) { board.advance_to(t); };
@@ -52,7 +52,7 @@ VirtualScheduler::Hooks scheduler_hooks(Board& board) {
 
 }  // namespace
 
-VirtualHostTime::VirtualHostTime(Board& board, const TimeConfig& config)
+VirtualHostTime::VirtualHostTime(DeviceBoard& board, const TimeConfig& config)
     : board_(board),
       time_(board.time()),
       boottime_offset_ns_(real_clock_ns(CLOCK_BOOTTIME) - real_clock_ns(CLOCK_MONOTONIC)),

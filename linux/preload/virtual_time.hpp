@@ -9,8 +9,8 @@
 #include <atomic>
 #include <cstdint>
 
-#include "linux/board.hpp"
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
+#include "linux/device_board.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/virtual_scheduler.hpp"
 
@@ -22,7 +22,7 @@ class VirtualHostTime {
  public:
   /// Makes `board`'s time the program's; `config` gives the idle grace. Counts the threads that
   /// exist already (/proc/self/task) as running.
-  VirtualHostTime(Board& board, const TimeConfig& config);
+  VirtualHostTime(DeviceBoard& board, const TimeConfig& config);
   ~VirtualHostTime();
   VirtualHostTime(const VirtualHostTime&) = delete;
   VirtualHostTime& operator=(const VirtualHostTime&) = delete;
@@ -81,7 +81,7 @@ class VirtualHostTime {
 
   std::int64_t offset_ns(clockid_t clock) const;
 
-  Board& board_;
+  DeviceBoard& board_;
   BoardTime& time_;
   std::int64_t boottime_offset_ns_;  // real BOOTTIME - MONOTONIC at the start
   std::int64_t tai_offset_ns_;       // real TAI - REALTIME at the start

@@ -5,8 +5,8 @@
 #include <sstream>
 #include <vector>
 
+#include "board/axis_config.hpp"
 #include "core/status.hpp"
-#include "linux/axis_config.hpp"
 
 namespace l6470emu {
 namespace {
@@ -84,7 +84,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  trace stop                          stop recording (every chain, or the --chain one)\n";
 }
 
-int run_control(Board& board, const std::string& command, std::string& out) {
+int run_control(DeviceBoard& board, const std::string& command, std::string& out) {
   std::vector<std::string> all;
   {
     std::istringstream in(command);

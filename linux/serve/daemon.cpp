@@ -23,7 +23,7 @@
 #include <thread>
 
 #include "daisychain/chip_numbering.hpp"
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/serve/control.hpp"
 #include "linux/shm_channel.hpp"
@@ -123,7 +123,7 @@ bool attach_shared(Connection& c, std::unique_ptr<SharedChannel>& shared) {
 /// briefly for the next request and then sleeps on the region's futex, looking every
 /// kShmAliveCheckMs whether the client is still there, so a client killed at any moment (even
 /// while the thread sleeps on its futex) ends only its own connection.
-void serve_connection(Board& board, const ControlHandler& control, Connection& c) {
+void serve_connection(DeviceBoard& board, const ControlHandler& control, Connection& c) {
   Packet packet;
   std::vector<std::uint8_t> payload;
   ReplyHeader reply;
@@ -244,7 +244,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   }
 
   DiagnosticLog log(config.log);
-  Board board(config, log);
+  DeviceBoard board(config, log);
   if (!config.trace.empty()) {
     if (const std::string error = board.start_recording_all(config.trace); !error.empty()) {
       err << "l6470emu serve: cannot record: " << error << "\n";

@@ -1,4 +1,4 @@
-// `l6470emu serve`: owns a Board and serves host programs (through the preload library)
+// `l6470emu serve`: owns a DeviceBoard and serves host programs (through the preload library)
 // and `ctl` over one Unix SOCK_SEQPACKET socket, a thread per connection.
 #pragma once
 
@@ -7,7 +7,7 @@
 #include <ostream>
 #include <string>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
 
 namespace l6470emu {
 
@@ -15,12 +15,12 @@ namespace l6470emu {
 /// else /tmp/l6470emu-<uid>.sock.
 std::string default_socket_path();
 
-class Board;
+class DeviceBoard;
 
 /// More ways in, started once the board exists (the kernel nodes of `serve --cuse --uhid`):
 /// returns what must stay alive while the daemon serves, or sets `error` to one line. Whatever
 /// it prints to `out` goes before the daemon's "run programs with" line.
-using FrontEnds = std::function<std::shared_ptr<void>(Board& board, std::ostream& out, std::string& error)>;
+using FrontEnds = std::function<std::shared_ptr<void>(DeviceBoard& board, std::ostream& out, std::string& error)>;
 
 /// Serves `config` on `socket_path` until SIGINT or SIGTERM. Prints one line when ready.
 /// Returns the exit status (non-zero when the socket or a front end cannot be set up).

@@ -1,8 +1,8 @@
 // PyChain: a chain, its host and an optional recorder (see py_chain.hpp).
 #include "py_chain.hpp"
 
+#include "board/trace_recorder.hpp"
 #include "daisychain/chain_spec.hpp"
-#include "linux/trace_recorder.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu::python {

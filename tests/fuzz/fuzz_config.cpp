@@ -1,10 +1,10 @@
-// libFuzzer harness of the board description parser (linux/config.hpp parse_board_config):
+// libFuzzer harness of the board description parser (board/board_config.hpp parse_board_config):
 // any text gives a config or one error line, never a crash; an accepted config's own
 // description (describe_board_config, what `serve` prints) reads back to the same chains.
 #include <string_view>
 
+#include "board/board_config.hpp"
 #include "fuzz_support.hpp"
-#include "linux/config.hpp"
 
 using namespace l6470emu;
 

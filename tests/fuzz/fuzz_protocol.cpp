@@ -1,5 +1,5 @@
 // libFuzzer harness of the daemon's request dispatcher (linux/protocol.hpp serve_request) on
-// a virtual-time Board: every Op, well-formed and not (truncated headers, payloads longer or
+// a virtual-time DeviceBoard: every Op, well-formed and not (truncated headers, payloads longer or
 // shorter than announced, oversized counts), spidev and gpio ioctls with argument buffers of
 // any size, spi_message with any transfers. About half the packets arrive through a shared
 // region (serve_shared_request, linux/shm_channel.hpp) as a hostile client could leave them:
@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "fuzz_support.hpp"
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/log.hpp"
 #include "linux/protocol.hpp"
 #include "linux/shm_channel.hpp"
@@ -27,7 +27,7 @@ using namespace l6470emu;
 
 namespace {
 
-/// The ioctls the Board knows (spidev and gpio uAPI v1/v2), and a few it must refuse.
+/// The ioctls the DeviceBoard knows (spidev and gpio uAPI v1/v2), and a few it must refuse.
 const std::array<unsigned long, 33> kIoctls = {
     SPI_IOC_RD_MODE,
     SPI_IOC_WR_MODE,
@@ -94,7 +94,7 @@ class Harness {
       cc.bufsiz = in_.ConsumeIntegralInRange<std::uint32_t>(1, 4096);
       config.chains.push_back(std::move(cc));
     }
-    board_ = std::make_unique<Board>(config, log_);
+    board_ = std::make_unique<DeviceBoard>(config, log_);
     for (int steps = 0; steps < 64 && in_.remaining_bytes() > 0; ++steps) request();
   }
 
@@ -281,7 +281,7 @@ class Harness {
   std::unique_ptr<SharedChannel> daemon_side_, client_side_;
   std::vector<std::uint8_t> scratch_;
   DiagnosticLog log_{"off"};
-  std::unique_ptr<Board> board_;
+  std::unique_ptr<DeviceBoard> board_;
   std::vector<int> fds_;
   std::vector<std::uint64_t> handles_;
   ControlHandler control_ = [this](const std::string& command, std::string& output) {

@@ -10,9 +10,9 @@
 #include <array>
 #include <vector>
 
+#include "board/trace_recorder.hpp"
 #include "core/status.hpp"
 #include "fuzz_support.hpp"
-#include "linux/trace_recorder.hpp"
 
 using namespace l6470emu;
 

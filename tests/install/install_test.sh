@@ -63,7 +63,7 @@ step "cmake --install into a temporary prefix"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 for f in bin/l6470emu include/l6470emu/core/chip.hpp include/l6470emu/daisychain/host.hpp \
-         include/l6470emu/linux/board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md; do
+         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md; do
   [ -f "$prefix/$f" ] || fail "not installed: $f"
 done
 [ -z "$(find "$prefix/include" -path '*preload*' -o -name '*_internal.hpp')" ] || fail "internal headers were installed"
@@ -81,7 +81,7 @@ cat >"$work/targets/CMakeLists.txt" <<'CMAKE'
 cmake_minimum_required(VERSION 3.25)
 project(targets LANGUAGES CXX)
 find_package(l6470emu CONFIG REQUIRED)
-foreach(t core spi daisychain linux l6470emu)
+foreach(t core spi daisychain board linux l6470emu)
   if(NOT TARGET l6470emu::${t})
     message(FATAL_ERROR "no target l6470emu::${t}")
   endif()

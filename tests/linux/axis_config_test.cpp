@@ -3,10 +3,10 @@
 // showing the true position next to ABS_POS and changing the load at runtime.
 #include <gtest/gtest.h>
 
+#include "board/axis_config.hpp"
+#include "board/board_config.hpp"
 #include "daisychain/host.hpp"
-#include "linux/axis_config.hpp"
-#include "linux/board.hpp"
-#include "linux/config.hpp"
+#include "linux/device_board.hpp"
 #include "linux/log.hpp"
 #include "linux/serve/control.hpp"
 
@@ -145,7 +145,7 @@ TEST(AxisCtl, StatusShowsTheTruePositionNextToAbsPosAndAxisChangesTheLoad) {
       "bus=0 cs=0 chips=2xL6470 axis.1=stops=0..,start=1280,switch=home@100:hyst=8; time=virtual", "test");
   ASSERT_TRUE(p.config) << p.error.message;
   DiagnosticLog log("off");
-  Board board(*p.config, log);
+  DeviceBoard board(*p.config, log);
   board.with_chain(0, [](Chain& c) {
     ChainHost h(c);
     h.move(1, true, 12800);
@@ -177,7 +177,7 @@ TEST(AxisCtl, AnAxisChipNumberCountsAsTheBoardsNumberingSays) {
   ParseResult p = parse_board_config("bus=0 cs=0 chips=3xL6470 axis.0=start=640; numbering=mosi", "test");
   ASSERT_TRUE(p.config) << p.error.message;
   DiagnosticLog log("off");
-  Board board(*p.config, log);
+  DeviceBoard board(*p.config, log);
   board.with_chain(0, [](Chain& c) {
     EXPECT_EQ(c.chip(0).axis(), nullptr) << "chip 0 from the MOSI end is the chain's last chip";
     ASSERT_NE(c.chip(2).axis(), nullptr);

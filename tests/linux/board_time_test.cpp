@@ -9,7 +9,7 @@
 #include <cstring>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "spi/message.hpp"
 #include "support/test_support.hpp"
 
@@ -42,7 +42,7 @@ BoardConfig config_of(const std::string& text) {
 struct Rig {
   FakeHostClock clock;
   DiagnosticLog log{"off"};
-  Board board;
+  DeviceBoard board;
   std::vector<NewFile> files;
 
   explicit Rig(const std::string& text) : board(config_of(text), log, clock) {
@@ -241,7 +241,7 @@ TEST(BoardPacing, ABusyEdgeCarriesTheHostClockAtTheTickItHappened) {
 TEST(BoardBus, ABufferlessTransferOfTwoGigabytesTakesItsBusTimeWithoutTheMemoryOrTheWork) {
   FakeHostClock clock;
   DiagnosticLog log("off");
-  Board board(config_of("bus=0 cs=0 chips=L6470 mode=3; time=virtual"), log, clock);
+  DeviceBoard board(config_of("bus=0 cs=0 chips=L6470 mode=3; time=virtual"), log, clock);
   const NewFile f = board.open(0, true);
   spi_ioc_transfer x{};
   x.len = 0x7FFFFFF0;  // the kernel's limit (INT_MAX in total); no tx_buf, no rx_buf: zeros out

@@ -13,7 +13,8 @@
 #include <fstream>
 #include <thread>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
+#include "linux/board_config_file.hpp"
 #include "linux/log.hpp"
 #include "linux/spidev_rules.hpp"
 

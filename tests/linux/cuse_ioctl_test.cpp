@@ -10,7 +10,7 @@
 #include <cstring>
 #include <vector>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/kernel/cuse_ioctl.hpp"
 
 namespace l6470emu::test {
@@ -25,7 +25,7 @@ BoardConfig config_of(const std::string& text) {
 /// A virtual-time board (messages take no wall time) with one spidev file open.
 struct Node {
   DiagnosticLog log{"off"};
-  Board board;
+  DeviceBoard board;
   NewFile file;
   std::vector<CuseIoctlStep> steps;  // every reply of the last ioctl
 

@@ -228,7 +228,7 @@ TEST(DaemonProtocol, AnEmptySpiMessageIsAnsweredWithoutTouchingTheBus) {
   ParseResult p = parse_board_config(kChain, "test");
   ASSERT_TRUE(p.config);
   DiagnosticLog log("off");
-  Board board(*p.config, log);
+  DeviceBoard board(*p.config, log);
   const NewFile f = board.open(0, true);
   RequestHeader req{static_cast<std::uint32_t>(Op::spi_message), 0, f.handle, 0};
   std::vector<std::uint8_t> packet(sizeof req);

@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu::test {
@@ -18,7 +18,7 @@ TEST(BoardDiagnostics, ADriverLoopingOnABadCommandGetsTenLinesAndATallyAtEachPow
     ParseResult p = parse_board_config("bus=0 cs=0 chips=2xL6470 mode=3; time=virtual", "test");
     ASSERT_TRUE(p.config);
     DiagnosticLog log(path);
-    Board board(*p.config, log);
+    DeviceBoard board(*p.config, log);
     const NewFile f = board.open(0, true);
     spi_ioc_transfer x{};
     x.tx_buf = 1;
@@ -46,7 +46,7 @@ TEST(BoardDiagnostics, NameTheChipAsTheBoardsNumberingCountsIt) {
     ParseResult p = parse_board_config("bus=0 cs=0 chips=2xL6470 mode=3 numbering=mosi; time=virtual", "test");
     ASSERT_TRUE(p.config);
     DiagnosticLog log(path);
-    Board board(*p.config, log);
+    DeviceBoard board(*p.config, log);
     const NewFile f = board.open(0, true);
     spi_ioc_transfer x{};
     x.tx_buf = 1;

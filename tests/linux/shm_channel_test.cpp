@@ -13,7 +13,7 @@
 
 #include <gtest/gtest.h>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/shm_channel.hpp"
 
@@ -79,7 +79,7 @@ struct VirtualBoard {
     return *p.config;
   }
   DiagnosticLog log{"off"};
-  Board board;
+  DeviceBoard board;
   NewFile file;
 };
 
@@ -91,7 +91,7 @@ struct Served {
   int pass_fd = -1;
 };
 
-Served serve_through(Pair& pair, Board& board, const std::vector<std::uint8_t>& packet) {
+Served serve_through(Pair& pair, DeviceBoard& board, const std::vector<std::uint8_t>& packet) {
   std::memcpy(pair.client->request_area(), packet.data(), packet.size());
   pair.client->post_request(static_cast<std::uint32_t>(packet.size()), 0);
   EXPECT_TRUE(pair.daemon->wait_request(0, {}));

@@ -1,8 +1,8 @@
-// ChainTraceRecorder's file names (linux/trace_recorder.hpp): one file per chain, the chain's
+// ChainTraceRecorder's file names (board/trace_recorder.hpp): one file per chain, the chain's
 // name before the extension, and ".gz" kept last so the recording stays compressed.
 #include <gtest/gtest.h>
 
-#include "linux/trace_recorder.hpp"
+#include "board/trace_recorder.hpp"
 
 namespace l6470emu {
 namespace {

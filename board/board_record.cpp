@@ -1,15 +1,15 @@
 // Board: recording chains into native traces (start/stop, the routes SPI, pins and backdoor
 // events take while a chain is recorded). The recording itself is ChainTraceRecorder's.
-#include "linux/board_internal.hpp"
+#include "board/board_internal.hpp"
 
 namespace l6470emu {
 
-SpiDevice& Board::spi_of(ChainDev& c) {
+SpiDevice& Board::spi_of(ChainState& c) {
   if (c.recorder) return c.recorder->device();
   return c.chain;
 }
 
-void Board::apply_input(ChainDev& c, std::size_t chip, Pin pin, bool level) {
+void Board::apply_input(ChainState& c, std::size_t chip, Pin pin, bool level) {
   if (c.recorder) {
     c.recorder->set_input(chip, pin, level);
     return;
@@ -20,20 +20,19 @@ void Board::apply_input(ChainDev& c, std::size_t chip, Pin pin, bool level) {
   if (pin == Pin::STBY_RST) ch.set_stby_rst_pin(level);
 }
 
-void Board::record_outputs(ChainDev& c) {
+void Board::record_outputs(ChainState& c) {
   if (!c.recorder) return;
   c.recorder->observe_outputs();
   if (!c.recorder->error().empty()) {
     // The file failed (disk full, removed device): say so once and go on without it.
-    log_.line(c.name + ": trace recording stopped: " + c.recorder->error());
+    log_(c.name + ": trace recording stopped: " + c.recorder->error());
     c.recorder.reset();
   }
 }
 
 bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value) {
-  std::lock_guard lock(m_);
   if (chain >= chains_.size()) return false;
-  ChainDev& c = *chains_[chain];
+  ChainState& c = *chains_[chain];
   if (chip >= c.chain.size()) return false;
   catch_up(c);
   if (c.recorder)
@@ -41,14 +40,12 @@ bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, 
   else
     apply_fault(c.chain.chip(chip), fault, value);
   emit_changes(c, c.chain.now());
-  wake_pump();
   return true;
 }
 
 std::string Board::start_recording(std::size_t chain, const std::string& path) {
-  std::lock_guard lock(m_);
   if (chain >= chains_.size()) return "no chain " + std::to_string(chain);
-  ChainDev& c = *chains_[chain];
+  ChainState& c = *chains_[chain];
   catch_up(c);
   c.recorder.reset();
   std::string error;
@@ -66,9 +63,8 @@ std::string Board::start_recording_all(const std::string& path) {
 }
 
 bool Board::stop_recording(std::size_t chain, std::string* summary) {
-  std::lock_guard lock(m_);
   if (chain >= chains_.size() || !chains_[chain]->recorder) return false;
-  ChainDev& c = *chains_[chain];
+  ChainState& c = *chains_[chain];
   catch_up(c);
   record_outputs(c);  // the levels at the end
   if (!c.recorder) return true;  // the file had failed: already reported
@@ -79,15 +75,14 @@ bool Board::stop_recording(std::size_t chain, std::string* summary) {
   return true;
 }
 
-std::string Board::recording_path(std::size_t chain) {
-  std::lock_guard lock(m_);
+std::string Board::recording_path(std::size_t chain) const {
   if (chain >= chains_.size() || !chains_[chain]->recorder) return "";
   return chains_[chain]->recorder->path();
 }
 
-void Board::forget_recordings_after_fork() {
-  // The parent keeps writing its traces; the child's copies must not add lines to them.
-  // Everything was flushed before fork(), so closing the child's FILE writes nothing.
+void Board::abandon_recordings() {
+  // Whoever holds the originals keeps writing them; these copies must add no lines. Every
+  // line was flushed as it was written, so closing them writes nothing.
   for (auto& c : chains_) c->recorder.reset();
 }
 

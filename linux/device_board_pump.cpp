@@ -1,4 +1,4 @@
-// Board: the pump thread. In wall-clock mode it sleeps until the next BUSY/FLAG edge a
+// DeviceBoard: the pump thread. In wall-clock mode it sleeps until the next BUSY/FLAG edge a
 // watched line will see and delivers it on time; in every mode it notices host ends of
 // handles closed elsewhere (a killed client, a forked child's last close) and releases them.
 #include <poll.h>
@@ -8,11 +8,11 @@
 #include <climits>
 #include <new>
 
-#include "linux/board_internal.hpp"
+#include "linux/device_board_internal.hpp"
 
 namespace l6470emu {
 
-void Board::start_pump() {
+void DeviceBoard::start_pump() {
   std::lock_guard lock(m_);
   if (pump_running_) return;
   pump_stop_ = false;
@@ -20,7 +20,7 @@ void Board::start_pump() {
   pump_ = std::thread([this] { pump_loop(); });
 }
 
-void Board::stop_pump() {
+void DeviceBoard::stop_pump() {
   {
     std::lock_guard lock(m_);
     if (!pump_running_) return;
@@ -32,19 +32,19 @@ void Board::stop_pump() {
   pump_running_ = false;
 }
 
-void Board::forget_pump_after_fork() {
+void DeviceBoard::forget_pump_after_fork() {
   // The thread does not exist in the child; drop the handle without touching it.
   new (&pump_) std::thread();
   pump_running_ = false;
 }
 
-void Board::wake_pump() {
+void DeviceBoard::wake_pump() {
   if (!pump_running_ || wake_fd_ < 0) return;
   const std::uint64_t one = 1;
   [[maybe_unused]] const ssize_t n = ::write(wake_fd_, &one, sizeof one);
 }
 
-void Board::pump_loop() {
+void DeviceBoard::pump_loop() {
   std::vector<pollfd> fds;
   std::vector<std::uint64_t> ids;
   for (;;) {
@@ -54,12 +54,12 @@ void Board::pump_loop() {
     {
       std::lock_guard lock(m_);
       if (pump_stop_) return;
-      for (auto& c : chains_) {
-        if (c->gpio < 0 || gpios_[static_cast<std::size_t>(c->gpio)]->watched.empty()) continue;
-        catch_up(*c);
-        if (time_.is_virtual()) continue;
-        const Tick t = predict_next_edge(*c);
-        if (t != kNever) deadline = std::min(deadline, time_.host_ns_of(t));
+      for (std::size_t i = 0; i < chains_.size(); ++i) {
+        if (chains_[i]->gpio < 0 || !board_.has_watched_pins(i)) continue;
+        board_.catch_up(i);
+        if (time().is_virtual()) continue;
+        const Tick t = board_.predict_edge_tick(i);
+        if (t != kNever) deadline = std::min(deadline, time().host_ns_of(t));
       }
       fds.push_back({wake_fd_, POLLIN, 0});
       for (auto& [id, h] : handles_) {
@@ -70,7 +70,7 @@ void Board::pump_loop() {
     timespec ts{};
     timespec* tsp = nullptr;
     if (deadline != INT64_MAX) {
-      std::int64_t wait = deadline - time_.host().monotonic_ns();
+      std::int64_t wait = deadline - time().host().monotonic_ns();
       if (wait < 0) wait = 0;
       // The kernel lets a poll timeout run late by 0.1 % of its length (select_estimate_accuracy):
       // 0.6 ms for a 0.6 s move. Wake early and plan again; the last short wait is nearly exact.

@@ -1,6 +1,7 @@
-// The emulated board a transport serves: one daisy chain per spidev node, one gpiochip per
-// chain carrying its chips' pins, the clock, and the open files / line requests of the host
-// programs, with the kernel's semantics (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
+// The emulated board's device nodes, as a transport serves them: a spidev node per chain and a
+// gpiochip per chain carrying its chips' pins, in front of the OS-free Board (board/board.hpp),
+// and the open files / line requests of the host programs, with the kernel's semantics
+// (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
 // Every open file or line request is a handle backed by a SOCK_SEQPACKET socketpair: the
 // host program gets one end as its file descriptor (poll/read see edge events natively),
 // the board keeps the other, and a handle lives until every copy of the host's end is closed.
@@ -21,9 +22,10 @@
 #include <unordered_map>
 #include <vector>
 
+#include "board/board.hpp"
+#include "board/board_config.hpp"
 #include "daisychain/chain.hpp"
 #include "linux/clock.hpp"
-#include "linux/config.hpp"
 #include "linux/gpio_lines.hpp"
 #include "linux/log.hpp"
 #include "linux/spidev_rules.hpp"
@@ -64,15 +66,16 @@ using MessageObserver = std::function<void(std::size_t chain, std::span<const sp
                                            std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx,
                                            Tick end_tick)>;
 
-/// The emulated hardware and the kernel-side state of its device nodes. Thread-safe.
-class Board {
+/// The emulated hardware (a Board) and the kernel-side state of its device nodes. Thread-safe:
+/// one lock covers the board and the nodes.
+class DeviceBoard {
  public:
   /// Builds the chains and gpiochips of `config`; diagnostics go to `log`. The board's time is
   /// read from `host` (the kernel's clocks unless a test injects its own).
-  Board(const BoardConfig& config, DiagnosticLog& log, HostClock& host = real_host_clock());
-  ~Board();
-  Board(const Board&) = delete;
-  Board& operator=(const Board&) = delete;
+  DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostClock& host = real_host_clock());
+  ~DeviceBoard();
+  DeviceBoard(const DeviceBoard&) = delete;
+  DeviceBoard& operator=(const DeviceBoard&) = delete;
 
   /// The device nodes, in a fixed order (index = device index for open()).
   const std::vector<DeviceNode>& nodes() const { return nodes_; }
@@ -101,16 +104,16 @@ class Board {
 
   // ---- the physical world (ctl, tests) ----------------------------------------
 
-  std::size_t chain_count() const { return chains_.size(); }
+  std::size_t chain_count() const { return board_.chain_count(); }
   /// Index in nodes() of chain `chain`'s spidev node.
   std::size_t spidev_node(std::size_t chain) const;
   /// Number of chips of chain `chain`.
   std::size_t chip_count(std::size_t chain) const;
   /// How diagnostics and `ctl` number the chips (the config's numbering=). Chip arguments of
-  /// Board's own functions are always chain indices (0 drives MISO).
-  NumberFrom numbering() const { return numbering_; }
+  /// DeviceBoard's own functions are always chain indices (0 drives MISO).
+  NumberFrom numbering() const { return board_.numbering(); }
   /// The numbering of chain `chain`: its chain indices as users see them.
-  ChipNumbering chip_numbering(std::size_t chain) const { return ChipNumbering(numbering_, chip_count(chain)); }
+  ChipNumbering chip_numbering(std::size_t chain) const { return board_.chip_numbering(chain); }
   /// "spidev0.0 (3 x L6470, gpiochip0)".
   std::string chain_summary(std::size_t chain) const;
   /// Index of the chain on node path or name ("spidev0.0", "/dev/spidev0.0", "0.0"), or -1.
@@ -133,15 +136,15 @@ class Board {
   /// Current tick of chain `chain`.
   Tick now(std::size_t chain);
   /// The board's time (the one owner of the clock: spidev, gpio events, ctl, traces).
-  BoardTime& time() { return time_; }
-  const BoardTime& time() const { return time_; }
+  BoardTime& time() { return board_.time(); }
+  const BoardTime& time() const { return board_.time(); }
   /// Attaches (or with an empty function detaches) the SPI message observer.
   void set_message_observer(MessageObserver observer);
   /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain `chain`,
   /// recorded when the chain is being recorded. Returns false for a bad index.
   bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
 
-  // ---- trace recording (board_record.cpp) -----------------------------------------
+  // ---- trace recording (the Board's, under the lock) ---------------------------------
 
   /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
   /// progress on the chain is stopped first): every CS frame, every input pin change (host gpio
@@ -187,12 +190,8 @@ class Board {
   long run_spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                        std::span<std::uint8_t> rx, Tick& end);
   void wait_for(Tick tick);
-  void catch_up(ChainDev& c);
-  void advance_chain(ChainDev& c, Tick target);
-  Tick first_change(ChainDev& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
-  Tick predict_next_edge(ChainDev& c);
-  void emit_changes(ChainDev& c, Tick tick);
-  void refresh_watch_list(GpioDev& g);
+  void report_edge(const PinEdge& edge);
+  void watch_line(GpioDev& g, unsigned offset, bool watched);
   bool physical_level(GpioDev& g, unsigned offset);
   void set_chip_input(GpioDev& g, unsigned offset, bool level);
   void send_line_event(Handle& h, unsigned index, bool rising, Tick tick);
@@ -200,7 +199,7 @@ class Board {
   void wake_pump();
   void pump_loop();
 
-  // gpio ioctls (board_gpio.cpp)
+  // gpio ioctls (device_board_gpio.cpp)
   long gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
   long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg);
   void fill_v2_info(GpioDev& g, unsigned offset, void* info);
@@ -211,17 +210,10 @@ class Board {
                          const std::vector<std::uint32_t>& debounce);
   bool logical_value(Handle& h, unsigned index);
 
-  // recording (board_record.cpp)
-  SpiDevice& spi_of(ChainDev& c);
-  void apply_input(ChainDev& c, std::size_t chip, Pin pin, bool level);
-  void record_outputs(ChainDev& c);
-
   DiagnosticLog& log_;
-  BoardTime time_;
-  NumberFrom numbering_ = NumberFrom::miso;
-  std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last message ends
+  Board board_;
   std::vector<DeviceNode> nodes_;
-  std::vector<std::unique_ptr<ChainDev>> chains_;
+  std::vector<std::unique_ptr<ChainDev>> chains_;  // the spidev node of each chain of board_
   std::vector<std::unique_ptr<GpioDev>> gpios_;
   std::vector<int> node_target_;  // node index -> chain or gpio index
   std::unordered_map<std::uint64_t, std::unique_ptr<Handle>> handles_;

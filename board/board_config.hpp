@@ -35,7 +35,7 @@ struct ChainConfig {
   std::uint32_t max_speed_hz = 5'000'000;  ///< the device's spi-max-frequency (RD_MAX_SPEED_HZ at open)
   std::uint8_t mode = 0;                   ///< SPI mode the device starts in (as a device tree sets it)
   std::uint32_t bufsiz = 4096;             ///< spidev's bufsiz module parameter
-  /// axis.K=...: the mechanics behind chip K (linux/axis_config.hpp), ascending K.
+  /// axis.K=...: the mechanics behind chip K (board/axis_config.hpp), ascending K.
   std::vector<std::pair<std::size_t, AxisSpec>> axes;
 };
 
@@ -72,12 +72,9 @@ struct ParseResult {
 };
 ParseResult parse_board_config(std::string_view text, std::string_view origin);
 
-/// The longest board description read or parsed (bytes); a longer one is an error.
+/// The longest board description read or parsed (bytes); a longer one is an error. Files are
+/// read by linux/board_config_file.hpp.
 inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
-
-/// Reads the file (at most kMaxConfigBytes + 1 bytes: /dev/zero or an endless FIFO fails fast)
-/// and parses it. A directory, a device or an unreadable file is a ConfigError saying so.
-ParseResult load_board_config_file(const std::string& path);
 
 /// How many characters of a user's text an error message shows.
 inline constexpr std::size_t kQuotedTextChars = 60;

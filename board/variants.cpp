@@ -1,7 +1,7 @@
 // Variant names as the config and the ctl interface spell them: core's table, plus aliases.
 #include <string>
 
-#include "linux/config.hpp"
+#include "board/board_config.hpp"
 
 namespace l6470emu {
 

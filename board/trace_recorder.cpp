@@ -1,5 +1,5 @@
 // ChainTraceRecorder: a RecordingChain writing to a native trace file, with write errors caught.
-#include "linux/trace_recorder.hpp"
+#include "board/trace_recorder.hpp"
 
 #include <exception>
 

@@ -1,51 +1,43 @@
-// Board's private state, shared by board.cpp (files, SPI, time), board_gpio.cpp (gpio
-// ioctls) and board_pump.cpp (the edge-delivery thread). Not part of the public API.
+// DeviceBoard's private state, shared by device_board.cpp (files, SPI, time), device_board_gpio.cpp
+// (gpio ioctls) and device_board_pump.cpp (the edge-delivery thread). Not part of the public API.
 #pragma once
 
 #include <linux/gpio.h>
 
-#include "linux/board.hpp"
+#include "linux/device_board.hpp"
 #include "linux/gpio_uapi.hpp"
-#include "linux/trace_recorder.hpp"
 
 namespace l6470emu {
 
-/// One chain and the spidev node in front of it.
-struct Board::ChainDev {
-  ChainConfig config;
-  Chain chain;
+/// The spidev node in front of one chain of the board.
+struct DeviceBoard::ChainDev {
   std::string name;               // "spidev0.0"
   SpidevSettings spi;
   unsigned users = 0;             // open files (spidev resets speed_hz at the last close)
   std::uint32_t reported = 0;     // setting problems already reported since the last settings change
   int gpio = -1;                  // index into gpios_, -1 = no gpiochip
-  std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
-  ChainDev(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 
 /// One line of a gpiochip.
-struct Board::LineDev {
+struct DeviceBoard::LineDev {
   std::string name;
   Handle* owner = nullptr;       // the line request holding it
   unsigned index = 0;            // its position in the owner's offsets
   std::uint64_t flags = 0;       // v2 flags of the current (or last) configuration
   std::uint32_t debounce_us = 0;
-  bool level = true;             // chip inputs (SW, STCK, STBY_RST): the level on the wire
-  bool out_value = false;        // physical level the host drives while it is an output
-  bool last = true;              // level last seen by edge detection
+  bool out_value = false;        // chip outputs: the level the host drives while it is an output
 };
 
-/// One gpiochip: the pins of one chain.
-struct Board::GpioDev {
+/// One gpiochip: the pins of one chain (their levels and edges are the Board's).
+struct DeviceBoard::GpioDev {
   std::string name;   // "gpiochip0"
   std::string label;  // "l6470emu spidev0.0"
   std::size_t chain = 0;
   std::vector<LineDev> lines;
-  std::vector<unsigned> watched;  // offsets owned by a request with edge detection
 };
 
 /// An open file or line request.
-struct Board::Handle {
+struct DeviceBoard::Handle {
   std::uint64_t id = 0;
   HandleKind kind = HandleKind::spidev;
   int fd = -1;             // the board's end of the socketpair

@@ -1,4 +1,4 @@
-// Board: the gpiochip character device (v1 and v2 uAPI ioctls), after drivers/gpio/gpiolib-cdev.c.
+// DeviceBoard: the gpiochip character device (v1 and v2 uAPI ioctls), after drivers/gpio/gpiolib-cdev.c.
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -6,7 +6,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "linux/board_internal.hpp"
+#include "linux/device_board_internal.hpp"
 
 namespace l6470emu {
 namespace {
@@ -35,7 +35,7 @@ bool any_nonzero(const void* p, std::size_t n) {
 
 }  // namespace
 
-void Board::fill_v2_info(GpioDev& g, unsigned offset, void* out) {
+void DeviceBoard::fill_v2_info(GpioDev& g, unsigned offset, void* out) {
   auto* info = static_cast<gpio_v2_line_info*>(out);
   const LineDev& l = g.lines[offset];
   std::memset(info, 0, sizeof *info);
@@ -58,14 +58,14 @@ void Board::fill_v2_info(GpioDev& g, unsigned offset, void* out) {
   }
 }
 
-void Board::notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_type) {
+void DeviceBoard::notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_type) {
   for (auto& [id, h] : handles_) {
     if (h->kind != HandleKind::gpiochip || gpios_[h->dev].get() != &g || offset >= h->watched.size() ||
         !h->watched[offset])
       continue;
     gpio_v2_line_info info{};
     fill_v2_info(g, offset, &info);
-    const std::uint64_t ts = static_cast<std::uint64_t>(time_.host_ns_of(time_.now()));
+    const std::uint64_t ts = static_cast<std::uint64_t>(time().host_ns_of(time().now()));
     if (h->watch_abi == 1) {
       gpioline_info_changed c{};
       c.info.line_offset = offset;
@@ -85,10 +85,10 @@ void Board::notify_lineinfo(GpioDev& g, unsigned offset, std::uint32_t event_typ
   }
 }
 
-long Board::gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {
+long DeviceBoard::gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned nlines = static_cast<unsigned>(g.lines.size());
-  catch_up(*chains_[g.chain]);
+  board_.catch_up(g.chain);
 
   switch (cmd) {
     case GPIO_GET_CHIPINFO_IOCTL: {
@@ -203,10 +203,10 @@ long Board::gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t>
   }
 }
 
-long Board::request_lines(Handle& chip, HandleKind kind, const std::vector<unsigned>& offsets,
-                          const std::vector<std::uint64_t>& flags, const std::vector<int>& values, const char* consumer,
-                          std::uint32_t /*event_buffer_size*/, const std::vector<std::uint32_t>& debounce,
-                          NewFile* created) {
+long DeviceBoard::request_lines(Handle& chip, HandleKind kind, const std::vector<unsigned>& offsets,
+                                const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
+                                const char* consumer, std::uint32_t /*event_buffer_size*/,
+                                const std::vector<std::uint32_t>& debounce, NewFile* created) {
   GpioDev& g = *gpios_[chip.dev];
   for (unsigned off : offsets)
     if (off >= g.lines.size()) return -EINVAL;
@@ -241,13 +241,12 @@ long Board::request_lines(Handle& chip, HandleKind kind, const std::vector<unsig
                 "\", but the chip drives it (the host reads back its own value)");
     edges = edges || (fl & kV2EdgeFlags);
   }
-  ChainDev& c = *chains_[g.chain];
-  for (std::size_t i = 0; i < offsets.size(); ++i) g.lines[offsets[i]].last = physical_level(g, offsets[i]);
-  if (edges) refresh_watch_list(g);
-  emit_changes(c, c.chain.now());  // outputs set at request time may have edges for others
+  for (unsigned off : offsets)
+    if (g.lines[off].flags & kV2EdgeFlags) watch_line(g, off, true);
+  board_.report_changes(g.chain);  // outputs set at request time may have edges for others
   for (unsigned off : offsets) notify_lineinfo(g, off, GPIO_V2_LINE_CHANGED_REQUESTED);
   *created = f;
-  if (edges && !time_.is_virtual() && !pump_running_) {
+  if (edges && !time().is_virtual() && !pump_running_) {
     pump_stop_ = false;
     pump_running_ = true;
     pump_ = std::thread([this] { pump_loop(); });
@@ -256,8 +255,8 @@ long Board::request_lines(Handle& chip, HandleKind kind, const std::vector<unsig
   return 0;
 }
 
-long Board::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
-                              const std::vector<std::uint32_t>& debounce) {
+long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
+                                    const std::vector<std::uint32_t>& debounce) {
   GpioDev& g = *gpios_[h.dev];
   bool edges = false;
   for (std::size_t i = 0; i < h.offsets.size(); ++i) {
@@ -269,14 +268,12 @@ long Board::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags
     l.debounce_us = debounce[i];
     if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && values[i] >= 0)
       set_chip_input(g, h.offsets[i], (values[i] != 0) != ((fl & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
-    l.last = physical_level(g, h.offsets[i]);
+    watch_line(g, h.offsets[i], (fl & kV2EdgeFlags) != 0);  // a watch starts from the level now
     edges = edges || (fl & kV2EdgeFlags);
   }
-  refresh_watch_list(g);
-  ChainDev& c = *chains_[g.chain];
-  emit_changes(c, c.chain.now());
+  board_.report_changes(g.chain);
   for (unsigned off : h.offsets) notify_lineinfo(g, off, GPIO_V2_LINE_CHANGED_CONFIG);
-  if (edges && !time_.is_virtual() && !pump_running_) {
+  if (edges && !time().is_virtual() && !pump_running_) {
     pump_stop_ = false;
     pump_running_ = true;
     pump_ = std::thread([this] { pump_loop(); });
@@ -285,16 +282,15 @@ long Board::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags
   return 0;
 }
 
-bool Board::logical_value(Handle& h, unsigned index) {
+bool DeviceBoard::logical_value(Handle& h, unsigned index) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned off = h.offsets[index];
   return physical_level(g, off) != ((g.lines[off].flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
 }
 
-long Board::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg) {
+long DeviceBoard::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg) {
   GpioDev& g = *gpios_[h.dev];
-  ChainDev& c = *chains_[g.chain];
-  catch_up(c);
+  board_.catch_up(g.chain);
   const unsigned n = static_cast<unsigned>(h.offsets.size());
 
   if (h.kind == HandleKind::line_handle_v1 || h.kind == HandleKind::line_event_v1) {
@@ -312,7 +308,7 @@ long Board::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg
         const LineDev& l = g.lines[h.offsets[i]];
         set_chip_input(g, h.offsets[i], (d.values[i] != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
       }
-      emit_changes(c, c.chain.now());
+      board_.report_changes(g.chain);
       wake_pump();
       return 0;
     }
@@ -351,7 +347,7 @@ long Board::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg
         const LineDev& l = g.lines[h.offsets[i]];
         set_chip_input(g, h.offsets[i], (((lv.bits >> i) & 1u) != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
       }
-      emit_changes(c, c.chain.now());
+      board_.report_changes(g.chain);
       wake_pump();
       return 0;
     }

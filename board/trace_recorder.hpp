@@ -8,13 +8,13 @@
 #include <memory>
 #include <string>
 
+#include "board/pins.hpp"
 #include "daisychain/recording_chain.hpp"
-#include "linux/gpio_lines.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
 
-/// A native trace being recorded from one chain. Not thread-safe (the Board's lock covers it).
+/// A native trace being recorded from one chain. Single-threaded: its owner (the Board) serialises every call.
 class ChainTraceRecorder {
  public:
   /// Creates or truncates `path` and writes the header (the chain and its BUSY/FLAG levels).

@@ -1,0 +1,294 @@
+// Board: the chains, their buses, the pins and their edges, and time.
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <sstream>
+
+#include "board/board_internal.hpp"
+
+namespace l6470emu {
+
+/// How often each kind of chip diagnostic is logged in full per chip.
+constexpr std::uint64_t kDiagnosticRepeats = 10;
+
+Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
+    : log_(std::move(log)), time_(config.time, host), numbering_(config.numbering) {
+  for (const ChainConfig& cc : config.chains) {
+    std::vector<Chip> chips;
+    chips.reserve(cc.chips.size());
+    for (const Variant* v : cc.chips) chips.emplace_back(*v);
+    // axis.K counts chips as the board's numbering= does.
+    const ChipNumbering axis_numbers(numbering_, chips.size());
+    for (const auto& [k, spec] : cc.axes) chips.at(axis_numbers.index_of(k)).attach_axis(spec);
+    auto cs = std::make_unique<ChainState>(cc, std::move(chips));
+    cs->name = cc.path.substr(cc.path.rfind('/') + 1);
+    cs->index = chains_.size();
+    cs->wired = cc.gpiochip.has_value();
+    ChainState::PinLevels initial{};
+    initial.fill(true);
+    initial[static_cast<unsigned>(Pin::STCK)] = false;  // SW open (pulled up), STBY_RST high (running), STCK low
+    cs->wire.assign(cs->chain.size(), initial);
+    cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
+    for (std::size_t k = 0; k < cs->chain.size(); ++k) {
+      const std::string where = cs->name + ": " + ChipNumbering(numbering_, cs->chain.size()).label(k) + ": ";
+      // A driver looping on a bad command must not flood the log: each kind is shown
+      // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
+      cs->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {
+        const std::size_t i = d.kind == DiagnosticKind::wrong_cmd ? 0 : d.kind == DiagnosticKind::notperf_cmd ? 1 : 2;
+        const char* kind = i == 0 ? "WRONG_CMD" : i == 1 ? "NOTPERF_CMD" : "ignored";
+        const std::uint64_t n = ++seen[i];
+        if (n < kDiagnosticRepeats) {
+          log_(where + kind + ": " + d.message);
+        } else if (n == kDiagnosticRepeats) {
+          log_(where + kind + ": " + d.message + "  (further ones of this kind are counted, not shown)");
+        } else {
+          std::uint64_t p = kDiagnosticRepeats;
+          while (p < n && p <= UINT64_MAX / 10) p *= 10;
+          if (p == n) log_(where + kind + ": " + std::to_string(n) + " so far");
+        }
+      });
+    }
+    chains_.push_back(std::move(cs));
+  }
+}
+
+Board::~Board() = default;
+
+Board::ChainState& Board::state(std::size_t chain) const { return *chains_.at(chain); }
+
+// ---------------------------------------------------------------- chains
+
+std::size_t Board::chip_count(std::size_t chain) const { return state(chain).chain.size(); }
+
+const ChainConfig& Board::chain_config(std::size_t chain) const { return state(chain).config; }
+
+const std::string& Board::chain_name(std::size_t chain) const { return state(chain).name; }
+
+const Chain& Board::chain(std::size_t chain) const { return state(chain).chain; }
+
+std::string Board::chain_summary(std::size_t chain) const {
+  const ChainState& c = state(chain);
+  std::ostringstream o;
+  o << c.config.path << ": " << c.chain.size() << " chip" << (c.chain.size() == 1 ? "" : "s") << " (";
+  for (std::size_t k = 0; k < c.config.chips.size(); ++k) o << (k ? "," : "") << c.config.chips[k]->name;
+  o << ")";
+  return o.str();
+}
+
+int Board::find_chain(const std::string& name) const {
+  for (std::size_t i = 0; i < chains_.size(); ++i) {
+    const ChainState& c = *chains_[i];
+    const std::string short_name = std::to_string(c.config.bus) + "." + std::to_string(c.config.cs);
+    if (name == c.name || name == c.config.path || name == short_name) return static_cast<int>(i);
+    if (c.config.gpiochip && name == "gpiochip" + std::to_string(*c.config.gpiochip)) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) {
+  ChainState& c = state(chain);
+  catch_up(c);
+  f(c.chain);
+  emit_changes(c, c.chain.now());
+}
+
+// ---------------------------------------------------------------- SPI
+
+SpiDevice& Board::begin_transfer(std::size_t chain) {
+  ChainState& c = state(chain);
+  // The use starts when the bus is free: now, or when the use before it on this bus ends.
+  const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
+  if (start > c.chain.now()) advance_chain(c, start);
+  record_outputs(c);
+  // One controller per bus: a chip-select still held low on another device of the bus is released first.
+  for (auto& other : chains_)
+    if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) spi_of(*other).deselect();
+  return spi_of(c);
+}
+
+Tick Board::end_transfer(std::size_t chain) {
+  ChainState& c = state(chain);
+  if (!c.watched.empty()) emit_changes(c, c.chain.now());
+  return bus_free_[c.config.bus] = c.chain.now();
+}
+
+Tick Board::transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing) {
+  run_message(begin_transfer(chain), transfers, timing);
+  return end_transfer(chain);
+}
+
+// ---------------------------------------------------------------- pins
+
+bool Board::level_of(const ChainState& c, std::size_t chip, Pin pin) const {
+  const Chip& ch = c.chain.chip(chip);
+  if (pin == Pin::BUSY) return ch.busy_sync_pin();
+  if (pin == Pin::FLAG) return ch.flag_pin();
+  if (c.wired) return c.wire[chip][static_cast<unsigned>(pin)];
+  if (pin == Pin::SW) return ch.sw_pin();
+  return pin == Pin::STBY_RST ? ch.spi_enabled() : false;
+}
+
+bool Board::level(std::size_t chain, std::size_t chip, Pin pin) const { return level_of(state(chain), chip, pin); }
+
+bool Board::set_input(std::size_t chain, std::size_t chip, Pin pin, bool level) {
+  if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
+  ChainState& c = *chains_[chain];
+  if (chip >= c.chain.size()) return false;
+  if (c.wired) {
+    bool& wire = c.wire[chip][static_cast<unsigned>(pin)];
+    if (wire == level) return true;
+    wire = level;
+  }
+  apply_input(c, chip, pin, level);
+  return true;
+}
+
+bool Board::drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level) {
+  if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
+  ChainState& c = *chains_[chain];
+  if (chip >= c.chain.size()) return false;
+  catch_up(c);
+  set_input(chain, chip, pin, level);
+  emit_changes(c, c.chain.now());
+  return true;
+}
+
+bool Board::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
+  ChainState& c = state(chain);
+  catch_up(c);
+  return level_of(c, chip, pin);
+}
+
+void Board::watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched) {
+  ChainState& c = state(chain);
+  const ChainState::WatchedPin w{chip, pin};
+  auto it = std::lower_bound(c.watched.begin(), c.watched.end(), w);
+  if (!watched) {
+    if (it != c.watched.end() && *it == w) c.watched.erase(it);
+    return;
+  }
+  if (it == c.watched.end() || *it != w) c.watched.insert(it, w);
+  c.last.at(chip)[static_cast<unsigned>(pin)] = level_of(c, chip, pin);
+}
+
+bool Board::has_watched_pins(std::size_t chain) const { return !state(chain).watched.empty(); }
+
+void Board::report_changes(std::size_t chain) {
+  ChainState& c = state(chain);
+  emit_changes(c, c.chain.now());
+}
+
+void Board::emit_changes(ChainState& c, Tick tick) {
+  record_outputs(c);
+  for (const ChainState::WatchedPin& w : c.watched) {
+    const bool level = level_of(c, w.chip, w.pin);
+    bool& last = c.last[w.chip][static_cast<unsigned>(w.pin)];
+    if (level == last) continue;
+    last = level;
+    if (edge_sink_) edge_sink_(PinEdge{c.index, w.chip, w.pin, level, tick});
+  }
+}
+
+// ---------------------------------------------------------------- time and edges
+
+void Board::catch_up(std::size_t chain) { catch_up(state(chain)); }
+
+void Board::catch_up(ChainState& c) {
+  const Tick target = time_.now();
+  if (target > c.chain.now()) advance_chain(c, target);
+}
+
+Tick Board::first_change(ChainState& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to) {
+  auto level_at = [&](Tick t) {
+    Chip probe = c.chain.chip(chip);
+    probe.set_diagnostic_sink({});
+    probe.advance_to(t);
+    return pin == Pin::BUSY ? probe.busy_sync_pin() : probe.flag_pin();
+  };
+  if (level_at(to) == level) return kNever;
+  Tick lo = from, hi = to;  // level at lo is `level`, at hi it differs
+  while (hi - lo > 1) {
+    const Tick mid = lo + (hi - lo) / 2;
+    if (level_at(mid) == level)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return hi;
+}
+
+void Board::advance_chain(ChainState& c, Tick target) {
+  if (c.watched.empty()) {
+    c.chain.advance_to(target);
+    return;
+  }
+  // Step from edge to edge so that every edge carries the tick it happened at.
+  for (int guard = 0; guard < 10000 && c.chain.now() < target; ++guard) {
+    Tick first = kNever;
+    for (const ChainState::WatchedPin& w : c.watched) {
+      if (!pin_is_chip_output(w.pin)) continue;
+      if (c.chain.chip(w.chip).next_event_tick() == kNever) continue;  // nothing moves on its own
+      first = std::min(first, first_change(c, w.chip, w.pin, c.last[w.chip][static_cast<unsigned>(w.pin)],
+                                           c.chain.now(), target));
+    }
+    if (first == kNever) {
+      c.chain.advance_to(target);
+      break;
+    }
+    c.chain.advance_to(first);
+    emit_changes(c, first);
+  }
+  if (c.chain.now() < target) c.chain.advance_to(target);
+}
+
+Tick Board::predict_next_edge(ChainState& c) {
+  Tick best = kNever;
+  const Tick now = c.chain.now();
+  for (const ChainState::WatchedPin& w : c.watched) {
+    if (!pin_is_chip_output(w.pin)) continue;
+    if (c.chain.chip(w.chip).next_event_tick() == kNever) continue;
+    // Exponential search forward, then bisection (first_change) inside the bracket.
+    Tick lo = now;
+    for (Tick step = 64; step < (Tick{1} << 40) && lo < best; step *= 2) {
+      const Tick hi = now + step;
+      const Tick t = first_change(c, w.chip, w.pin, c.last[w.chip][static_cast<unsigned>(w.pin)], lo, hi);
+      if (t != kNever) {
+        best = std::min(best, t);
+        break;
+      }
+      lo = hi;
+    }
+  }
+  return best;
+}
+
+bool Board::advance(Tick ticks) { return time_.is_virtual() && advance_to(time_.now() + ticks); }
+
+bool Board::advance_to(Tick tick) {
+  if (!time_.is_virtual()) return false;
+  const Tick target = time_.set_now(tick);
+  for (auto& c : chains_) {
+    if (c->chain.now() < target) advance_chain(*c, target);
+    emit_changes(*c, c->chain.now());
+  }
+  return true;
+}
+
+Tick Board::next_edge_tick() {
+  Tick best = kNever;
+  for (auto& c : chains_) {
+    catch_up(*c);
+    best = std::min(best, predict_next_edge(*c));
+  }
+  return best;
+}
+
+Tick Board::predict_edge_tick(std::size_t chain) { return predict_next_edge(state(chain)); }
+
+Tick Board::now(std::size_t chain) {
+  ChainState& c = state(chain);
+  catch_up(c);
+  return c.chain.now();
+}
+
+}  // namespace l6470emu

@@ -1,0 +1,193 @@
+// The OS-free board every front stands on: the chains of a board description on their buses,
+// the named pins of every chip with their levels and edges, one clock, the recordings.
+// Single-threaded and lock-free; it knows no device node, file descriptor or thread (linux/'s
+// DeviceBoard puts spidev and gpiochip semantics and a lock around it; a firmware front, HAL calls).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "board/board_config.hpp"
+#include "board/board_time.hpp"
+#include "board/pins.hpp"
+#include "daisychain/chain.hpp"
+#include "daisychain/chip_numbering.hpp"
+#include "spi/message.hpp"
+#include "spi/trace.hpp"
+
+namespace l6470emu {
+
+/// A level change of a watched pin, at the tick it happened.
+struct PinEdge {
+  std::size_t chain = 0;  ///< index of the chain in the board description
+  std::size_t chip = 0;   ///< chain index of the chip (0 drives MISO)
+  Pin pin = Pin::BUSY;
+  bool level = false;     ///< the physical level after the edge (true = high)
+  Tick tick = 0;          ///< when it changed
+};
+
+/// Where the board's diagnostics go: one line per call, without "l6470emu: " or a newline.
+using LineSink = std::function<void(std::string_view)>;
+/// Where the board reports the edges of watched pins (called inside the board's operations).
+using EdgeSink = std::function<void(const PinEdge&)>;
+
+/// The emulated hardware of a board description: one daisy chain per chip-select, the buses
+/// they share, every chip's pins, the board's time and the trace recordings. Chip arguments are
+/// always chain indices (0 drives MISO); numbering() says how users count them. Not thread-safe:
+/// its front serialises every call.
+///
+/// Time: the chains catch up lazily with the clock (time()). Operations that act "now" (those
+/// documented so) first bring the chain up to the board's time, reporting on the way every edge
+/// of a watched output pin at its own tick; the raw ones (set_input, level, report_changes)
+/// work at the chain's own tick, so that a front can compose them into one step.
+class Board {
+ public:
+  /// Builds the chains of `config` (variants, axes, numbering) on a clock read from `host`
+  /// (which must outlive the board). Chip diagnostics go to `log`, each kind shown ten times
+  /// per chip and then counted, with a tally at every power of ten.
+  Board(const BoardConfig& config, LineSink log, HostClock& host);
+  ~Board();
+  Board(const Board&) = delete;
+  Board& operator=(const Board&) = delete;
+
+  // ---- chains -----------------------------------------------------------------
+
+  std::size_t chain_count() const { return chains_.size(); }
+  /// Number of chips of chain `chain`.
+  std::size_t chip_count(std::size_t chain) const;
+  /// How diagnostics and users number the chips (the description's numbering=).
+  NumberFrom numbering() const { return numbering_; }
+  /// The numbering of chain `chain`: its chain indices as users see them.
+  ChipNumbering chip_numbering(std::size_t chain) const { return ChipNumbering(numbering_, chip_count(chain)); }
+  /// The description of chain `chain`.
+  const ChainConfig& chain_config(std::size_t chain) const;
+  /// The chain's name: the last part of its path ("spidev0.0").
+  const std::string& chain_name(std::size_t chain) const;
+  /// "/dev/spidev0.0: 3 chips (L6470,L6470,L6480)".
+  std::string chain_summary(std::size_t chain) const;
+  /// Index of the chain called `name` (its name "spidev0.0", path "/dev/spidev0.0", "B.C", or
+  /// the "gpiochipN" the description gives its pins), or -1.
+  int find_chain(const std::string& name) const;
+  /// The chain as it stands at its own tick (for reading; nothing is brought up to the clock).
+  const Chain& chain(std::size_t chain) const;
+  /// Runs `f` on chain `chain` brought up to the clock, then reports the edges it caused.
+  void with_chain(std::size_t chain, const std::function<void(Chain&)>& f);
+
+  // ---- SPI: a front clocks bytes on a chain between begin_transfer and end_transfer --------
+
+  /// Starts a use of the bus of chain `chain` and returns the device to clock on (the chain,
+  /// or its recording while it is recorded). The use starts when the bus is free: at the
+  /// board's time, or when the use before it on the same bus ended, if later (its caller may
+  /// still be waiting for that end); the chain is brought there. One controller drives a bus:
+  /// another chain of the bus left selected is deselected first. Between begin and end the
+  /// front selects, exchanges (advancing the device's clock by each byte's bus time, as
+  /// run_message does) and deselects as its host would; nothing else may touch the board.
+  SpiDevice& begin_transfer(std::size_t chain);
+  /// Ends the use begun by begin_transfer: reports the edges of watched pins at the chain's
+  /// tick and frees the bus from then. Returns that tick: the use's end, which the front's
+  /// host reaches by waiting (advance_to in virtual time).
+  Tick end_transfer(std::size_t chain);
+  /// begin_transfer, run_message(transfers, timing), end_transfer. Returns the end tick.
+  Tick transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing = {});
+
+  // ---- pins ---------------------------------------------------------------------
+
+  /// Drives input pin `pin` (SW, STCK, STBY_RST) of chip `chip` now, as the physical world
+  /// would, and reports the edges it caused. Returns false for an output pin or a bad index.
+  bool drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level);
+  /// Physical level of a pin now (BUSY and FLAG: the chip's outputs; inputs: see level()).
+  bool pin_level(std::size_t chain, std::size_t chip, Pin pin);
+  /// Raw: drives input pin `pin` at the chain's own tick without reporting edges (a front
+  /// driving several pins at once calls report_changes after the last). On a chain whose pins
+  /// are on lines (the description's gpiochip=), the board keeps each input's level and a drive
+  /// to the level it has is no change; without, every drive goes to the chip as it comes.
+  /// Returns false for an output pin or a bad index.
+  bool set_input(std::size_t chain, std::size_t chip, Pin pin, bool level);
+  /// Raw: physical level of a pin at the chain's own tick. An input on lines reads the level it
+  /// is driven to (SW high, STBY_RST high, STCK low until driven); without lines, the chip's
+  /// own view (SW with the axis's switches, STBY_RST, and STCK as low).
+  bool level(std::size_t chain, std::size_t chip, Pin pin) const;
+  /// Starts (true) or stops watching a pin: the board then reports each change of its level to
+  /// the edge sink, at its tick (BUSY and FLAG changing by themselves are found at their exact
+  /// ticks as time passes). A watch starts from the pin's level at the chain's tick, even when
+  /// the pin was already watched.
+  void watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched);
+  /// Whether any pin of chain `chain` is watched.
+  bool has_watched_pins(std::size_t chain) const;
+  /// Raw: records the outputs of a chain being recorded and reports the changes of its watched
+  /// pins, at the chain's own tick.
+  void report_changes(std::size_t chain);
+  /// Where edges of watched pins go (an empty function drops them).
+  void set_edge_sink(EdgeSink sink) { edge_sink_ = std::move(sink); }
+
+  // ---- time ---------------------------------------------------------------------
+
+  /// The board's time (the one owner of the clock).
+  BoardTime& time() { return time_; }
+  const BoardTime& time() const { return time_; }
+  /// Brings chain `chain` up to the board's time, reporting the edges on the way.
+  void catch_up(std::size_t chain);
+  /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
+  bool advance(Tick ticks);
+  /// Virtual time: moves the board's time to `tick` if it is later and brings every chain
+  /// there, reporting the edges of watched pins at their own ticks. Wall time: false.
+  bool advance_to(Tick tick);
+  /// Brings every chain up to the clock, then says the earliest tick at which a watched BUSY
+  /// or FLAG will change by itself (kNever: none). A host waiting for edges wakes then.
+  Tick next_edge_tick();
+  /// The same for one chain, from the chain's own tick (nothing is brought up to the clock).
+  Tick predict_edge_tick(std::size_t chain);
+  /// Current tick of chain `chain`, brought up to the clock.
+  Tick now(std::size_t chain);
+
+  // ---- the backdoor and the recordings ---------------------------------------------
+
+  /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain
+  /// `chain` now, recorded when the chain is being recorded; edges reported. False for a bad index.
+  bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
+  /// progress on the chain is stopped first): every CS frame, every input pin change, every
+  /// backdoor event and the BUSY/FLAG changes, each line flushed as it is written.
+  /// Returns "" or one line saying why not.
+  std::string start_recording(std::size_t chain, const std::string& path);
+  /// Starts recording every chain: into `path` for one chain, else trace_path_for_chain files.
+  std::string start_recording_all(const std::string& path);
+  /// Stops recording chain `chain` (a frame still open, CS held low, is not written).
+  /// Returns false when it was not recording; `summary` gets "N frames to PATH".
+  bool stop_recording(std::size_t chain, std::string* summary = nullptr);
+  /// Where chain `chain` is being recorded ("" = not recording).
+  std::string recording_path(std::size_t chain) const;
+  /// Drops every recording without writing to it again (a forked child's copies of its
+  /// parent's recordings, which the parent keeps writing).
+  void abandon_recordings();
+
+ private:
+  struct ChainState;
+
+  ChainState& state(std::size_t chain) const;
+  SpiDevice& spi_of(ChainState& c);
+  void apply_input(ChainState& c, std::size_t chip, Pin pin, bool level);
+  void record_outputs(ChainState& c);
+  void catch_up(ChainState& c);
+  void advance_chain(ChainState& c, Tick target);
+  Tick first_change(ChainState& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
+  Tick predict_next_edge(ChainState& c);
+  void emit_changes(ChainState& c, Tick tick);
+  bool level_of(const ChainState& c, std::size_t chip, Pin pin) const;
+
+  LineSink log_;
+  EdgeSink edge_sink_;
+  BoardTime time_;
+  NumberFrom numbering_ = NumberFrom::miso;
+  std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last use ends
+  std::vector<std::unique_ptr<ChainState>> chains_;
+};
+
+}  // namespace l6470emu

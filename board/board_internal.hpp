@@ -1,0 +1,36 @@
+// Board's private state, shared by board.cpp (chains, SPI, pins, time) and board_record.cpp
+// (recordings). Not part of the public API.
+#pragma once
+
+#include <array>
+#include <compare>
+
+#include "board/board.hpp"
+#include "board/trace_recorder.hpp"
+
+namespace l6470emu {
+
+/// One chain of the board, its pins and its recording.
+struct Board::ChainState {
+  /// One level per pin of a chip, indexed by Pin.
+  using PinLevels = std::array<bool, kPinsPerChip>;
+  /// A watched pin; sorted by chip, then pin (a gpiochip's line order).
+  struct WatchedPin {
+    std::size_t chip = 0;
+    Pin pin = Pin::BUSY;
+    auto operator<=>(const WatchedPin&) const = default;
+  };
+
+  ChainConfig config;
+  Chain chain;
+  std::string name;                   // "spidev0.0"
+  std::size_t index = 0;              // in the board description
+  bool wired = false;                 // its pins are on lines (gpiochip=): wire levels are kept
+  std::vector<PinLevels> wire;        // inputs on lines: the level each is driven to
+  std::vector<PinLevels> last;        // watched pins: the level last reported
+  std::vector<WatchedPin> watched;    // sorted
+  std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
+  ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
+};
+
+}  // namespace l6470emu
