@@ -6,9 +6,9 @@
  *   getstatus  GetStatus polled in a tight loop as one-chip drivers send it, one CS frame per
  *              byte: 0xD0, then two NOPs that carry STATUS back (three round trips per poll)
  * Usage: l6470emu_preload_roundtrips /dev/spidevB.C COUNT [nop|getstatus]
- * Prints "COUNT WALL_SECONDS PER_WALL_SECOND HOST_SECONDS": wall time read with the raw system
- * call (the preload cannot see it), host time with clock_gettime (CLOCK_MONOTONIC: the board's
- * time under time=virtual). COUNT counts round trips. */
+ * Prints "COUNT WALL_SECONDS PER_WALL_SECOND HOST_SECONDS CPU_SECONDS": wall time read with the
+ * raw system call (the preload cannot see it), host time with clock_gettime (CLOCK_MONOTONIC: the
+ * board's time under time=virtual), the process's CPU time (never virtual). COUNT counts round trips. */
 #include <fcntl.h>
 #include <linux/spi/spidev.h>
 #include <stdint.h>
@@ -23,6 +23,12 @@
 static double wall_seconds(void) {
   struct timespec t;
   syscall(SYS_clock_gettime, CLOCK_MONOTONIC, &t);
+  return t.tv_sec + t.tv_nsec / 1e9;
+}
+
+static double cpu_seconds(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return t.tv_sec + t.tv_nsec / 1e9;
 }
 
@@ -52,14 +58,14 @@ int main(int argc, char** argv) {
   x.tx_buf = (uintptr_t)&tx;
   x.rx_buf = (uintptr_t)&rx;
   x.len = 1;
-  const double wall0 = wall_seconds(), host0 = host_seconds();
+  const double wall0 = wall_seconds(), host0 = host_seconds(), cpu0 = cpu_seconds();
   for (long i = 0; i < n; ++i) {
     tx = poll && i % 3 == 0 ? 0xD0 : 0x00;
     if (ioctl(fd, SPI_IOC_MESSAGE(1), &x) != 1) { perror("SPI_IOC_MESSAGE"); return 1; }
     /* A NOP gets 0x00 back, and so does the command byte of a poll; its two NOPs bring STATUS. */
     if (!poll ? rx != 0 : (i % 3 == 0 && rx != 0)) { fprintf(stderr, "round trip %ld: MISO 0x%02X\n", i, rx); return 1; }
   }
-  const double wall = wall_seconds() - wall0, host = host_seconds() - host0;
-  printf("%ld %.6f %.0f %.6f\n", n, wall, n / wall, host);
+  const double wall = wall_seconds() - wall0, host = host_seconds() - host0, cpu = cpu_seconds() - cpu0;
+  printf("%ld %.6f %.0f %.6f %.6f\n", n, wall, n / wall, host, cpu);
   return 0;
 }
