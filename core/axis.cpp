@@ -260,11 +260,7 @@ Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now)
          (40 - p.step_sel)) * p.el_increment();
     if (have && reach >= static_cast<unsigned __int128>(fwd ? target - u : u - target)) {
       const std::int64_t goal = target - offset_;  // commanded travel at which it happens
-      const Tick k = first_true(1, best - 1, [&](Tick i) {
-        const std::int64_t t = travel_after_uniform_ticks(s, p, i);
-        return fwd ? t >= goal : t <= goal;
-      });
-      best = std::min(best, k);
+      best = std::min(best, first_uniform_tick_at_travel(s, p, goal, best - 1));
     }
   }
   return best;

@@ -207,6 +207,25 @@ Tick first_uniform_tick_at_speed(const MotionState& s, const Profile& p, std::ui
   return i > n ? n + 1 : i;
 }
 
+Tick first_uniform_tick_at_travel(const MotionState& s, const Profile& p, std::int64_t travel, Tick n) {
+  const Rule r = motion_active(s) ? uniform_rule(s, p) : Rule{};
+  const auto reached = [&](Tick i) {
+    const std::int64_t t = travel_after_uniform_ticks(s, p, i);
+    return s.dir ? t >= travel : t <= travel;
+  };
+  if (r.delta != 0) return first_true(1, n, reached);  // a ramp: searched
+  // Constant speed v: after i ticks the microsteps made are (frac + i*v) >> shift, each moving
+  // the travel by el_increment() in the motor's direction; solved for the first i.
+  const std::int64_t gap = s.dir ? travel - s.travel : s.travel - travel;
+  if (gap <= 0) return n >= 1 ? 1 : n + 1;
+  const std::uint64_t el = p.el_increment();
+  const u128 steps = (static_cast<std::uint64_t>(gap) + el - 1) / el;  // microsteps needed
+  const u128 need = (steps << (40u - p.step_sel)) - s.frac;              // distance, 2^-40 step
+  if (s.speed == 0) return n + 1;
+  const u128 i = (need + s.speed - 1) / s.speed;
+  return i > n ? n + 1 : static_cast<Tick>(i);
+}
+
 std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
   if (n == 0 || !motion_active(s)) return s.travel;
   return s.travel + travel_of(s, p, steps_after(s, p, uniform_rule(s, p), n).steps);
