@@ -30,6 +30,11 @@ struct Board::ChainState {
   std::vector<PinLevels> last;        // watched pins: the level last reported
   std::vector<WatchedPin> watched;    // sorted
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
+  // The next change of a watched BUSY/FLAG as predict_next_edge found it (kNever: none), valid
+  // until something other than time reaches the chain (a byte, a CS edge, an input, a fault,
+  // a new watch): until then the chain advances to any earlier tick without probing.
+  bool prediction_valid = false;
+  Tick predicted_edge = kNever;
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

@@ -35,6 +35,7 @@ bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, 
   ChainState& c = *chains_[chain];
   if (chip >= c.chain.size()) return false;
   catch_up(c);
+  c.prediction_valid = false;
   if (c.recorder)
     c.recorder->fault(chip, fault, value);
   else

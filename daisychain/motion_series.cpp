@@ -259,6 +259,9 @@ Tick trace_end_tick(TraceReader& in, const PassProgress& progress) {
 }
 
 MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const MotionOptions& options) {
+  if (options.max_points > kMaxMotionPoints)
+    throw std::invalid_argument("max_points " + std::to_string(options.max_points) + ": at most " +
+                                std::to_string(kMaxMotionPoints) + " samples per chip (a picture has a few thousand columns)");
   const Tick from = options.from;
   const Tick last = options.to != kNever ? options.to : trace_end + options.tail;
   if (from >= last) {

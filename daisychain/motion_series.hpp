@@ -56,6 +56,10 @@ struct ChipMotion {
 /// draws at.
 using PassProgress = std::function<void(const ReadProgress&)>;
 
+/// The most samples a chip's series may ask for (MotionOptions::max_points): a picture has a
+/// few thousand columns, and memory and time grow with the number.
+inline constexpr std::size_t kMaxMotionPoints = 100'000;
+
 /// Choices for sample_motion.
 struct MotionOptions {
   std::vector<std::size_t> chips;  ///< chips to sample, numbered as number_from says (empty = all)
@@ -66,7 +70,8 @@ struct MotionOptions {
   Tick tail = kTicksPerSecond;
   /// Most samples per chip: a long run is sampled on a coarser grid and then thinned (each
   /// time slice keeps its first and last sample and those with the extremes of ABS_POS and
-  /// SPEED and the first change of each pin), so the picture keeps its shape. At least 64.
+  /// SPEED and the first change of each pin), so the picture keeps its shape. At least 64
+  /// (a smaller number is taken as 64), at most kMaxMotionPoints (more is refused).
   std::size_t max_points = 4000;
   std::size_t max_commands = 2000;  ///< most command marks per chip
   PassProgress progress;            ///< told how far the replay has come (empty: nobody asks)
@@ -90,7 +95,8 @@ Tick trace_end_tick(TraceReader& in, const PassProgress& progress = {});
 /// and on a regular grid of about max_points / 4 ticks across the window while a chip moves.
 /// `trace_end` is trace_end_tick() of the same trace (needed for an open window).
 /// Throws TraceError for malformed input and events naming chips outside the chain, and
-/// std::invalid_argument for a chip outside the chain or an empty window.
+/// std::invalid_argument for a chip outside the chain, an empty window or more than
+/// kMaxMotionPoints points.
 MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const MotionOptions& options = {});
 
 }  // namespace l6470emu

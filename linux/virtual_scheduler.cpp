@@ -3,10 +3,13 @@
 #include "linux/virtual_scheduler.hpp"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cinttypes>
+#include <cstdio>
 #include <string>
 
 #include "linux/clock.hpp"
@@ -72,11 +75,35 @@ timespec to_timespec(std::int64_t ns) {
   return {static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
 }
 
+// A thread's name as the kernel has it (/proc/self/task/TID/comm), or "".
+std::string thread_name(pid_t tid) {
+  const std::string path = "/proc/self/task/" + std::to_string(tid) + "/comm";
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return {};
+  char buf[64];
+  const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+  ::close(fd);
+  if (n <= 0) return {};
+  std::string name(buf, static_cast<std::size_t>(n));
+  while (!name.empty() && (name.back() == '\n' || name.back() == '\0')) name.pop_back();
+  for (char& c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7F) c = '?';
+  return name;
+}
+
+std::string seconds_of(Tick t) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%" PRIu64 ".%06" PRIu64, static_cast<std::uint64_t>(t / kTicksPerSecond),
+                static_cast<std::uint64_t>(t % kTicksPerSecond / 4));
+  return buf;
+}
+
 }  // namespace
 
 struct VirtualScheduler::Waiter {
   const Wait* w = nullptr;
   pthread_t owner = pthread_self();
+  pid_t tid = ::gettid();
   int fd = -1;  // the waiting thread's wake-up eventfd
   std::uint64_t seq = 0;
   std::atomic<bool> done{false};
@@ -147,7 +174,7 @@ VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
       at_most(std::max<std::int64_t>(kFallbackPollNs,
                                      last_activity_ns_.load(std::memory_order_acquire) + idle_ns_ - real_now()));
     if (w.ready && w.recheck_ns > 0) at_most(w.recheck_ns);
-    if (me.fd < 0) at_most(kFallbackPollNs);
+    if (me.fd < 0 || redecide_) at_most(kFallbackPollNs);
     const timespec ts = to_timespec(timeout_ns < 0 ? 0 : timeout_ns);
     for (pollfd& p : pf) p.revents = 0;
     const int n = ::ppoll(pf.data(), pf.size(), timeout_ns < 0 ? nullptr : &ts, w.sigmask);
@@ -172,9 +199,13 @@ VirtualScheduler::End VirtualScheduler::block(Waiter& me) {
         }
       continue;
     }
-    // A real timeout: the periodic check, and the idle grace.
+    // A real timeout: the periodic check, a decision to take up again, and the idle grace.
     if (w.ready && w.ready()) {
       end_locked(me, End::ready);
+      continue;
+    }
+    if (redecide_ && running_ == 0) {
+      decide_locked(false);
       continue;
     }
     if (idle_ns_ > 0 && running_ > 0 &&
@@ -253,6 +284,7 @@ bool VirtualScheduler::wake_ready_locked() {
 }
 
 void VirtualScheduler::decide_locked(bool forced) {
+  redecide_ = false;
   for (int empty = 0; empty < kMaxEmptyJumps; ++empty) {
     if (waiters_.empty()) return;
     if (running_ > 0 && !forced) return;
@@ -268,7 +300,11 @@ void VirtualScheduler::decide_locked(bool forced) {
     }
     if (board && hooks_.next_edge) d = std::min(d, hooks_.next_edge());
     for (const auto& [id, tick] : timers_) d = std::min(d, tick);
-    if (d == kNever) return;  // every thread waits for something outside the process
+    if (d == kNever) {
+      // Every thread waits for something outside the process, or for nothing that can come.
+      if (!forced && running_ == 0) check_deadlock_locked();
+      return;
+    }
     d = std::max(d, hooks_.now());
     hooks_.advance_to(d);
     for (auto it = timers_.begin(); it != timers_.end();) {
@@ -289,6 +325,75 @@ void VirtualScheduler::decide_locked(bool forced) {
     if (wake_ready_locked()) woke = true;
     if (woke) return;
   }
+  redecide_ = true;  // so many jumps woke nobody: the waiters take the decision up again shortly
+}
+
+void VirtualScheduler::check_deadlock_locked() {
+  if (!hooks_.deadlock || running_ > 0) return;
+  bool any = false;
+  for (const Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed)) continue;
+    any = true;
+    if (w->w->outside) return;  // another process may post or signal
+    for (const pollfd& p : w->w->fds)
+      if (!hooks_.inside_fd || !hooks_.inside_fd(p.fd)) return;  // another process may write to it
+  }
+  if (!any) return;
+  if (hooks_.outside_wakeup) {
+    const std::string why = hooks_.outside_wakeup();
+    if (!why.empty()) {
+      if (!outside_logged_ && hooks_.log) {
+        outside_logged_ = true;
+        hooks_.log("virtual time: every thread waits and nothing in the process can wake them, but " + why +
+                   ": waiting for its signal in real time");
+      }
+      return;
+    }
+  }
+  hooks_.deadlock(deadlock_report_locked());
+}
+
+std::string VirtualScheduler::deadlock_report_locked() const {
+  const Tick now = hooks_.now();
+  std::string r = "virtual time: deadlock at t=" + seconds_of(now) +
+                  " s: every thread waits and nothing can wake any of them (no timeout, timer or line edge to come); "
+                  "the run ends with exit status " + std::to_string(kDeadlockExitStatus);
+  for (const Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed)) continue;
+    const Wait& wait = *w->w;
+    const std::string name = thread_name(w->tid);
+    r += "\n  thread " + std::to_string(w->tid) + (name.empty() ? "" : " (" + name + ")") + ": " +
+         (wait.call == nullptr ? std::string("a covered wait")
+          : std::string_view(wait.call).find(' ') != std::string_view::npos ? std::string(wait.call)
+                                                                           : std::string(wait.call) + "()");
+    for (std::size_t i = 0; i < wait.fds.size(); ++i)
+      r += (i == 0 ? " on " : ", ") + (hooks_.describe_fd ? hooks_.describe_fd(wait.fds[i].fd)
+                                                           : "fd " + std::to_string(wait.fds[i].fd));
+    if (const pid_t joined = wait.joined_tid ? wait.joined_tid->load(std::memory_order_acquire) : 0; joined != 0) {
+      const std::string name_of_joined = thread_name(joined);
+      r += " of thread " + std::to_string(joined) + (name_of_joined.empty() ? "" : " (" + name_of_joined + ")");
+    } else if (wait.fds.empty() && wait.object != nullptr) {
+      char obj[32];
+      std::snprintf(obj, sizeof obj, "%p", wait.object);
+      r += std::string(" on the object at ") + obj;
+    }
+    if (wait.deadline != kNever)
+      r += ", until t=" + seconds_of(wait.deadline) + " s";  // (not reached: a jump would have come first)
+    else
+      r += wait.timeout_beyond_end ? ", its timeout past the last time the clocks can show (it never ends)"
+                                   : ", no timeout";
+  }
+  if (hooks_.describe_board) {
+    const std::string board = hooks_.describe_board();
+    std::size_t at = 0;
+    while (at < board.size()) {
+      const std::size_t nl = board.find('\n', at);
+      const std::size_t end = nl == std::string::npos ? board.size() : nl;
+      if (end > at) r += "\n  " + board.substr(at, end - at);
+      at = end + 1;
+    }
+  }
+  return r;
 }
 
 int VirtualScheduler::notify(const void* object, bool all) {

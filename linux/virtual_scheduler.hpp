@@ -5,6 +5,7 @@
 #include <poll.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/types.h>
 
 #include <atomic>
 #include <cstdint>
@@ -12,12 +13,18 @@
 #include <map>
 #include <mutex>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/tick.hpp"
 
 namespace l6470emu {
+
+/// The exit status of a program that virtual time found deadlocked: every thread waits in a
+/// covered call and nothing can ever wake any of them (see VirtualScheduler). Distinct from the
+/// statuses programs and tools commonly use (0-5, 23, 64-78, 99, 124-127, 128 + a signal).
+inline constexpr int kDeadlockExitStatus = 86;
 
 /// Virtual time for the threads of one process.
 ///
@@ -33,6 +40,14 @@ namespace l6470emu {
 /// A thread that is neither running covered code nor waiting (blocked in a call the preload does
 /// not see) stalls time; after `idle_ns` of real time without any wait entered or left, time moves
 /// on anyway to the earliest wake-up, and that is logged once (the run may not repeat exactly).
+///
+/// A deadlock is what virtual time can see and real time cannot: every thread waits, none has a
+/// wake-up to come (no deadline, no armed timer, no edge on a line a waiter watches), none waits
+/// on anything another process could end (a descriptor that is not an emulated line or virtual
+/// timer, a process-shared semaphore or condition variable), and no real timer (alarm, setitimer,
+/// timer_create) is armed to send a signal. Then Hooks::deadlock gets a report of what each thread
+/// waits on (it ends the process with kDeadlockExitStatus); a thread outside the covered calls
+/// counts as running, so a deadlock is never declared while one exists.
 class VirtualScheduler {
  public:
   /// What the scheduler drives and reads. `now` and `advance_to` are required.
@@ -43,6 +58,18 @@ class VirtualScheduler {
     std::function<void(int)> fire_timer;     ///< a timer set with set_timer() expired
     std::function<std::int64_t()> real_ns;   ///< the real monotonic clock, ns (idle grace)
     std::function<void(std::string_view)> log;  ///< diagnostics (the idle-grace line)
+    /// Whether descriptor `fd` becomes ready only through this process (an emulated gpio line, a
+    /// virtual timerfd). Unset: every descriptor may be made ready from outside (no deadlock).
+    std::function<bool(int fd)> inside_fd;
+    /// Words for a descriptor in the deadlock report ("fd 5, a gpio line request on /dev/gpiochip0").
+    std::function<std::string(int fd)> describe_fd;
+    /// Why a signal may still come from outside the covered calls (an armed alarm), or "".
+    std::function<std::string()> outside_wakeup;
+    /// The board's side of the deadlock report (lines watched, their levels), or "".
+    std::function<std::string()> describe_board;
+    /// A deadlock was found (the scheduler's lock is held): `report` says what each thread waits
+    /// on. Expected to end the process; if it returns, the threads simply go on waiting.
+    std::function<void(const std::string& report)> deadlock;
   };
 
   /// How a wait ends.
@@ -56,10 +83,17 @@ class VirtualScheduler {
 
   /// One covered wait, described by the caller (the preload's interposers, or a test).
   struct Wait {
+    const char* call = nullptr;             ///< the covered call, for the deadlock report ("read")
     Tick deadline = kNever;                 ///< virtual tick at which the wait times out
+    /// The caller's timeout lies past the last time the clocks can show (KTIME_MAX): deadline is
+    /// kNever, and the report says so instead of "no timeout".
+    bool timeout_beyond_end = false;
+    /// Another process may end the wait (a process-shared semaphore or condition variable).
+    bool outside = false;
     std::span<const pollfd> fds;            ///< real descriptors whose readiness ends the wait
     bool watches_board = false;             ///< fds include lines with edge events: the next edge is a wake-up
     const void* object = nullptr;           ///< notify(object) / grant(object) ends the wait
+    const std::atomic<pid_t>* joined_tid = nullptr;  ///< pthread_join: the joined thread's id, once it runs (report)
     const sigset_t* sigmask = nullptr;      ///< signal mask while blocked (ppoll, pselect, epoll_pwait)
     bool interruptible = true;              ///< a signal handler ends the wait (else it goes on)
     /// Checked under the scheduler's lock before registering: true ends the wait at once (ready).
@@ -127,6 +161,8 @@ class VirtualScheduler {
   End block(Waiter& me);
   void leave_wait(Waiter& me);
   void decide_locked(bool forced);
+  void check_deadlock_locked();
+  std::string deadlock_report_locked() const;
   bool wake_ready_locked();
   void end_locked(Waiter& w, End how);
   void remove_locked(Waiter& w);
@@ -142,6 +178,9 @@ class VirtualScheduler {
   std::uint64_t next_seq_ = 0;
   std::atomic<std::int64_t> last_activity_ns_{0};
   std::atomic<bool> idle_logged_{false};
+  // A decision stopped after kMaxEmptyJumps jumps that woke nobody: a waiter takes it up again.
+  bool redecide_ = false;
+  bool outside_logged_ = false;
 };
 
 }  // namespace l6470emu

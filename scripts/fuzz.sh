@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=${1:-60}
-harnesses=(spi_chain native saleae sigrok umockdev ftrace config protocol)
+harnesses=(spi_chain native saleae sigrok umockdev ftrace config protocol sketch)
 build=build-fuzz
 
 echo "== fuzz: setting up $build (clang, libFuzzer, ASan + UBSan)"

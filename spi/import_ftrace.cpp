@@ -1,9 +1,11 @@
 // Linux ftrace text (tracefs "trace" file or `trace-cmd report`) with the spi events of
 // include/trace/events/spi.h: spi_transfer_start/stop "spiB.C <xfer> len=N tx=[..] rx=[..]",
 // spi_set_cs "spiB.C activate|deactivate", spi_message_start/done. Bytes come from
-// spi_transfer_stop (rx is only valid there); CS frames from spi_set_cs when traced.
+// spi_transfer_stop (rx is only valid there); CS frames from spi_set_cs when traced. Read a
+// line at a time (a file is streamed, never held whole) after a look for the event names.
 #include <vector>
 
+#include "spi/import_source.hpp"
 #include "spi/import_support.hpp"
 #include "spi/trace_import.hpp"
 
@@ -11,7 +13,7 @@ namespace l6470emu {
 namespace {
 
 using detail::FrameBuilder;
-using detail::LineCursor;
+using detail::ImportSource;
 using detail::printable;
 using detail::quote;
 
@@ -36,15 +38,15 @@ std::string_view token(std::string_view& rest) {
 
 class FtraceImporter {
  public:
-  FtraceImporter(std::string_view text, const std::string& name, const ImportOptions& options)
-      : text_(text), name_(name), options_(options), frames_(trace_, name_) {}
+  FtraceImporter(ImportSource& source, const ImportOptions& options)
+      : source_(source), name_(source.name()), options_(options), frames_(trace_, name_, options.max_frames) {}
 
   Trace run() {
     trace_.header.name = name_;
     trace_.header.format = "ftrace";
-    const bool has_cs = text_.find("spi_set_cs:") != std::string_view::npos;
-    const bool has_stop = text_.find("spi_transfer_stop:") != std::string_view::npos;
-    const bool has_start = text_.find("spi_transfer_start:") != std::string_view::npos;
+    const std::string_view events[] = {"spi_set_cs:", "spi_transfer_stop:", "spi_transfer_start:"};
+    const std::vector<bool> found = source_.contains(events);
+    const bool has_cs = found[0], has_stop = found[1], has_start = found[2];
     if (!has_stop && !has_start)
       throw TraceError(name_, 0, "no spi_transfer_start/stop events (record with: trace-cmd record -e spi, or "
                                  "echo 1 > /sys/kernel/tracing/events/spi/enable)");
@@ -60,7 +62,7 @@ class FtraceImporter {
       throw TraceError(name_, 0, "CS framing asked for, but the file has no spi_set_cs events");
     }
 
-    LineCursor lines(text_);
+    ImportSource& lines = source_;
     std::string_view line;
     bool any_time = false;
     SourceTime last_time;
@@ -100,14 +102,14 @@ class FtraceImporter {
   }
 
  private:
-  [[noreturn]] void fail(const LineCursor& lines, const std::string& message) {
+  [[noreturn]] void fail(const ImportSource& lines, const std::string& message) {
     std::string m = message;
     if (lines.unterminated()) m += " (the last line has no newline: truncated file?)";
     throw TraceError(name_, lines.number(), m);
   }
 
   /// Recognises an spi event line; false for anything else.
-  bool parse(const LineCursor& lines, std::string_view line, Parsed& p) {
+  bool parse(const ImportSource& lines, std::string_view line, Parsed& p) {
     static constexpr struct {
       std::string_view name;
       Event event;
@@ -146,7 +148,7 @@ class FtraceImporter {
   }
 
   /// "tx=[21-00-ff]" → bytes; the list may be empty.
-  void byte_list(const LineCursor& lines, std::string_view tok, std::string_view key, std::vector<std::uint8_t>& out) {
+  void byte_list(const ImportSource& lines, std::string_view tok, std::string_view key, std::vector<std::uint8_t>& out) {
     out.clear();
     // key=[..]
     if (tok.size() < key.size() + 3 || tok.substr(0, key.size()) != key || tok[key.size()] != '=' ||
@@ -187,7 +189,7 @@ class FtraceImporter {
     open_ = false;
   }
 
-  void handle(const LineCursor& lines, const Parsed& p) {
+  void handle(const ImportSource& lines, const Parsed& p) {
     switch (p.event) {
       case Event::set_cs: {
         if (framing_ != FtraceFraming::cs) return;
@@ -266,6 +268,8 @@ class FtraceImporter {
       fail(lines, framing_ == FtraceFraming::cs ? "transfer while CS is not active (no spi_set_cs activate before it)"
                                                 : "transfer outside an spi_message_start/done pair");
     }
+    if (mosi_.size() + len > kMaxTraceFrameBytes)
+      fail(lines, frame_too_long(mosi_.size() + len) + " (the frame of line " + std::to_string(open_line_) + ")");
     for (std::size_t i = 0; i < len; ++i) {
       mosi_.push_back(tx_.empty() ? 0x00 : tx_[i]);
       miso_.push_back(rx_.empty() ? 0x00 : rx_[i]);
@@ -274,7 +278,7 @@ class FtraceImporter {
     if (framing_ == FtraceFraming::transfer) close(p.time);
   }
 
-  std::string_view text_;
+  ImportSource& source_;
   const std::string& name_;
   const ImportOptions& options_;
   Trace trace_;
@@ -291,8 +295,8 @@ class FtraceImporter {
 
 }  // namespace
 
-Trace import_ftrace(std::string_view text, const std::string& name, const ImportOptions& options) {
-  return FtraceImporter(text, name, options).run();
+Trace detail::import_ftrace(ImportSource& source, const ImportOptions& options) {
+  return FtraceImporter(source, options).run();
 }
 
 }  // namespace l6470emu

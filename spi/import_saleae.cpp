@@ -1,10 +1,12 @@
 // Saleae Logic SPI analyzer exports: Logic 2's data table (name,type,start_time,duration,
 // "mosi","miso" with enable/result/disable rows; older 2.x without duration) and Logic 1.x
-// (Time [s],Packet ID,MOSI,MISO). One pass, no allocation per row.
+// (Time [s],Packet ID,MOSI,MISO). Read a line at a time (a file is streamed, never held whole),
+// one pass and a look for enable rows, no allocation per row.
 #include <algorithm>
 #include <cctype>
 #include <vector>
 
+#include "spi/import_source.hpp"
 #include "spi/import_support.hpp"
 #include "spi/trace_import.hpp"
 
@@ -12,7 +14,7 @@ namespace l6470emu {
 namespace {
 
 using detail::FrameBuilder;
-using detail::LineCursor;
+using detail::ImportSource;
 using detail::printable;
 using detail::quote;
 
@@ -95,14 +97,13 @@ bool parse_value(std::string_view s, std::uint8_t& out) {
 
 class SaleaeImporter {
  public:
-  SaleaeImporter(std::string_view text, const std::string& name, const ImportOptions& options)
-      : text_(text), name_(name), options_(options), frames_(trace_, name_) {}
+  SaleaeImporter(ImportSource& source, const ImportOptions& options)
+      : source_(source), name_(source.name()), options_(options), frames_(trace_, name_, options.max_frames) {}
 
   Trace run() {
     trace_.header.name = name_;
     trace_.header.format = "saleae";
-    if (text_.substr(0, 3) == "\xEF\xBB\xBF") text_.remove_prefix(3);  // UTF-8 byte order mark
-    LineCursor lines(text_);
+    ImportSource& lines = source_;  // a UTF-8 byte order mark is dropped by the source
     std::string_view line;
     // Header: the first non-empty line.
     while (lines.next(line) && line.empty()) {
@@ -137,21 +138,21 @@ class SaleaeImporter {
   }
 
  private:
-  [[noreturn]] void fail(const LineCursor& lines, const std::string& message) {
+  [[noreturn]] void fail(const ImportSource& lines, const std::string& message) {
     std::string m = message;
     if (lines.unterminated()) m += " (the last line has no newline: truncated file?)";
     throw TraceError(name_, lines.number(), m);
   }
 
   /// Splits a data row and checks its width.
-  void row(const LineCursor& lines, std::string_view line) {
+  void row(const ImportSource& lines, std::string_view line) {
     if (!split_csv(line, fields_)) fail(lines, "unterminated quote in the row " + printable(line));
     if (fields_.size() != columns_)
       fail(lines, std::to_string(fields_.size()) + " fields, the header has " + std::to_string(columns_) + " (" +
                       printable(header_line_) + ")");
   }
 
-  SourceTime time_field(const LineCursor& lines, int col, const char* what) {
+  SourceTime time_field(const ImportSource& lines, int col, const char* what) {
     SourceTime t;
     const std::string_view text = fields_[static_cast<std::size_t>(col)];
     switch (parse_source_time_checked(text, 0, t)) {
@@ -163,7 +164,7 @@ class SaleaeImporter {
   }
 
   /// The duration column: a time in seconds, not negative, at most 10^6 s (no CS frame or byte is longer).
-  SourceTime duration_field(const LineCursor& lines) {
+  SourceTime duration_field(const ImportSource& lines) {
     const SourceTime d = time_field(lines, col_duration_, "duration");
     const std::string_view text = fields_[static_cast<std::size_t>(col_duration_)];
     if (d < SourceTime{}) fail(lines, "duration " + quote(text) + " is negative");
@@ -172,7 +173,9 @@ class SaleaeImporter {
   }
 
   /// Appends the MOSI/MISO bytes of the current row to the frame being built.
-  void take_bytes(const LineCursor& lines) {
+  void take_bytes(const ImportSource& lines, std::uint64_t frame_line) {
+    if (mosi_.size() >= kMaxTraceFrameBytes)
+      fail(lines, frame_too_long(mosi_.size() + 1) + " (the frame of line " + std::to_string(frame_line) + ")");
     std::uint8_t b = 0;
     const std::string_view mosi = fields_[static_cast<std::size_t>(col_mosi_)];
     if (!parse_value(mosi, b))
@@ -213,7 +216,7 @@ class SaleaeImporter {
     throw TraceError(name_, 0, "no SPI frames in the file");
   }
 
-  bool selected(const LineCursor& lines) {
+  bool selected(const ImportSource& lines) {
     if (col_name_ < 0) return true;
     const std::string_view n = fields_[static_cast<std::size_t>(col_name_)];
     if (!options_.select.empty()) {
@@ -232,18 +235,22 @@ class SaleaeImporter {
     return true;
   }
 
-  void run_logic2(LineCursor& lines) {
+  void run_logic2(ImportSource& lines) {
     // Does the export have CS (enable/disable rows) at all? Without an Enable channel
     // every byte is taken as its own frame.
-    const bool has_enable = text_.find("\"enable\"") != std::string_view::npos ||
-                            text_.find(",enable,") != std::string_view::npos;
+    // (A look through the whole file, then back to the header, which is read again.)
+    const std::string_view enable_rows[] = {"\"enable\"", ",enable,"};
+    const std::vector<bool> found = lines.contains(enable_rows);
+    const bool has_enable = found[0] || found[1];
+    std::string_view line;
+    while (lines.next(line) && line.empty()) {
+    }
     if (!has_enable)
       trace_.header.notes.push_back(
           "no enable/disable rows (the analyzer had no Enable channel): each byte is taken as its own CS frame");
     bool open = false, seen_enable = false;
     std::uint64_t open_line = 0, skipped = 0, errors = 0;
     SourceTime start;
-    std::string_view line;
     while (lines.next(line)) {
       if (line.empty()) continue;
       row(lines, line);
@@ -254,7 +261,7 @@ class SaleaeImporter {
       if (col_duration_ >= 0) duration = duration_field(lines);
       if (type == "result") {
         if (!has_enable) {
-          take_bytes(lines);
+          take_bytes(lines, lines.number());
           SourceTime end = t;
           end.picoseconds += duration.picoseconds;
           end.seconds += duration.seconds + end.picoseconds / 1'000'000'000'000;
@@ -271,7 +278,7 @@ class SaleaeImporter {
         }
         if (t < start) fail(lines, "time " + FrameBuilder::seconds(t) + " s goes backwards (the frame began at " +
                                        FrameBuilder::seconds(start) + " s)");
-        take_bytes(lines);
+        take_bytes(lines, open_line);
       } else if (type == "enable") {
         if (open) fail(lines, "enable row while the frame opened on line " + std::to_string(open_line) + " is still open");
         open = true;
@@ -308,7 +315,7 @@ class SaleaeImporter {
     if (trace_.frame_count() == 0) no_frames();
   }
 
-  void run_logic1(LineCursor& lines) {
+  void run_logic1(ImportSource& lines) {
     bool open = false;
     std::string packet;
     SourceTime start, last;
@@ -330,7 +337,7 @@ class SaleaeImporter {
         packet = std::string(id);
         open_line = lines.number();
       }
-      take_bytes(lines);
+      take_bytes(lines, open_line);
       last = t;
     }
     if (open) emit(start, last, open_line);
@@ -339,7 +346,7 @@ class SaleaeImporter {
     if (trace_.frame_count() == 0) no_frames();
   }
 
-  std::string_view text_;
+  ImportSource& source_;
   const std::string& name_;
   const ImportOptions& options_;
   Trace trace_;
@@ -357,8 +364,8 @@ class SaleaeImporter {
 
 }  // namespace
 
-Trace import_saleae_csv(std::string_view text, const std::string& name, const ImportOptions& options) {
-  return SaleaeImporter(text, name, options).run();
+Trace detail::import_saleae(ImportSource& source, const ImportOptions& options) {
+  return SaleaeImporter(source, options).run();
 }
 
 }  // namespace l6470emu

@@ -99,12 +99,23 @@ inline std::string quote(std::string_view s) { return '"' + printable(s) + '"'; 
 
 /// Appends frames to a Trace in capture order: times become ticks counted from the first
 /// frame's start (rounded to nearest); going backwards or overlapping frames is an error.
+/// At most `max_frames` frames (0: no limit) and kMaxTraceFrameBytes bytes a frame are taken.
 class FrameBuilder {
  public:
-  FrameBuilder(Trace& trace, const std::string& name) : trace_(trace), name_(name) {}
+  FrameBuilder(Trace& trace, const std::string& name, std::uint64_t max_frames = kDefaultMaxTraceFrames)
+      : trace_(trace), name_(name), max_frames_(max_frames) {}
+
+  /// Throws the TraceError for a trace with more than max_frames frames, at `line`.
+  static void check_frame_count(const Trace& trace, const std::string& name, std::uint64_t max_frames,
+                                std::uint64_t line) {
+    if (max_frames != 0 && trace.frame_count() >= max_frames)
+      throw TraceError(name, line, "the trace holds " + too_many_frames(max_frames));
+  }
 
   void frame(const SourceTime& start, const SourceTime& end, std::span<const std::uint8_t> mosi,
              std::span<const std::uint8_t> miso, std::span<const std::uint8_t> known, std::uint64_t line) {
+    check_frame_count(trace_, name_, max_frames_, line);
+    if (mosi.size() > kMaxTraceFrameBytes) throw TraceError(name_, line, frame_too_long(mosi.size()));
     if (!started_) {
       origin_ = start;
       started_ = true;
@@ -153,6 +164,7 @@ class FrameBuilder {
  private:
   Trace& trace_;
   const std::string& name_;
+  std::uint64_t max_frames_;
   bool started_ = false;
   SourceTime origin_, last_start_, last_end_;
 };

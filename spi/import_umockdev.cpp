@@ -1,8 +1,10 @@
 // umockdev SPI .ioctl recordings (umockdev-spi.vala): "@DEV /dev/spidevB.C (SPI)", then
 // transfers "T" (CS asserted anew) or "C" (CS kept asserted) with "W hex" / "R hex" parts.
-// The format has no times; frames are given the duration of their bytes on the bus.
+// The format has no times; frames are given the duration of their bytes on the bus. Read a line
+// at a time (a file is streamed, never held whole).
 #include <vector>
 
+#include "spi/import_source.hpp"
 #include "spi/import_support.hpp"
 #include "spi/message.hpp"
 #include "spi/trace_import.hpp"
@@ -10,18 +12,19 @@
 namespace l6470emu {
 namespace {
 
-using detail::LineCursor;
+using detail::FrameBuilder;
+using detail::ImportSource;
 using detail::quote;
 
 class UmockdevImporter {
  public:
-  UmockdevImporter(std::string_view text, const std::string& name, const ImportOptions& options)
-      : text_(text), name_(name), options_(options) {}
+  UmockdevImporter(ImportSource& source, const ImportOptions& options)
+      : source_(source), name_(source.name()), options_(options) {}
 
   Trace run() {
     trace_.header.name = name_;
     trace_.header.format = "umockdev";
-    LineCursor lines(text_);
+    ImportSource& lines = source_;
     std::string_view line;
     bool saw_dev = false;
     while (lines.next(line)) {
@@ -38,7 +41,7 @@ class UmockdevImporter {
       if (start == 'T' || start == 'C') {
         if (start == 'C' && !in_chunk_) fail(lines, "\"C\" (CS kept asserted) without a transfer before it");
         close_chunk(lines);
-        if (start == 'T') close_frame();
+        if (start == 'T') close_frame(lines.number());
         in_chunk_ = true;
         if (frame_line_ == 0) frame_line_ = lines.number();
       } else if (start != ' ') {
@@ -56,6 +59,9 @@ class UmockdevImporter {
       std::string_view hex = line.substr(3);
       while (!hex.empty() && (hex.back() == ' ' || hex.back() == '\t')) hex.remove_suffix(1);
       if (hex.size() % 2 != 0) fail(lines, "odd number of hex digits in " + quote(hex));
+      if (mosi_.size() + dst->size() + hex.size() / 2 > kMaxTraceFrameBytes)
+        fail(lines, frame_too_long(mosi_.size() + dst->size() + hex.size() / 2) + " (the frame of line " +
+                        std::to_string(frame_line_) + ")");
       for (std::size_t i = 0; i < hex.size(); i += 2) {
         const int hi = hex_digit_value(hex[i]), lo = hex_digit_value(hex[i + 1]);
         if (hi < 0 || lo < 0)
@@ -67,7 +73,7 @@ class UmockdevImporter {
                         " (read and write of one transfer must have the same length)");
     }
     close_chunk(lines);
-    close_frame();
+    close_frame(lines.number());
     if (!saw_dev) trace_.header.notes.push_back("no @DEV line (not checked as an SPI recording)");
     const std::uint32_t hz = options_.umockdev_speed_hz;
     const std::string speed = hz % 1'000'000 == 0 ? std::to_string(hz / 1'000'000) + " MHz"
@@ -82,13 +88,13 @@ class UmockdevImporter {
   }
 
  private:
-  [[noreturn]] void fail(const LineCursor& lines, const std::string& message) {
+  [[noreturn]] void fail(const ImportSource& lines, const std::string& message) {
     std::string m = message;
     if (lines.unterminated()) m += " (the last line has no newline: truncated file?)";
     throw TraceError(name_, lines.number(), m);
   }
 
-  void close_chunk(const LineCursor& lines) {
+  void close_chunk(const ImportSource& lines) {
     if (!in_chunk_) return;
     if (!has_w_ && !has_r_) fail(lines, "transfer without W or R bytes");
     const std::size_t n = has_w_ ? chunk_w_.size() : chunk_r_.size();
@@ -104,8 +110,10 @@ class UmockdevImporter {
     in_chunk_ = false;
   }
 
-  void close_frame() {
+  /// Ends the frame under way; `line` is where the next one begins (for the frame bound).
+  void close_frame(std::uint64_t line) {
     if (frame_line_ == 0) return;
+    FrameBuilder::check_frame_count(trace_, name_, options_.max_frames, frame_line_ != 0 ? frame_line_ : line);
     bool any_known = false, all_known = true;
     for (auto k : known_) {
       any_known = any_known || k;
@@ -128,7 +136,7 @@ class UmockdevImporter {
     frame_line_ = 0;
   }
 
-  std::string_view text_;
+  ImportSource& source_;
   const std::string& name_;
   const ImportOptions& options_;
   Trace trace_;
@@ -140,8 +148,8 @@ class UmockdevImporter {
 
 }  // namespace
 
-Trace import_umockdev_ioctl(std::string_view text, const std::string& name, const ImportOptions& options) {
-  return UmockdevImporter(text, name, options).run();
+Trace detail::import_umockdev(ImportSource& source, const ImportOptions& options) {
+  return UmockdevImporter(source, options).run();
 }
 
 }  // namespace l6470emu

@@ -219,6 +219,21 @@ bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out) {
   return true;
 }
 
+std::string too_many_frames(std::uint64_t max_frames) {
+  return "more than " + std::to_string(max_frames) +
+         " frames, the limit (raise it with --max-frames N, or max_frames=N in Python; 0 = no limit)";
+}
+
+std::string frame_too_long(std::uint64_t bytes) {
+  return "a frame of " + std::to_string(bytes) + " bytes or more: a trace frame holds at most " +
+         std::to_string(kMaxTraceFrameBytes) + " bytes";
+}
+
+std::string line_too_long() {
+  return "a line longer than " + std::to_string(kMaxTraceLineBytes) + " bytes (a frame holds at most " +
+         std::to_string(kMaxTraceFrameBytes) + " bytes: not a trace, or a damaged one)";
+}
+
 std::string format_seconds(Tick t) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%llu.%08llu", static_cast<unsigned long long>(t / kTicksPerSecond),

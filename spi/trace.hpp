@@ -16,6 +16,27 @@
 
 namespace l6470emu {
 
+// ---- bounds on the work and memory a trace may ask for --------------------------
+
+/// The most bytes one CS frame may hold (1 MiB, 4096 times the longest chain): every reader
+/// refuses a longer frame with one line naming where it is, and the native writer refuses to
+/// write one, so that a file (or a gzip bomb) cannot make a reader hold more.
+inline constexpr std::size_t kMaxTraceFrameBytes = std::size_t{1} << 20;
+/// The longest line a line-based reader takes (8 MiB: a frame of kMaxTraceFrameBytes written
+/// as native text, MOSI and MISO, with room to spare).
+inline constexpr std::size_t kMaxTraceLineBytes = 8 * kMaxTraceFrameBytes;
+/// The most frames a trace may hand out unless the caller allows more (`--max-frames`,
+/// `max_frames=`): a few seconds of replay. A `repeat` line asking for more is refused at once.
+inline constexpr std::uint64_t kDefaultMaxTraceFrames = 10'000'000;
+
+/// The message for a trace that asks for more than `max_frames` frames: says how to raise the
+/// limit ("more than 10000000 frames, the limit (raise it ...)").
+std::string too_many_frames(std::uint64_t max_frames);
+/// The message for a frame of more than kMaxTraceFrameBytes bytes (`bytes` so far).
+std::string frame_too_long(std::uint64_t bytes);
+/// The message for a line of more than kMaxTraceLineBytes bytes.
+std::string line_too_long();
+
 /// What a trace event is.
 enum class TraceEventKind : std::uint8_t {
   frame,  ///< one CS frame: CS falls, bytes are exchanged, CS rises

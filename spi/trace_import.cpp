@@ -1,6 +1,7 @@
 // Format names, recognising a format from the start of a file, and the dispatcher.
 #include "spi/trace_import.hpp"
 
+#include "spi/import_source.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu {
@@ -60,19 +61,71 @@ TraceFormat detect_trace_format(std::string_view head, std::string_view file_nam
   return TraceFormat::unknown;
 }
 
-Trace import_trace(std::string_view text, const std::string& name, TraceFormat format, const ImportOptions& options) {
+namespace {
+
+Trace import_from(detail::ImportSource& source, TraceFormat format, const ImportOptions& options) {
   switch (format) {
-    case TraceFormat::native: return read_native_trace(text, name);
-    case TraceFormat::saleae: return import_saleae_csv(text, name, options);
-    case TraceFormat::umockdev: return import_umockdev_ioctl(text, name, options);
-    case TraceFormat::ftrace: return import_ftrace(text, name, options);
-    case TraceFormat::sigrok: return import_sigrok_json(text, name, options);
+    case TraceFormat::saleae: return detail::import_saleae(source, options);
+    case TraceFormat::umockdev: return detail::import_umockdev(source, options);
+    case TraceFormat::ftrace: return detail::import_ftrace(source, options);
+    case TraceFormat::sigrok: return detail::import_sigrok(source, options);
     case TraceFormat::vcd:
-      throw TraceError(name, 0, "a logic capture (VCD or .sr) must be decoded by sigrok-cli first");
+      throw TraceError(source.name(), 0, "a logic capture (VCD or .sr) must be decoded by sigrok-cli first");
+    case TraceFormat::native:
     case TraceFormat::unknown: break;
   }
-  throw TraceError(name, 0,
+  throw TraceError(source.name(), 0,
                    "unknown trace format (native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON trace or VCD)");
+}
+
+Trace read_all(NativeTraceReader& reader) {
+  Trace t;
+  t.header = reader.header();
+  TraceEvent e;
+  while (reader.next(e)) t.write(e);
+  return t;
+}
+
+}  // namespace
+
+Trace import_saleae_csv(std::string_view text, const std::string& name, const ImportOptions& options) {
+  detail::ImportSource source(text, name);
+  return detail::import_saleae(source, options);
+}
+
+Trace import_umockdev_ioctl(std::string_view text, const std::string& name, const ImportOptions& options) {
+  detail::ImportSource source(text, name);
+  return detail::import_umockdev(source, options);
+}
+
+Trace import_ftrace(std::string_view text, const std::string& name, const ImportOptions& options) {
+  detail::ImportSource source(text, name);
+  return detail::import_ftrace(source, options);
+}
+
+Trace import_sigrok_json(std::string_view text, const std::string& name, const ImportOptions& options) {
+  detail::ImportSource source(text, name);
+  return detail::import_sigrok(source, options);
+}
+
+Trace import_trace(std::string_view text, const std::string& name, TraceFormat format, const ImportOptions& options) {
+  if (format == TraceFormat::native) return read_native_trace(text, name, options.max_frames);
+  detail::ImportSource source(text, name);
+  return import_from(source, format, options);
+}
+
+Trace import_trace_file(const std::string& path, TraceFormat format, const ImportOptions& options) {
+  if (format == TraceFormat::native) {
+    NativeTraceReader reader(path, options.max_frames);
+    return read_all(reader);
+  }
+  if (format == TraceFormat::vcd || format == TraceFormat::unknown) {
+    detail::ImportSource none(std::string_view{}, path);
+    return import_from(none, format, options);
+  }
+  detail::ImportSource source(path);
+  source.on_progress(options.progress);
+  return import_from(source, format, options);
 }
 
 }  // namespace l6470emu

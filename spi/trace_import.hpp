@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -46,6 +47,13 @@ struct ImportOptions {
   FtraceFraming ftrace_framing = FtraceFraming::automatic;
   /// umockdev recordings carry no times: frames are spaced as at this SCK, 1 µs CS high.
   std::uint32_t umockdev_speed_hz = 5'000'000;
+  /// The most frames the trace may hold (0: no limit): a capture with more is refused at the
+  /// frame that passes the limit (an imported trace is held in memory: about 70 bytes a frame
+  /// plus 3 a byte). Native traces: the same bound on the frames `repeat` lines stand for.
+  std::uint64_t max_frames = kDefaultMaxTraceFrames;
+  /// Told how far reading a file has come (import_trace_file), a few times a second at most
+  /// (empty: nobody asks).
+  std::function<void(const ReadProgress&)> progress;
 };
 
 /// Saleae Logic 2 SPI analyzer CSV export (also the older header without duration,
@@ -64,5 +72,11 @@ Trace import_sigrok_json(std::string_view text, const std::string& name, const I
 /// Any text format above (or native), by `format`; TraceError for unknown/vcd.
 Trace import_trace(std::string_view text, const std::string& name, TraceFormat format,
                    const ImportOptions& options = {});
+
+/// The file at `path` (plain or gzip-compressed) in `format`, read a piece at a time: memory
+/// holds the trace, never the file's text (a line is at most kMaxTraceLineBytes, a frame at most
+/// kMaxTraceFrameBytes, the trace at most options.max_frames frames). TraceError for unknown/vcd,
+/// a file that cannot be read and malformed input, naming the file and line.
+Trace import_trace_file(const std::string& path, TraceFormat format, const ImportOptions& options = {});
 
 }  // namespace l6470emu

@@ -50,6 +50,22 @@ std::string bad_time(std::string_view tok) {
   return "bad timestamp " + quoted(tok) + " (seconds from 0, e.g. 0.00100300)";
 }
 
+/// A duration or period in µs as the writer prints it (any decimal parse_source_time takes), in
+/// ticks rounded to nearest; false when malformed, negative or beyond kMaxNativeTraceTick.
+bool parse_native_us(std::string_view text, Tick& out) {
+  SourceTime t;
+  if (!parse_source_time(text, -6, t) || t.seconds < 0 ||
+      static_cast<std::uint64_t>(t.seconds) > kMaxNativeTraceSeconds)
+    return false;
+  const Tick ticks = static_cast<Tick>(t.seconds) * kTicksPerSecond + static_cast<Tick>((t.picoseconds + 125'000) / 250'000);
+  if (ticks > kMaxNativeTraceTick) return false;
+  out = ticks;
+  return true;
+}
+
+/// "10^12 s" for messages.
+std::string max_time_words() { return "10^" + std::to_string(std::to_string(kMaxNativeTraceSeconds).size() - 1) + " s"; }
+
 bool parse_uint(std::string_view s, unsigned long max, unsigned long& out) {
   if (s.empty() || s.size() > 10) return false;
   unsigned long v = 0;
@@ -66,7 +82,7 @@ bool parse_uint(std::string_view s, unsigned long max, unsigned long& out) {
 
 // ---------------------------------------------------------------- reader
 
-NativeTraceReader::NativeTraceReader(const std::string& path) {
+NativeTraceReader::NativeTraceReader(const std::string& path, std::uint64_t max_frames) : max_frames_(max_frames) {
   header_.name = path;
   header_.format = "native";
   file_ = std::make_unique<TraceFileReader>(path);
@@ -77,7 +93,8 @@ NativeTraceReader::NativeTraceReader(const std::string& path) {
   read_header();  // a throw here closes the file (file_ is a member already constructed)
 }
 
-NativeTraceReader::NativeTraceReader(std::string_view text, std::string name) : text_(text) {
+NativeTraceReader::NativeTraceReader(std::string_view text, std::string name, std::uint64_t max_frames)
+    : text_(text), max_frames_(max_frames) {
   header_.name = std::move(name);
   header_.format = "native";
   eof_ = true;
@@ -107,6 +124,10 @@ bool NativeTraceReader::next_line(std::string_view& line) {
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       return true;
     }
+    if (text_.size() > kMaxTraceLineBytes) {  // a line that never ends (a binary file, a gzip bomb)
+      ++line_no_;
+      fail(line_too_long());
+    }
     if (eof_) {
       if (text_.empty()) return false;
       line = text_;
@@ -119,7 +140,7 @@ bool NativeTraceReader::next_line(std::string_view& line) {
     // File mode: move the partial line to the front and read more.
     const std::size_t keep = text_.size();
     if (keep > 0 && text_.data() != buffer_.data()) std::memmove(buffer_.data(), text_.data(), keep);
-    if (keep == buffer_.size()) buffer_.resize(buffer_.size() * 2);
+    if (keep == buffer_.size()) buffer_.resize(std::min(buffer_.size() * 2, kMaxTraceLineBytes + 2));
     std::size_t got = 0;
     try {
       got = file_->read(buffer_.data() + keep, buffer_.size() - keep);
@@ -235,12 +256,11 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
     fail("repeat: count " + quoted(count_tok) + " is not a number of repetitions from 1 to 10^12" + form);
   if (times_tok != "times" && times_tok != "time") fail("repeat: " + quoted(times_tok) + " where 'times' belongs" + form);
   if (every_tok != "every") fail("repeat: " + quoted(every_tok) + " where 'every' belongs" + form);
-  SourceTime p;
   Tick period = 0;
   if (period_tok.size() <= 2 || period_tok.substr(period_tok.size() - 2) != "us" ||
-      !parse_source_time(period_tok.substr(0, period_tok.size() - 2), -6, p) || p.seconds < 0 ||
-      !ticks_between({}, p, period))
-    fail("repeat: period " + quoted(period_tok) + " is not a number of microseconds (e.g. 1000.00us)" + form);
+      !parse_native_us(period_tok.substr(0, period_tok.size() - 2), period))
+    fail("repeat: period " + quoted(period_tok) + " is not a number of microseconds up to " + max_time_words() +
+         " (e.g. 1000.00us)" + form);
   if (!next_token(rest).empty()) fail("too many fields in the repeat line" + form);
   if (kept_count_ < group)
     fail("repeat: there " + std::string(kept_count_ == 1 ? "is " : "are ") + std::to_string(kept_count_) +
@@ -254,12 +274,18 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
          " frames it repeats (" + format_microseconds(last.tick + last.duration - first.tick) + " us from the first CS "
          "falling edge to the last CS rising edge): repetitions would overlap");
   // The time written is the last repeated frame's: the group's last frame, count periods on.
-  const Tick limit = 1'000'000'000'000ull * kTicksPerSecond;
+  const Tick limit = kMaxNativeTraceTick - last.duration;  // the last repetition's CS rising edge fits too
   if (period > limit / count || last.tick > limit - period * count || last.tick + period * count != tick)
     fail("repeat: the line's time " + as_written(time_tok, tick) + " s is not when the last repetition's last frame starts (" +
          (period <= limit / count && last.tick <= limit - period * count ? format_seconds(last.tick + period * count) + " s"
-                                                                         : std::string("beyond 10^12 s")) +
+                                                                         : "beyond " + max_time_words()) +
          ": its last frame at " + format_seconds(last.tick) + " s plus " + std::to_string(count) + " periods)");
+  // The work it asks for, refused before any of it is done (10^12 frames from 160 bytes).
+  if (max_frames_ != 0 && (count > (max_frames_ - std::min(frames_, max_frames_)) / group))
+    fail("repeat: " + std::to_string(count) + " repetitions of " + std::to_string(group) +
+         (group == 1 ? " frame" : " frames") + " make the trace " + std::to_string(frames_ + group * count) +
+         " frames long: " + too_many_frames(max_frames_));
+  frames_ += group * count;
   group_ = group;
   group_index_ = 0;
   repeat_count_ = count;
@@ -287,7 +313,8 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     std::size_t i = 0;
     for (; i < time_tok.size() && time_tok[i] >= '0' && time_tok[i] <= '9'; ++i) {
       whole = whole * 10 + static_cast<std::uint64_t>(time_tok[i] - '0');
-      if (whole > 1'000'000'000'000ull) fail("timestamp " + quoted(time_tok) + " is too large (at most 10^12 s)");
+      if (whole > kMaxNativeTraceSeconds)
+        fail("timestamp " + quoted(time_tok) + " is too large (at most " + max_time_words() + ")");
     }
     std::uint64_t frac_ticks = 0;
     if (i < time_tok.size() && time_tok[i] == '.') {
@@ -312,6 +339,8 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     }
     if (i != time_tok.size()) fail(bad_time(time_tok));
     tick = whole * kTicksPerSecond + frac_ticks;
+    if (tick > kMaxNativeTraceTick)
+      fail("timestamp " + quoted(time_tok) + " is too large (at most " + max_time_words() + ")");
   }
   if (any_event_ && tick < last_tick_)
     fail("time " + as_written(time_tok, tick) + " s goes backwards (the previous event was at " + format_seconds(last_tick_) +
@@ -349,7 +378,8 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
         if (!parse_source_time(tok.substr(0, tok.size() - 2), -6, d) || d.seconds < 0)
           fail("frame duration " + quoted(tok) + " is not a number of microseconds");
         Tick ticks = 0;
-        if (!ticks_between({}, d, ticks)) fail("frame duration " + quoted(tok) + " is too long");
+        if (!parse_native_us(tok.substr(0, tok.size() - 2), ticks))
+          fail("frame duration " + quoted(tok) + " is too long (at most " + max_time_words() + ")");
         if (e.duration != 0) fail("a second frame duration " + quoted(tok));
         e.duration = ticks;
         continue;
@@ -376,12 +406,18 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
       fail(std::string(in_miso ? "MISO " : "MOSI ") + quoted(tok) + " is not a byte (two hex digits" +
            (in_miso ? ", or ?? for unknown)" : ")"));
     }
+    if (mosi_.size() > kMaxTraceFrameBytes) fail(frame_too_long(mosi_.size()));
+    if (max_frames_ != 0 && frames_ >= max_frames_) fail("the trace holds " + too_many_frames(max_frames_));
+    ++frames_;
     if (in_miso && miso_.size() != mosi_.size())
       fail("frame has " + std::to_string(mosi_.size()) + " MOSI bytes but " + std::to_string(miso_.size()) +
            " MISO bytes");
     e.mosi = mosi_;
     if (in_miso) e.miso = miso_;
     if (any_unknown) e.miso_known = known_;
+    if (e.duration > kMaxNativeTraceTick - tick)
+      fail("frame at " + as_written(time_tok, tick) + " s ends after " + max_time_words() +
+           " (the latest time a native trace holds)");
     last_frame_end_ = e.end();
     keep_frame(e);
   } else if (kind == "pin" || kind == "fault") {
@@ -563,6 +599,15 @@ void NativeTraceWriter::write_line(const TraceEvent& e) {
 
 void NativeTraceWriter::write(const TraceEvent& e) {
   if (finished_) throw std::logic_error("NativeTraceWriter::write after finish()");
+  // What the reader would refuse is not written (a virtual host that slept past 10^12 s, a
+  // frame longer than a reader takes).
+  if (e.kind == TraceEventKind::frame && e.mosi.size() > kMaxTraceFrameBytes)
+    throw std::runtime_error((file_ ? file_->path() : out_name_) + ": the frame at " + format_seconds(e.tick) +
+                             " s cannot be written: " + frame_too_long(e.mosi.size()));
+  if (e.tick > kMaxNativeTraceTick || e.duration > kMaxNativeTraceTick - e.tick)
+    throw std::runtime_error((file_ ? file_->path() : out_name_) + ": an event at " + format_seconds(e.tick) + " s" +
+                             (e.kind == TraceEventKind::frame ? " lasting " + format_microseconds(e.duration) + " us" : "") +
+                             " is beyond " + max_time_words() + ", the latest time a native trace holds");
   if (!header_written_) write_header({});
   if (e.kind == TraceEventKind::frame && options_.compact) {
     frame(e);
@@ -587,7 +632,8 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     const Held& model = run_[partial_.size()];
     Held h;
     h.assign(e);
-    if (e.tick == model.tick + run_period_ && h.same_bytes(model)) {
+    // A repeat line stands for at most kMaxRepeatCount repetitions: a longer run starts anew.
+    if (e.tick == model.tick + run_period_ && h.same_bytes(model) && line_count_ < kMaxRepeatCount) {
       if (rewritable()) write_line(e);  // a killed process leaves it; rewritten into the count below
       partial_.push_back(std::move(h));
       if (partial_.size() < run_group_) return;
@@ -721,8 +767,8 @@ std::string to_native_text(const Trace& trace, bool compact) {
   return out.str();
 }
 
-Trace read_native_trace(std::string_view text, const std::string& name) {
-  NativeTraceReader reader(text, name);
+Trace read_native_trace(std::string_view text, const std::string& name, std::uint64_t max_frames) {
+  NativeTraceReader reader(text, name, max_frames);
   Trace t;
   t.header = reader.header();
   TraceEvent e;

@@ -26,20 +26,31 @@ inline constexpr std::string_view kNativeTraceNumbering =
 
 /// The most frames a `repeat` line can repeat as one group.
 inline constexpr std::size_t kMaxRepeatGroup = 16;
-/// The most repetitions one `repeat` line can stand for.
+/// The most repetitions one `repeat` line can stand for (the writer starts a new line beyond).
 inline constexpr std::uint64_t kMaxRepeatCount = 1'000'000'000'000ull;
+/// The latest time a native trace holds, in seconds: every event's time, a frame's CS rising
+/// edge, a frame's duration and a `repeat` period are at most this. The writer refuses an event
+/// beyond it (std::runtime_error) rather than write what its reader would refuse.
+inline constexpr std::uint64_t kMaxNativeTraceSeconds = 1'000'000'000'000ull;
+/// kMaxNativeTraceSeconds in ticks (4·10^18, well inside a Tick).
+inline constexpr Tick kMaxNativeTraceTick = kMaxNativeTraceSeconds * kTicksPerSecond;
 
 class TraceFileReader;
 class TraceFileWriter;
 
-/// Reads a native trace event by event; memory use does not grow with its length.
+/// Reads a native trace event by event; memory use does not grow with its length (a line is
+/// at most kMaxTraceLineBytes, a frame at most kMaxTraceFrameBytes).
+///
+/// The work a trace asks for is bounded too: it may hand out at most `max_frames` frames (0: no
+/// limit). A frame line past the limit, or a `repeat` line whose repetitions would pass it, is a
+/// TraceError naming that line, before any of the work is done.
 class NativeTraceReader final : public TraceReader {
  public:
   /// Opens `path` (gzip-compressed or not: recognised by its first bytes). Throws TraceError
   /// when it cannot be read or is not a version-1 native trace.
-  explicit NativeTraceReader(const std::string& path);
+  explicit NativeTraceReader(const std::string& path, std::uint64_t max_frames = kDefaultMaxTraceFrames);
   /// Reads `text` (kept by reference: it must outlive the reader), called `name` in messages.
-  NativeTraceReader(std::string_view text, std::string name);
+  NativeTraceReader(std::string_view text, std::string name, std::uint64_t max_frames = kDefaultMaxTraceFrames);
   ~NativeTraceReader() override;
   NativeTraceReader(const NativeTraceReader&) = delete;
   NativeTraceReader& operator=(const NativeTraceReader&) = delete;
@@ -84,6 +95,9 @@ class NativeTraceReader final : public TraceReader {
   std::uint64_t repeat_count_ = 0, repeat_done_ = 0;
   Tick repeat_period_ = 0;
   std::uint64_t repeat_line_ = 0;
+  // The work bound: frames handed out or promised by the `repeat` lines read so far.
+  std::uint64_t max_frames_ = kDefaultMaxTraceFrames;
+  std::uint64_t frames_ = 0;
 };
 
 /// Choices for a NativeTraceWriter.
@@ -174,7 +188,8 @@ class NativeTraceWriter final : public TraceSink {
 /// A native trace as text (header and every event; runs collapsed when `compact`).
 std::string to_native_text(const Trace& trace, bool compact = false);
 
-/// Reads a whole native trace into memory.
-Trace read_native_trace(std::string_view text, const std::string& name);
+/// Reads a whole native trace into memory (at most `max_frames` frames; 0: no limit).
+Trace read_native_trace(std::string_view text, const std::string& name,
+                        std::uint64_t max_frames = kDefaultMaxTraceFrames);
 
 }  // namespace l6470emu

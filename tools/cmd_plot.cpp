@@ -14,6 +14,9 @@
 #include <memory>
 #include <sys/stat.h>
 
+#include "daisychain/motion_series.hpp"
+#include "spi/trace.hpp"
+
 namespace l6470emu {
 namespace {
 
@@ -59,7 +62,7 @@ std::vector<std::string> plot_command(const std::vector<std::string>& args) {
 namespace {
 
 struct PlotArgs {
-  std::string trace, output, chips, from, to, chain, format, select, max_points, title, size, dpi, number_from;
+  std::string trace, output, chips, from, to, chain, format, select, max_points, max_frames, title, size, dpi, number_from;
 };
 
 [[noreturn]] void run_plot(const PlotArgs& a, const CLI::App& sub) {
@@ -68,7 +71,8 @@ struct PlotArgs {
   const std::pair<const char*, const std::string*> options[] = {
       {"--output", &a.output}, {"--chips", &a.chips},   {"--from", &a.from},   {"--to", &a.to},
       {"--chain", &a.chain},   {"--format", &a.format}, {"--select", &a.select}, {"--max-points", &a.max_points},
-      {"--title", &a.title},   {"--size", &a.size},     {"--dpi", &a.dpi},     {"--number-from", &a.number_from}};
+      {"--title", &a.title},   {"--size", &a.size},     {"--dpi", &a.dpi},     {"--number-from", &a.number_from},
+      {"--max-frames", &a.max_frames}};
   for (const auto& [name, value] : options)
     if (sub.count(name) > 0) args.push_back(std::string(name) + "=" + *value);
 
@@ -109,7 +113,11 @@ void add_plot_command(CLI::App& app) {
   p->add_option("--chain", a->chain, "the emulated chain (3, 2*L6470,L6480); default: the trace's own");
   p->add_option("--format", a->format, "input format: native, saleae, umockdev, ftrace, sigrok, vcd (default: recognised)");
   p->add_option("--select", a->select, "the stream to take when the file has several");
-  p->add_option("--max-points", a->max_points, "most samples per chip (default 4000)");
+  p->add_option("--max-points", a->max_points,
+                "most samples per chip (default 4000, at most " + std::to_string(kMaxMotionPoints) + ")");
+  p->add_option("--max-frames", a->max_frames,
+                "the most frames the trace may hold, 'repeat' lines counted as the frames they stand for (default " +
+                    std::to_string(kDefaultMaxTraceFrames) + "; 0 = no limit)");
   p->add_option("--title", a->title, "the picture's title (default: the file and the chain)");
   p->add_option("--size", a->size, "width x height in inches (default 10x7.5)");
   p->add_option("--dpi", a->dpi, "PNG resolution (default 100)");

@@ -26,6 +26,11 @@ std::string amount(std::uint64_t n, std::string_view unit) {
 
 std::string format_progress(std::string_view label, std::uint64_t done, std::uint64_t total, std::string_view unit,
                             std::size_t width) {
+  return format_progress(label, done, total, unit, width, 0);
+}
+
+std::string format_progress(std::string_view label, std::uint64_t done, std::uint64_t total, std::string_view unit,
+                            std::size_t width, std::uint64_t frames) {
   std::string tail;
   if (total == 0) {
     tail = " " + amount(done, unit) + (unit == "bytes" ? "" : " " + std::string(unit));
@@ -35,6 +40,13 @@ std::string format_progress(std::string_view label, std::uint64_t done, std::uin
     char pc[16];
     std::snprintf(pc, sizeof pc, " %3u%% ", percent);
     tail = pc + amount(done, unit) + " of " + amount(total, unit) + (unit == "bytes" ? "" : " " + std::string(unit));
+  }
+  if (frames > 0) {
+    char buf[48];
+    if (frames < 10'000) std::snprintf(buf, sizeof buf, ", %llu frames", static_cast<unsigned long long>(frames));
+    else if (frames < 10'000'000) std::snprintf(buf, sizeof buf, ", %.1f k frames", static_cast<double>(frames) / 1e3);
+    else std::snprintf(buf, sizeof buf, ", %.1f M frames", static_cast<double>(frames) / 1e6);
+    tail += buf;
   }
   // The label is cut (from the left: the end of a path says most) to leave room for a bar of 10.
   constexpr std::size_t kMinBar = 10;
@@ -60,12 +72,16 @@ ProgressBar::ProgressBar(std::ostream& err, bool enabled, std::string label)
 ProgressBar::~ProgressBar() { finish(); }
 
 void ProgressBar::update(std::uint64_t done, std::uint64_t total, std::string_view unit) {
+  update_frames(done, total, unit, 0);
+}
+
+void ProgressBar::update_frames(std::uint64_t done, std::uint64_t total, std::string_view unit, std::uint64_t frames) {
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   if (now - last_ < std::chrono::milliseconds(200)) return;
   last_ = now;
   // Clear to the end of the line after the text: a shorter line leaves nothing behind.
-  *err_ << '\r' << format_progress(label_, done, total, unit) << "\x1b[K" << std::flush;
+  *err_ << '\r' << format_progress(label_, done, total, unit, 80, frames) << "\x1b[K" << std::flush;
   drawn_ = true;
 }
 
@@ -83,9 +99,11 @@ bool ProgressTraceReader::next(TraceEvent& e) {
   if (++count_ == 4096) {
     count_ = 0;
     const ReadProgress p = in_.progress();
-    bar_.update(p.done, p.total, p.bytes ? "bytes" : "events");
+    bar_.update_frames(p.done, p.total, p.bytes ? "bytes" : "events", frames_);
   }
-  return in_.next(e);
+  if (!in_.next(e)) return false;
+  if (e.kind == TraceEventKind::frame) ++frames_;
+  return true;
 }
 
 }  // namespace l6470emu

@@ -19,6 +19,10 @@ namespace l6470emu {
 /// anything else (shown as numbers: "events"). Without a total: what was done, no bar.
 std::string format_progress(std::string_view label, std::uint64_t done, std::uint64_t total, std::string_view unit,
                             std::size_t width = 80);
+/// format_progress() with how many frames went by so far ("..., 12.3 M frames"): a trace's
+/// `repeat` line stands for many frames on a few bytes, so the bytes alone would stand still.
+std::string format_progress(std::string_view label, std::uint64_t done, std::uint64_t total, std::string_view unit,
+                            std::size_t width, std::uint64_t frames);
 
 /// Draws format_progress() lines over each other on `err` ('\r'), at most every 200 ms, and
 /// clears the line when done. Does nothing at all when not enabled.
@@ -36,6 +40,8 @@ class ProgressBar {
   bool enabled() const { return enabled_; }
   /// Redraws when 200 ms passed since the last drawing.
   void update(std::uint64_t done, std::uint64_t total, std::string_view unit = "bytes");
+  /// The same, saying how many frames went by (format_progress with frames).
+  void update_frames(std::uint64_t done, std::uint64_t total, std::string_view unit, std::uint64_t frames);
   /// Takes the bar off the screen until the next drawing (before printing other lines).
   void clear();
   /// Clears the line; later updates draw nothing.
@@ -50,7 +56,7 @@ class ProgressBar {
 };
 
 /// A TraceReader that passes events through and moves a progress bar (every few thousand
-/// events, from the reader's own progress()).
+/// events, from the reader's own progress() and the frames it counts).
 class ProgressTraceReader final : public TraceReader {
  public:
   ProgressTraceReader(TraceReader& in, ProgressBar& bar) : in_(in), bar_(bar) {}
@@ -62,6 +68,7 @@ class ProgressTraceReader final : public TraceReader {
   TraceReader& in_;
   ProgressBar& bar_;
   std::uint32_t count_ = 0;
+  std::uint64_t frames_ = 0;
 };
 
 }  // namespace l6470emu

@@ -25,6 +25,7 @@ TraceInputOptions input_options(const TraceArgs& args) {
   else if (args.framing == "message") o.import.ftrace_framing = FtraceFraming::message;
   else throw std::invalid_argument("unknown framing \"" + args.framing + "\" (auto, cs, transfer, message)");
   if (!args.sigrok_decoder.empty()) o.sigrok_decoder = args.sigrok_decoder;
+  o.import.max_frames = args.max_frames;
   return o;
 }
 
@@ -42,6 +43,13 @@ void print_notes(const TraceHeader& header, std::ostream& err) {
 
 namespace {
 
+/// A count given on the command line: decimal digits only (CLI11 would take "-1" as 2^64 - 1).
+std::string count_option(const std::string& text) {
+  if (text.empty() || text.size() > 19 || text.find_first_not_of("0123456789") != std::string::npos)
+    return "'" + text.substr(0, 40) + "' is not a count (decimal digits, at most 19; 0 = no limit)";
+  return {};
+}
+
 void add_trace_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("TRACE", a.path, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
       ->required();
@@ -57,6 +65,10 @@ void add_trace_options(CLI::App* sub, TraceArgs& a) {
       ->check(CLI::IsMember({"auto", "cs", "transfer", "message"}));
   sub->add_option("--sigrok-decoder", a.sigrok_decoder,
                   "sigrok-cli decoder for VCD/.sr captures (default spi:clk=SCK:mosi=MOSI:miso=MISO:cs=CS:cpol=1:cpha=1)");
+  sub->add_option("--max-frames", a.max_frames,
+                  "the most frames the trace may hold, 'repeat' lines counted as the frames they stand for (default " +
+                      std::to_string(kDefaultMaxTraceFrames) + "; 0 = no limit): a trace asking for more is refused at once")
+      ->check(count_option);
 }
 
 void add_number_from_option(CLI::App* sub, std::string& value) {

@@ -25,6 +25,7 @@ struct TraceArgs {
   std::string select;          ///< analyzer / device / decoder to take when the file has several
   std::string framing = "auto";  ///< ftrace: auto, cs, transfer, message
   std::string sigrok_decoder;  ///< sigrok-cli decoder spec for VCD/.sr captures (empty = the default)
+  std::uint64_t max_frames = kDefaultMaxTraceFrames;  ///< the most frames the trace may hold (0: no limit)
 };
 
 /// The reading options `args` stand for. Throws std::invalid_argument for an unknown

@@ -16,9 +16,11 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <algorithm>
 #include <map>
 #include <sstream>
+#include <new>
 #include <stdexcept>
 
 #include "daisychain/chain_spec.hpp"
@@ -57,7 +59,12 @@ static std::chrono::seconds sigrok_time_limit(const std::string& path, const Tra
   return std::chrono::seconds(std::max<std::uintmax_t>(30, size / 100'000));
 }
 
-std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOptions& options) {
+namespace {
+
+// Runs sigrok-cli's spi decoder and hands its standard output to `sink` as it comes; returns how
+// many bytes it wrote.
+std::uint64_t run_sigrok(const std::string& path, const TraceInputOptions& options,
+                         const std::function<void(const char*, std::size_t)>& sink) {
   std::vector<std::string> args = {options.sigrok_cli};
   if (!ends_with(path, ".sr")) {
     args.push_back("-I");
@@ -124,7 +131,8 @@ std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOpti
   }
 
   // Its output, until it closes stdout or the time limit passes.
-  std::string out;
+  std::uint64_t out_bytes = 0;
+  std::string sink_error;
   const auto deadline = std::chrono::steady_clock::now() + limit;
   bool timed_out = false;
   char buf[1 << 16];
@@ -139,8 +147,18 @@ std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOpti
     if (r < 0 && errno != EINTR) break;
     if (r <= 0) continue;
     const ssize_t got = read(out_pipe[0], buf, sizeof buf);
-    if (got > 0) out.append(buf, static_cast<std::size_t>(got));
-    else if (got == 0 || errno != EINTR) break;
+    if (got > 0) {
+      try {
+        sink(buf, static_cast<std::size_t>(got));
+      } catch (const std::exception& e) {
+        sink_error = e.what();
+        kill(pid, SIGKILL);
+        break;
+      }
+      out_bytes += static_cast<std::uint64_t>(got);
+    } else if (got == 0 || errno != EINTR) {
+      break;
+    }
   }
   if (timed_out) kill(pid, SIGKILL);
   int status = 0;
@@ -152,60 +170,118 @@ std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOpti
     std::getline(e, err);
   }
   cleanup();
+  if (!sink_error.empty()) throw TraceError(path, 0, "sigrok-cli's output could not be kept: " + sink_error);
   if (timed_out)
     throw TraceError(path, 0, "sigrok-cli did not finish within " + std::to_string(limit.count()) +
                                   " s and was stopped (a malformed capture, or one too long: cut it, or give "
                                   "-I vcd:compress=N to sigrok-cli yourself)");
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     throw TraceError(path, 0, "sigrok-cli failed" + (err.empty() ? std::string() : ": " + err));
-  if (out.empty()) throw TraceError(path, 0, "sigrok-cli decoded nothing (check the channel names: --sigrok-decoder)");
+  if (out_bytes == 0) throw TraceError(path, 0, "sigrok-cli decoded nothing (check the channel names: --sigrok-decoder)");
+  return out_bytes;
+}
+
+// A temporary file removed when this goes away.
+class TempFile {
+ public:
+  TempFile() {
+    char name[] = "/tmp/l6470emu-sigrok-json-XXXXXX";
+    fd_ = mkostemp(name, O_CLOEXEC);
+    if (fd_ < 0) throw std::runtime_error(std::string("mkstemp: ") + std::strerror(errno));
+    path_ = name;
+  }
+  ~TempFile() {
+    if (fd_ >= 0) close(fd_);
+    unlink(path_.c_str());
+  }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  const std::string& path() const { return path_; }
+  void write_all(const char* data, std::size_t size) {
+    while (size > 0) {
+      const ssize_t n = ::write(fd_, data, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) throw std::runtime_error(path_ + ": write failed: " + std::strerror(n < 0 ? errno : EIO));
+      data += n;
+      size -= static_cast<std::size_t>(n);
+    }
+  }
+
+ private:
+  int fd_ = -1;
+  std::string path_;
+};
+
+}  // namespace
+
+std::string run_sigrok_spi_decoder(const std::string& path, const TraceInputOptions& options) {
+  std::string out;
+  run_sigrok(path, options, [&](const char* data, std::size_t size) { out.append(data, size); });
   return out;
 }
 
 TraceFile::TraceFile(std::string path, const TraceInputOptions& options)
-    : path_(std::move(path)), format_(format_of(path_, options)) {
+    : path_(std::move(path)), format_(format_of(path_, options)), max_frames_(options.import.max_frames) {
+  try {
+    open(options);
+  } catch (const std::bad_alloc&) {
+    throw TraceError(path_, 0, out_of_memory());
+  }
+}
+
+std::string TraceFile::out_of_memory() const {
+  return "out of memory while reading it (an imported trace takes about 70 bytes a frame plus 3 a byte: a lower "
+         "--max-frames than " + std::to_string(max_frames_) + " refuses it sooner)";
+}
+
+void TraceFile::open(const TraceInputOptions& options) {
   if (format_ == TraceFormat::native) {
-    header_ = NativeTraceReader(path_).header();
+    header_ = NativeTraceReader(path_, max_frames_).header();
     return;
   }
+  // Reading a large capture takes a while: a bar on a terminal.
+  ProgressBar bar = ProgressBar::on_stderr("reading " + path_);
+  ImportOptions import = options.import;
+  import.progress = [&bar](const ReadProgress& p) { bar.update(p.done, p.total, p.bytes ? "bytes" : "events"); };
   if (format_ == TraceFormat::vcd) {
     if (TraceFileReader(path_).gzip())
       throw TraceError(path_, 0, "a gzip-compressed logic capture: sigrok-cli reads it uncompressed (gunzip it first)");
-    trace_ = import_sigrok_json(run_sigrok_spi_decoder(path_, options), path_, options.import);
+    // sigrok-cli's output goes to a file and is read from there a piece at a time (a long
+    // capture's JSON is many times its size).
+    TempFile json;
+    run_sigrok(path_, options, [&json](const char* data, std::size_t size) { json.write_all(data, size); });
+    try {
+      trace_ = import_trace_file(json.path(), TraceFormat::sigrok, import);
+    } catch (const TraceError& e) {
+      // Named after the capture: the JSON was ours.
+      throw TraceError(path_, e.line(), e.reason());
+    }
+    trace_.header.name = path_;
     trace_.header.format = "sigrok-cli on a logic capture";
   } else {
-    {
-      // Reading a large capture takes a while: a bar on a terminal (the parse that follows
-      // is faster than the disk).
-      std::string text;
-      {
-        TraceFileReader in(path_);
-        ProgressBar bar = ProgressBar::on_stderr("reading " + path_);
-        std::vector<char> buf(1 << 20);
-        while (const std::size_t got = in.read(buf.data(), buf.size())) {
-          text.append(buf.data(), got);
-          bar.update(in.disk_offset(), in.size_on_disk());
-        }
-      }
-      trace_ = import_trace(text, path_, format_, options.import);
-    }
+    trace_ = import_trace_file(path_, format_, import);
   }
+  bar.finish();
   header_ = trace_.header;
 }
 
 std::unique_ptr<TraceReader> TraceFile::read() const {
-  if (format_ == TraceFormat::native) return std::make_unique<NativeTraceReader>(path_);
+  if (format_ == TraceFormat::native) return std::make_unique<NativeTraceReader>(path_, max_frames_);
   return trace_.reader();
 }
 
 Trace TraceFile::load() const {
-  if (format_ != TraceFormat::native) return trace_;
-  Trace t;
-  NativeTraceReader r(path_);
-  t.header = r.header();
-  TraceEvent e;
-  while (r.next(e)) t.write(e);
-  return t;
+  try {
+    if (format_ != TraceFormat::native) return trace_;
+    Trace t;
+    NativeTraceReader r(path_, max_frames_);
+    t.header = r.header();
+    TraceEvent e;
+    while (r.next(e)) t.write(e);
+    return t;
+  } catch (const std::bad_alloc&) {
+    throw TraceError(path_, 0, out_of_memory());
+  }
 }
 
 std::vector<const Variant*> chain_for_trace(const std::string& spec, const TraceFile& file, std::string& how) {

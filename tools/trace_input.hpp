@@ -27,8 +27,10 @@ struct TraceInputOptions {
 };
 
 /// A trace file, opened: native traces are streamed from disk on every pass (any length),
-/// other formats are imported into memory once. Throws TraceError (cannot open, unknown
-/// format, malformed input) from the constructor and from the readers.
+/// other formats are imported into memory once (read from the file a piece at a time). Either
+/// way a trace hands out at most options.import.max_frames frames. Throws TraceError (cannot
+/// open, unknown format, malformed input, too many frames) from the constructor and from the
+/// readers.
 class TraceFile {
  public:
   TraceFile(std::string path, const TraceInputOptions& options);
@@ -43,8 +45,12 @@ class TraceFile {
   Trace load() const;
 
  private:
+  void open(const TraceInputOptions& options);
+  std::string out_of_memory() const;
+
   std::string path_;
   TraceFormat format_;
+  std::uint64_t max_frames_;
   TraceHeader header_;
   Trace trace_;  // non-native formats
 };

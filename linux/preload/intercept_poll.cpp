@@ -24,11 +24,19 @@ constexpr std::int64_t kNsPerMs = 1'000'000;
 constexpr int kEpollTable = 1 << 16;
 std::atomic<bool> g_epoll_has_lines[kEpollTable];
 
-bool valid(const timespec& ts) { return ts.tv_sec >= 0 && ts.tv_nsec >= 0 && ts.tv_nsec < 1'000'000'000; }
+// Timeouts as the kernel takes them: timespec64_valid, then saturated at KTIME_MAX (a timeout
+// that reaches it never ends).
+bool valid(const timespec& ts) { return kernel_valid(ts); }
+std::int64_t to_ns(const timespec& ts) { return saturated_ns(ts); }
 
-std::int64_t to_ns(const timespec& ts) {
-  if (ts.tv_sec >= INT64_MAX / 1'000'000'000 - 1) return INT64_MAX / 2;
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
+// select()'s timeval as glibc and the kernel take it: negative fields are EINVAL (false), and
+// microseconds of a second or more carry into the seconds; saturated at KTIME_MAX.
+bool select_timeout_ns(const timeval& tv, std::int64_t& ns) {
+  if (tv.tv_sec < 0 || tv.tv_usec < 0) return false;
+  const std::int64_t carry = tv.tv_usec / 1'000'000;
+  const std::int64_t sec = tv.tv_sec > INT64_MAX - carry ? INT64_MAX : tv.tv_sec + carry;
+  ns = saturated_ns(timespec{static_cast<time_t>(sec), static_cast<long>(tv.tv_usec % 1'000'000 * 1000)});
+  return true;
 }
 
 bool any_emulated_line(const pollfd* fds, nfds_t n) {
@@ -60,7 +68,8 @@ int ready_now(VirtualHostTime& vt, pollfd* fds, nfds_t n, const sigset_t* mask, 
 }
 
 // poll/ppoll with a timeout (ns, < 0 = none) on virtual time.
-int virtual_poll(VirtualHostTime& vt, pollfd* fds, nfds_t n, std::int64_t timeout_ns, const sigset_t* mask) {
+int virtual_poll(VirtualHostTime& vt, pollfd* fds, nfds_t n, std::int64_t timeout_ns, const sigset_t* mask,
+                 const char* call) {
   std::vector<char> future;
   Tick later = kNever;
   if (timeout_ns == 0) vt.look();
@@ -73,7 +82,9 @@ int virtual_poll(VirtualHostTime& vt, pollfd* fds, nfds_t n, std::int64_t timeou
     // A line whose next event is already queued (for later) is waited for by its tick instead.
     for (nfds_t i = 0; i < n; ++i) watch[i].events = future[i] ? 0 : fds[i].events;
     VirtualScheduler::Wait w;
+    w.call = call;
     w.deadline = std::min(deadline, later);
+    w.timeout_beyond_end = timeout_ns >= 0 && w.deadline == kNever;
     w.fds = watch;
     w.watches_board = board;
     w.sigmask = mask;
@@ -92,7 +103,7 @@ int virtual_poll(VirtualHostTime& vt, pollfd* fds, nfds_t n, std::int64_t timeou
 // the kernel's select would give (read: IN/HUP/ERR, write: OUT/ERR, except: PRI).
 // `remaining` (select's timeval) gets the time left.
 int virtual_select(VirtualHostTime& vt, int nfds, fd_set* r, fd_set* w, fd_set* e, std::int64_t timeout_ns,
-                   const sigset_t* mask, timeval* remaining) {
+                   const sigset_t* mask, timeval* remaining, const char* call) {
   std::vector<pollfd> fds;
   for (int fd = 0; fd < nfds && fd < FD_SETSIZE; ++fd) {
     short events = 0;
@@ -102,9 +113,9 @@ int virtual_select(VirtualHostTime& vt, int nfds, fd_set* r, fd_set* w, fd_set* 
     if (events) fds.push_back({fd, events, 0});
   }
   const Tick start = vt.tick_after(0);
-  const int n = virtual_poll(vt, fds.data(), fds.size(), timeout_ns, mask);
+  const int n = virtual_poll(vt, fds.data(), fds.size(), timeout_ns, mask, call);
   if (remaining && timeout_ns > 0) {
-    const std::int64_t used = static_cast<std::int64_t>(vt.tick_after(0) - start) * 250;
+    const std::int64_t used = static_cast<std::int64_t>(std::min<Tick>(vt.tick_after(0) - start, kKtimeMax / 250)) * 250;
     const std::int64_t left = timeout_ns > used ? timeout_ns - used : 0;
     remaining->tv_sec = static_cast<time_t>(left / 1'000'000'000);
     remaining->tv_usec = static_cast<suseconds_t>(left % 1'000'000'000 / 1000);
@@ -128,7 +139,7 @@ int virtual_select(VirtualHostTime& vt, int nfds, fd_set* r, fd_set* w, fd_set* 
 }
 
 int virtual_epoll(VirtualHostTime& vt, int epfd, epoll_event* events, int max, std::int64_t timeout_ns,
-                  const sigset_t* mask) {
+                  const sigset_t* mask, const char* call) {
   if (timeout_ns == 0) {
     vt.look();
     return real::epoll_pwait(epfd, events, max, 0, mask);
@@ -138,7 +149,9 @@ int virtual_epoll(VirtualHostTime& vt, int epfd, epoll_event* events, int max, s
   // An epoll set is readable when one of its descriptors is ready.
   const pollfd set{epfd, POLLIN, 0};
   VirtualScheduler::Wait w;
+  w.call = call;
   w.deadline = timeout_ns < 0 ? kNever : vt.tick_after(timeout_ns);
+  w.timeout_beyond_end = timeout_ns >= 0 && w.deadline == kNever;
   w.fds = std::span<const pollfd>(&set, 1);
   w.watches_board = epfd >= 0 && epfd < kEpollTable && g_epoll_has_lines[epfd].load(std::memory_order_relaxed);
   w.sigmask = mask;
@@ -174,7 +187,7 @@ __attribute__((visibility("default"))) int poll(struct pollfd* fds, nfds_t n, in
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_poll(*vt, fds, n, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
+      return virtual_poll(*vt, fds, n, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr, "poll");
     } catch (...) {
       return real::poll(fds, n, timeout_ms);
     }
@@ -193,7 +206,7 @@ __attribute__((visibility("default"))) int ppoll(struct pollfd* fds, nfds_t n, c
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_poll(*vt, fds, n, timeout ? to_ns(*timeout) : -1, mask);
+      return virtual_poll(*vt, fds, n, timeout ? to_ns(*timeout) : -1, mask, "ppoll");
     } catch (...) {
       return real::ppoll(fds, n, timeout, mask);
     }
@@ -208,13 +221,12 @@ __attribute__((visibility("default"))) int __ppoll_chk(struct pollfd* fds, nfds_
 
 __attribute__((visibility("default"))) int select(int nfds, fd_set* r, fd_set* w, fd_set* e, struct timeval* timeout) {
   VirtualHostTime* vt = virtual_time();
-  if (!vt || nfds < 0 || (timeout && (timeout->tv_sec < 0 || timeout->tv_usec < 0 || timeout->tv_usec >= 1'000'000)))
-    return real::select(nfds, r, w, e, timeout);
+  std::int64_t ns = -1;
+  if (!vt || nfds < 0 || (timeout && !select_timeout_ns(*timeout, ns))) return real::select(nfds, r, w, e, timeout);
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      const std::int64_t ns = timeout ? (std::int64_t{timeout->tv_sec} * 1'000'000 + timeout->tv_usec) * 1000 : -1;
-      return virtual_select(*vt, nfds, r, w, e, ns, nullptr, timeout);
+      return virtual_select(*vt, nfds, r, w, e, ns, nullptr, timeout, "select");
     } catch (...) {
       return real::select(nfds, r, w, e, timeout);
     }
@@ -228,7 +240,7 @@ __attribute__((visibility("default"))) int pselect(int nfds, fd_set* r, fd_set* 
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_select(*vt, nfds, r, w, e, timeout ? to_ns(*timeout) : -1, mask, nullptr);
+      return virtual_select(*vt, nfds, r, w, e, timeout ? to_ns(*timeout) : -1, mask, nullptr, "pselect");
     } catch (...) {
       return real::pselect(nfds, r, w, e, timeout, mask);
     }
@@ -241,7 +253,7 @@ __attribute__((visibility("default"))) int epoll_wait(int epfd, struct epoll_eve
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr);
+      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, nullptr, "epoll_wait");
     } catch (...) {
       return real::epoll_wait(epfd, events, max, timeout_ms);
     }
@@ -255,7 +267,7 @@ __attribute__((visibility("default"))) int epoll_pwait(int epfd, struct epoll_ev
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, mask);
+      return virtual_epoll(*vt, epfd, events, max, timeout_ms < 0 ? -1 : timeout_ms * kNsPerMs, mask, "epoll_pwait");
     } catch (...) {
       return real::epoll_pwait(epfd, events, max, timeout_ms, mask);
     }
@@ -269,7 +281,7 @@ __attribute__((visibility("default"))) int epoll_pwait2(int epfd, struct epoll_e
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_epoll(*vt, epfd, events, max, timeout ? to_ns(*timeout) : -1, mask);
+      return virtual_epoll(*vt, epfd, events, max, timeout ? to_ns(*timeout) : -1, mask, "epoll_pwait2");
     } catch (...) {
       return real::epoll_pwait2(epfd, events, max, timeout, mask);
     }

@@ -5,6 +5,7 @@
 #include <pthread.h>
 #include <semaphore.h>
 
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -23,18 +24,29 @@ namespace {
 // over at once).
 constexpr std::int64_t kSemaphoreRecheckNs = 10'000'000;
 
+// An absolute timeout as glibc takes it: tv_nsec outside [0, 10^9) is EINVAL, a negative tv_sec
+// has passed already (ETIMEDOUT), a time past KTIME_MAX saturates there (it never comes).
 bool valid(const timespec& ts) { return ts.tv_nsec >= 0 && ts.tv_nsec < 1'000'000'000; }
+std::int64_t to_ns(const timespec& ts) { return ts.tv_sec < 0 ? -1 : saturated_ns(ts); }
 
-std::int64_t to_ns(const timespec& ts) {
-  if (ts.tv_sec >= INT64_MAX / 1'000'000'000 - 1) return INT64_MAX / 2;
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
+// Whether another process may post the semaphore: glibc (struct new_sem on 64-bit targets)
+// keeps the futex flag after the 64-bit value: 0 for a process-private semaphore, FUTEX_PRIVATE_FLAG
+// (128) for one shared between processes (sem_init with pshared, sem_open).
+bool shared_semaphore(const sem_t* s) {
+  int flag = 0;
+  std::memcpy(&flag, reinterpret_cast<const char*>(s) + sizeof(std::uint64_t), sizeof flag);
+  return flag != 0;
 }
+
+// Whether another process may signal the condition variable: bit 0 of __wrefs (glibc >= 2.25).
+bool shared_cond(const pthread_cond_t* c) { return (c->__data.__wrefs & 1) != 0; }
 
 // ---- threads --------------------------------------------------------------------------
 
 // What a joiner waits on: the thread's exit, seen by its thread-exit key destructor.
 struct Joinable {
   std::atomic<bool> exited{false};
+  std::atomic<pid_t> tid{0};  // the thread's id, once it runs (for the deadlock report)
 };
 
 struct Start {
@@ -75,6 +87,7 @@ void* start_thread(void* p) {
     Guard guard;
     return fn(arg);
   }
+  s->joinable->tid.store(::gettid(), std::memory_order_release);
   pthread_setspecific(g_exit_key, new std::shared_ptr<Joinable>(std::move(s->joinable)));
   delete s;
   return fn(arg);
@@ -90,13 +103,17 @@ clockid_t cond_clock(const pthread_cond_t* c) {
 
 // A wait that never touches the C library's condition variable: the mutex is released once the
 // scheduler has registered the waiter (a signal after that cannot be lost) and taken again after.
-int cond_wait(VirtualHostTime& vt, pthread_cond_t* c, pthread_mutex_t* m, clockid_t clock, const timespec* abstime) {
+int cond_wait(VirtualHostTime& vt, pthread_cond_t* c, pthread_mutex_t* m, clockid_t clock, const timespec* abstime,
+              const char* call) {
   VirtualScheduler::Wait w;
+  w.call = call;
   w.object = c;
+  w.outside = shared_cond(c);
   w.interruptible = false;  // a signal handler runs and the wait goes on (a spurious wake-up is allowed)
   if (abstime) {
     if (!valid(*abstime)) return EINVAL;
     w.deadline = vt.tick_at(clock, to_ns(*abstime));
+    w.timeout_beyond_end = w.deadline == kNever;
   }
   int unlock_error = 0;
   bool unlocked = false;
@@ -117,9 +134,11 @@ int cond_wait(VirtualHostTime& vt, pthread_cond_t* c, pthread_mutex_t* m, clocki
 // ---- semaphores -------------------------------------------------------------------------
 
 // 0, or -1 with errno, as sem_wait does.
-int sem_wait_virtual(VirtualHostTime& vt, sem_t* s, clockid_t clock, const timespec* abstime) {
+int sem_wait_virtual(VirtualHostTime& vt, sem_t* s, clockid_t clock, const timespec* abstime, const char* call) {
   VirtualScheduler::Wait w;
+  w.call = call;
   w.object = s;
+  w.outside = shared_semaphore(s);
   w.try_now = [s] {
     const int saved = errno;
     const bool taken = real::sem_trywait(s) == 0;
@@ -135,6 +154,7 @@ int sem_wait_virtual(VirtualHostTime& vt, sem_t* s, clockid_t clock, const times
       return -1;
     }
     w.deadline = vt.tick_at(clock, to_ns(*abstime));
+    w.timeout_beyond_end = w.deadline == kNever;
   }
   switch (vt.wait(w)) {
     case End::ready:
@@ -218,7 +238,9 @@ __attribute__((visibility("default"))) int pthread_join(pthread_t t, void** resu
     int r = 0;
     try {
       VirtualScheduler::Wait w;
+      w.call = "pthread_join";
       w.object = joinable.get();
+      w.joined_tid = &joinable->tid;
       w.try_now = [&] { return joinable->exited.load(std::memory_order_acquire); };
       vt->scheduler().wait_in(w, [&] { r = real::pthread_join(t, result); });
     } catch (...) {
@@ -249,7 +271,7 @@ __attribute__((visibility("default"))) int pthread_cond_wait(pthread_cond_t* c, 
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return cond_wait(*vt, c, m, CLOCK_REALTIME, nullptr);
+      return cond_wait(*vt, c, m, CLOCK_REALTIME, nullptr, "pthread_cond_wait");
     } catch (...) {
       return real::pthread_cond_wait(c, m);
     }
@@ -263,7 +285,7 @@ __attribute__((visibility("default"))) int pthread_cond_timedwait(pthread_cond_t
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return cond_wait(*vt, c, m, cond_clock(c), abstime);
+      return cond_wait(*vt, c, m, cond_clock(c), abstime, "pthread_cond_timedwait");
     } catch (...) {
       return real::pthread_cond_timedwait(c, m, abstime);
     }
@@ -278,7 +300,7 @@ __attribute__((visibility("default"))) int pthread_cond_clockwait(pthread_cond_t
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return cond_wait(*vt, c, m, clock, abstime);
+      return cond_wait(*vt, c, m, clock, abstime, "pthread_cond_clockwait");
     } catch (...) {
       return real::pthread_cond_clockwait(c, m, clock, abstime);
     }
@@ -313,7 +335,7 @@ __attribute__((visibility("default"))) int sem_wait(sem_t* s) {
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, nullptr);
+      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, nullptr, "sem_wait");
     } catch (...) {
       return real::sem_wait(s);
     }
@@ -326,7 +348,7 @@ __attribute__((visibility("default"))) int sem_timedwait(sem_t* s, const struct 
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, abstime);
+      return sem_wait_virtual(*vt, s, CLOCK_REALTIME, abstime, "sem_timedwait");
     } catch (...) {
       return real::sem_timedwait(s, abstime);
     }
@@ -340,7 +362,7 @@ __attribute__((visibility("default"))) int sem_clockwait(sem_t* s, clockid_t clo
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return sem_wait_virtual(*vt, s, clock, abstime);
+      return sem_wait_virtual(*vt, s, clock, abstime, "sem_clockwait");
     } catch (...) {
       return real::sem_clockwait(s, clock, abstime);
     }

@@ -21,22 +21,20 @@ timespec to_timespec(std::int64_t ns) {
   return {static_cast<time_t>(ns / kNsPerSecond), static_cast<long>(ns % kNsPerSecond)};
 }
 
-bool valid(const timespec& ts) { return ts.tv_nsec >= 0 && ts.tv_nsec < kNsPerSecond; }
-
-std::int64_t to_ns(const timespec& ts) {
-  // Far-future values saturate (a deadline after the year 2262 is no deadline).
-  if (ts.tv_sec >= INT64_MAX / kNsPerSecond - 1) return INT64_MAX / 2;
-  return std::int64_t{ts.tv_sec} * kNsPerSecond + ts.tv_nsec;
-}
-
 // clock_nanosleep on a virtual clock: 0 or an error number (EINTR with `rem` for relative sleeps).
-int virtual_sleep(VirtualHostTime& vt, clockid_t clock, int flags, const timespec* req, timespec* rem) {
-  if (!valid(*req) || (!(flags & TIMER_ABSTIME) && req->tv_sec < 0)) return EINVAL;
+// The kernel's rules: a timespec with tv_sec < 0 or tv_nsec outside [0, 10^9) is EINVAL, relative
+// or absolute; a time is saturated at KTIME_MAX, and a sleep until then never ends.
+int virtual_sleep(VirtualHostTime& vt, clockid_t clock, int flags, const timespec* req, timespec* rem,
+                  const char* call) {
+  if (!kernel_valid(*req)) return EINVAL;
   const bool absolute = flags & TIMER_ABSTIME;
   const std::int64_t start = vt.now_ns(clock);
-  const std::int64_t deadline_ns = absolute ? to_ns(*req) : start + to_ns(*req);
+  const std::int64_t ns = saturated_ns(*req);
+  const std::int64_t deadline_ns = absolute ? ns : add_saturated(start, ns);
   VirtualScheduler::Wait w;
-  w.deadline = absolute ? vt.tick_at(clock, deadline_ns) : vt.tick_after(to_ns(*req));
+  w.call = call;
+  w.deadline = absolute ? vt.tick_at(clock, deadline_ns) : vt.tick_after(ns);
+  w.timeout_beyond_end = w.deadline == kNever;
   if (w.deadline <= vt.tick_after(0)) {  // a zero sleep (a yield, sleep(0) in a loop): a look at time
     vt.look();
     return 0;
@@ -115,7 +113,7 @@ __attribute__((visibility("default"))) int clock_nanosleep(clockid_t clock, int 
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      return virtual_sleep(*vt, clock, flags, req, rem);
+      return virtual_sleep(*vt, clock, flags, req, rem, "clock_nanosleep");
     } catch (...) {
       return real::clock_nanosleep(clock, flags, req, rem);
     }
@@ -128,7 +126,7 @@ __attribute__((visibility("default"))) int nanosleep(const struct timespec* req,
   return as_cancellation_point([&]() __attribute__((noinline)) -> int {
     Guard guard;
     try {
-      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, req, rem);
+      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, req, rem, "nanosleep");
       if (r == 0) return 0;
       errno = r;
       return -1;
@@ -145,7 +143,7 @@ __attribute__((visibility("default"))) int usleep(useconds_t us) {
     Guard guard;
     try {
       const timespec req = to_timespec(std::int64_t{us} * 1000);
-      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, nullptr);
+      const int r = virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, nullptr, "usleep");
       if (r == 0) return 0;
       errno = r;
       return -1;
@@ -164,7 +162,7 @@ __attribute__((visibility("default"))) unsigned sleep(unsigned seconds) {
       const timespec req{static_cast<time_t>(seconds), 0};
       timespec rem{};
       const int saved = errno;
-      if (virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, &rem) == 0) {
+      if (virtual_sleep(*vt, CLOCK_MONOTONIC, 0, &req, &rem, "sleep") == 0) {
         errno = saved;
         return 0;
       }

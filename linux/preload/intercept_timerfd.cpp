@@ -33,12 +33,9 @@ std::unordered_map<int, VirtualTimer>* g_timers = nullptr;  // never freed
 std::atomic<int> g_count{0};                                // timers in the table (cheap "none" test)
 std::atomic<pid_t> g_owner_pid{0};                          // the process the table belongs to
 
-bool valid(const timespec& ts) { return ts.tv_sec >= 0 && ts.tv_nsec >= 0 && ts.tv_nsec < kNsPerSecond; }
-
-std::int64_t to_ns(const timespec& ts) {
-  if (ts.tv_sec >= INT64_MAX / kNsPerSecond - 1) return INT64_MAX / 4;
-  return std::int64_t{ts.tv_sec} * kNsPerSecond + ts.tv_nsec;
-}
+// Values as the kernel takes them (timerfd_settime: timespec64_valid, then saturated at KTIME_MAX).
+bool valid(const timespec& ts) { return kernel_valid(ts); }
+std::int64_t to_ns(const timespec& ts) { return saturated_ns(ts); }
 
 timespec to_timespec(std::int64_t ns) {
   if (ns < 0) ns = 0;
@@ -67,7 +64,11 @@ std::uint64_t take_expirations(VirtualTimer& t, std::int64_t now) {
     return 1;
   }
   const std::uint64_t n = 1 + static_cast<std::uint64_t>((now - t.expiry_ns) / t.interval_ns);
-  t.expiry_ns += static_cast<std::int64_t>(n) * t.interval_ns;
+  // The next expiry saturates at KTIME_MAX (hrtimer_forward's ktime_add_safe): never, not wrapped.
+  const std::int64_t later = n > static_cast<std::uint64_t>(kKtimeMax / t.interval_ns)
+                                 ? kKtimeMax
+                                 : static_cast<std::int64_t>(n) * t.interval_ns;
+  t.expiry_ns = add_saturated(t.expiry_ns, later);
   return n;
 }
 
@@ -81,7 +82,7 @@ itimerspec describe(VirtualHostTime& vt, const VirtualTimer& t) {
   if (t.expiry_ns < 0) return v;
   const std::int64_t now = vt.now_ns(CLOCK_MONOTONIC);
   std::int64_t next = t.expiry_ns;
-  if (now >= next && t.interval_ns > 0) next += ((now - next) / t.interval_ns + 1) * t.interval_ns;
+  if (now >= next && t.interval_ns > 0) next = add_saturated(next, ((now - next) / t.interval_ns + 1) * t.interval_ns);
   v.it_value = to_timespec(next > now ? next - now : 0);
   if (next <= now) v.it_value = {0, 1};  // expired one-shot not yet read: the kernel says "1 ns"
   return v;
@@ -103,6 +104,15 @@ void fire_virtual_timerfd(int fd) {
 }
 
 bool virtual_timerfds_exist() { return g_count.load(std::memory_order_acquire) > 0; }
+
+bool is_virtual_timerfd(int fd, bool* armed) {
+  if (g_count.load(std::memory_order_acquire) == 0) return false;
+  std::lock_guard lock(g_mutex);
+  const auto it = g_timers->find(fd);
+  if (it == g_timers->end()) return false;
+  if (armed) *armed = it->second.expiry_ns >= 0;
+  return true;
+}
 
 bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result) {
   if (g_count.load(std::memory_order_acquire) == 0) return false;
@@ -147,6 +157,7 @@ bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result)
     }
     const pollfd p{fd, POLLIN, 0};  // re-armed to expire at once by another thread
     VirtualScheduler::Wait w;
+    w.call = "read";
     w.deadline = wake;
     w.fds = std::span<const pollfd>(&p, 1);
     if (vt->wait(w) == VirtualScheduler::End::interrupted) {
@@ -237,10 +248,12 @@ __attribute__((visibility("default"))) int timerfd_settime(int fd, int flags, co
   if (v == 0) {
     t.expiry_ns = -1;
   } else if (flags & TFD_TIMER_ABSTIME) {
+    // On the timer's clock, as MONOTONIC: a time past the end of the clock is KTIME_MAX (never).
     const std::int64_t now_clock = vt->now_ns(t.clock);
-    t.expiry_ns = vt->now_ns(CLOCK_MONOTONIC) + (v - now_clock);
+    const std::int64_t now_mono = vt->now_ns(CLOCK_MONOTONIC);
+    t.expiry_ns = v >= now_clock ? add_saturated(now_mono, v - now_clock) : std::max<std::int64_t>(0, now_mono - (now_clock - v));
   } else {
-    t.expiry_ns = vt->now_ns(CLOCK_MONOTONIC) + v;
+    t.expiry_ns = add_saturated(vt->now_ns(CLOCK_MONOTONIC), v);
   }
   Tick next = tick_of(*vt, t);
   if (t.expiry_ns >= 0 && t.expiry_ns <= vt->now_ns(CLOCK_MONOTONIC)) {

@@ -201,4 +201,6 @@ void log_line(std::string_view text) {
   if (g_log) g_log->line(text);
 }
 
+bool log_is_stderr() { return g_log && g_log->to_stderr(); }
+
 }  // namespace l6470emu::preload

@@ -61,5 +61,7 @@ void real_close_protected(int fd);
 
 /// Reports a line on the diagnostic log of this process (stderr unless log= says otherwise).
 void log_line(std::string_view text);
+/// Whether log_line() writes to standard error (also when the log is off: false).
+bool log_is_stderr();
 
 }  // namespace l6470emu::preload

@@ -3,12 +3,19 @@
 #include "linux/preload/virtual_time.hpp"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <pthread.h>
 #include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <vector>
 
+#include "linux/log.hpp"
 #include "linux/preload/real.hpp"
 
 namespace l6470emu::preload {
@@ -39,26 +46,176 @@ int count_threads() {
 // The busy-wait rule's count of looks at time since the calling thread's last covered wait.
 thread_local std::int64_t t_looks = 0;
 
-VirtualScheduler::Hooks scheduler_hooks(DeviceBoard& board) {
-  VirtualScheduler::Hooks h;
-  h.now = [&board] { return board.time().now(); };
-  h.advance_to = [&board](Tick t) { board.advance_to(t); };
-  h.next_edge = [&board] { return board.next_edge_tick(); };
-  h.fire_timer = [](int fd) { fire_virtual_timerfd(fd); };
-  h.real_ns = [] { return real_clock_ns(CLOCK_MONOTONIC); };
-  h.log = [](std::string_view line) { log_line(line); };
-  return h;
+// Why a signal may still come from outside the covered calls: a real timer that is armed.
+std::string armed_real_timers() {
+  for (const auto& [which, name] : {std::pair{ITIMER_REAL, "an alarm() or setitimer(ITIMER_REAL) timer is armed"},
+                                    std::pair{ITIMER_VIRTUAL, "a setitimer(ITIMER_VIRTUAL) timer is armed"},
+                                    std::pair{ITIMER_PROF, "a setitimer(ITIMER_PROF) timer is armed"}}) {
+    itimerval v{};
+    if (getitimer(which, &v) == 0 && (v.it_value.tv_sec != 0 || v.it_value.tv_usec != 0)) return name;
+  }
+  // POSIX timers (timer_create): listed in /proc/self/timers (when the kernel has it).
+  const int fd = real::open("/proc/self/timers", O_RDONLY | O_CLOEXEC, 0);
+  if (fd >= 0) {
+    char c;
+    const ssize_t n = real::read(fd, &c, 1);
+    real::close(fd);
+    if (n == 1) return "a POSIX timer (timer_create) exists";
+  }
+  return {};
+}
+
+// Whether `fd` is an epoll set; `members` gets the descriptors in it (/proc/self/fdinfo lines
+// "tfd:        7 events:       19 data: ...").
+bool epoll_members(int fd, std::vector<int>& members) {
+  members.clear();
+  char link[64] = {};
+  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  if (real::readlink(self.c_str(), link, sizeof link - 1) <= 0 || std::strcmp(link, "anon_inode:[eventpoll]") != 0)
+    return false;
+  const std::string info_path = "/proc/self/fdinfo/" + std::to_string(fd);
+  const int info = real::open(info_path.c_str(), O_RDONLY | O_CLOEXEC, 0);
+  if (info < 0) return false;
+  std::string text;
+  char buf[4096];
+  for (ssize_t n; (n = real::read(info, buf, sizeof buf)) > 0 && text.size() < (1u << 20);)
+    text.append(buf, static_cast<std::size_t>(n));
+  real::close(info);
+  for (std::size_t at = text.find("tfd:"); at != std::string::npos; at = text.find("tfd:", at + 4))
+    members.push_back(std::atoi(text.c_str() + at + 4));
+  return true;
+}
+
+// Whether descriptor `fd` becomes ready only through this process: an emulated gpio line, a
+// virtual timerfd, or an epoll set of such descriptors.
+bool inside_fd(int fd, int depth = 0) {
+  if (is_emulated_line(fd) || is_virtual_timerfd(fd)) return true;
+  std::vector<int> members;
+  if (depth > 3 || !epoll_members(fd, members)) return false;
+  for (const int m : members)
+    if (!inside_fd(m, depth + 1)) return false;
+  return true;
+}
+
+// Writes every line of `text` on standard error as the log writes them ("l6470emu: ...").
+void write_stderr_lines(const std::string& text) {
+  std::string out;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t nl = std::min(text.find('\n', at), text.size());
+    out += "l6470emu: " + text.substr(at, nl - at) + "\n";
+    at = nl + 1;
+  }
+  raw_write_all(2, out.data(), out.size());
 }
 
 }  // namespace
+
+bool kernel_valid(const timespec& ts) { return ts.tv_sec >= 0 && ts.tv_nsec >= 0 && ts.tv_nsec < 1'000'000'000; }
+
+std::int64_t saturated_ns(const timespec& ts) {
+  if (ts.tv_sec >= kKtimeMax / 1'000'000'000) return kKtimeMax;  // KTIME_SEC_MAX and beyond
+  return add_saturated(std::int64_t{ts.tv_sec} * 1'000'000'000, ts.tv_nsec);
+}
+
+std::int64_t add_saturated(std::int64_t a, std::int64_t b) { return a > kKtimeMax - b ? kKtimeMax : a + b; }
 
 VirtualHostTime::VirtualHostTime(DeviceBoard& board, const TimeConfig& config)
     : board_(board),
       time_(board.time()),
       boottime_offset_ns_(real_clock_ns(CLOCK_BOOTTIME) - real_clock_ns(CLOCK_MONOTONIC)),
       tai_offset_ns_(real_clock_ns(CLOCK_TAI) - real_clock_ns(CLOCK_REALTIME)),
-      scheduler_(scheduler_hooks(board), config.idle_ns, count_threads()) {
+      last_tick_([this] {
+        // Every clock at most KTIME_MAX: the one with the largest offset from MONOTONIC decides.
+        const std::int64_t realtime = time_.realtime_offset_ns();
+        const std::int64_t largest = std::max({std::int64_t{0}, boottime_offset_ns_, realtime, realtime + tai_offset_ns_});
+        return static_cast<Tick>((kKtimeMax - largest - time_.host_ns_of(0)) / 250);
+      }()),
+      scheduler_(scheduler_hooks(), config.idle_ns, count_threads()) {
   time_.set_waiter(&bus_waiter_);
+}
+
+VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
+  VirtualScheduler::Hooks h;
+  DeviceBoard& board = board_;
+  h.now = [&board] { return board.time().now(); };
+  h.advance_to = [&board](Tick t) { board.advance_to(t); };
+  h.next_edge = [&board] { return board.next_edge_tick(); };
+  h.fire_timer = [](int fd) { fire_virtual_timerfd(fd); };
+  h.real_ns = [] { return real_clock_ns(CLOCK_MONOTONIC); };
+  h.log = [](std::string_view line) { log_line(line); };
+  h.inside_fd = [](int fd) { return inside_fd(fd); };
+  h.describe_fd = [this](int fd) { return describe_fd(fd); };
+  h.outside_wakeup = [] { return armed_real_timers(); };
+  h.describe_board = [this] { return describe_board(); };
+  h.deadlock = [this](const std::string& report) { end_deadlocked(report); };
+  return h;
+}
+
+std::string VirtualHostTime::describe_fd(int fd) const {
+  const std::string n = "fd " + std::to_string(fd);
+  if (const FdEntry* e = fd_entry(fd)) {
+    const std::vector<DeviceNode>& all = nodes();
+    const std::string node = e->node < all.size() ? all[e->node].path : std::string("a gpiochip");
+    if (e->kind == HandleKind::line_event_v1) return n + " (a v1 line event request on " + node + ")";
+    if (e->kind == HandleKind::line_request_v2) return n + " (a line request on " + node + ")";
+    return n + " (" + node + ")";
+  }
+  bool armed = false;
+  if (is_virtual_timerfd(fd, &armed)) return n + (armed ? " (a timerfd)" : " (a timerfd that is not armed)");
+  std::vector<int> members;
+  if (epoll_members(fd, members)) {
+    std::string set = n + " (an epoll set of";
+    for (std::size_t i = 0; i < members.size(); ++i) set += (i ? ", " : " ") + describe_fd(members[i]);
+    return set + (members.empty() ? " nothing)" : ")");
+  }
+  return n;
+}
+
+std::string VirtualHostTime::describe_board() {
+  std::string out;
+  for (std::size_t c = 0; c < board_.chain_count(); ++c) {
+    const ChipNumbering numbering = board_.chip_numbering(c);
+    std::string line = board_.chain_summary(c) + ":";
+    for (std::size_t k = 0; k < board_.chip_count(c); ++k) {
+      const bool busy_high = board_.pin_level(c, k, Pin::BUSY), flag_high = board_.pin_level(c, k, Pin::FLAG);
+      line += std::string(k ? ";" : "") + " " + numbering.label(k) + " BUSY " +
+              (busy_high ? "high (no command running)" : "low (busy)") + ", FLAG " + (flag_high ? "high" : "low (alarm)");
+    }
+    out += line + "\n";
+  }
+  const std::string handles = board_.describe_handles();
+  std::size_t at = 0;
+  while (at < handles.size()) {
+    const std::size_t nl = std::min(handles.find('\n', at), handles.size());
+    const std::string l = handles.substr(at, nl - at);
+    if (l.find(" line ") != std::string::npos) out += l + "\n";  // the gpio lines requested
+    at = nl + 1;
+  }
+  if (board_.next_edge_tick() == kNever) out += "no BUSY or FLAG edge is to come on a line with edge events\n";
+  return out;
+}
+
+void VirtualHostTime::end_deadlocked(const std::string& report) {
+  // The report on standard error (as a sanitizer's), and in the log file when there is one.
+  write_stderr_lines(report);
+  if (!log_is_stderr()) {
+    std::size_t at = 0;
+    while (at <= report.size()) {
+      const std::size_t nl = std::min(report.find('\n', at), report.size());
+      log_line(report.substr(at, nl - at));
+      at = nl + 1;
+    }
+  }
+  // Nothing recorded is lost: traces are finished (a gzip trace gets its end), the program's
+  // standard output and error buffers written.
+  for (std::size_t c = 0; c < board_.chain_count(); ++c) board_.stop_recording(c);
+  for (FILE* f : {stdout, stderr})  // (a stream another thread holds locked is left as it is)
+    if (ftrylockfile(f) == 0) {
+      fflush_unlocked(f);
+      funlockfile(f);
+    }
+  _exit(kDeadlockExitStatus);
 }
 
 VirtualHostTime::~VirtualHostTime() { time_.set_waiter(nullptr); }
@@ -96,12 +253,18 @@ std::int64_t VirtualHostTime::offset_ns(clockid_t clock) const {
   }
 }
 
-std::int64_t VirtualHostTime::ns_at(clockid_t clock, Tick tick) const { return time_.host_ns_of(tick) + offset_ns(clock); }
+std::int64_t VirtualHostTime::ns_at(clockid_t clock, Tick tick) const {
+  if (tick > last_tick_) return kKtimeMax;  // saturated, never wrapped
+  return time_.host_ns_of(tick) + offset_ns(clock);
+}
 
 std::int64_t VirtualHostTime::now_ns(clockid_t clock) const { return ns_at(clock, time_.now()); }
 
 Tick VirtualHostTime::tick_at(clockid_t clock, std::int64_t ns) const {
-  const std::int64_t monotonic = ns - offset_ns(clock);
+  const std::int64_t offset = offset_ns(clock);
+  // A deadline past the last time this clock can show is no deadline (a saturated kernel timer).
+  if (ns > ns_at(clock, last_tick_)) return kNever;
+  const std::int64_t monotonic = offset > 0 && ns < INT64_MIN + offset ? INT64_MIN : ns - offset;
   Tick t = time_.tick_of(monotonic);
   if (time_.host_ns_of(t) < monotonic) ++t;  // never wake before the deadline
   return t;
@@ -110,9 +273,9 @@ Tick VirtualHostTime::tick_at(clockid_t clock, std::int64_t ns) const {
 Tick VirtualHostTime::tick_after(std::int64_t ns) const {
   const Tick now = time_.now();
   if (ns <= 0) return now;
-  // A deadline that far away is no deadline.
-  if (ns >= std::int64_t{1} << 62) return kNever;
-  return now + static_cast<Tick>((ns + 249) / 250);
+  const Tick ticks = static_cast<Tick>(ns / 250 + (ns % 250 != 0 ? 1 : 0));
+  if (now >= last_tick_ || ticks > last_tick_ - now) return kNever;  // past the end of time: no deadline
+  return now + ticks;
 }
 
 Tick VirtualHostTime::first_event_tick(int fd) const {
@@ -130,6 +293,12 @@ Tick VirtualHostTime::first_event_tick(int fd) const {
 
 VirtualScheduler::End VirtualHostTime::wait(const VirtualScheduler::Wait& w) {
   t_looks = 0;
+  if (w.call == nullptr && w.fds.size() == 1 && is_emulated_line(w.fds[0].fd)) {
+    // The one covered wait that does not name itself: read() of a line request (intercept_io).
+    VirtualScheduler::Wait named = w;
+    named.call = "read";
+    return scheduler_.wait(named);
+  }
   return scheduler_.wait(w);
 }
 
@@ -139,6 +308,7 @@ void VirtualHostTime::look() {
   if (doublings == 12) t_looks = kSpinLooks + 12 * kLooksPerDoubling;  // no overflow in a long spin
   const Tick quantum = std::min(kFirstQuantum << doublings, kLastQuantum);
   VirtualScheduler::Wait w;
+  w.call = "a busy-wait quantum";
   w.deadline = time_.now() + quantum;
   w.interruptible = false;
   int cancel_state;  // a clock read is no cancellation point
@@ -153,6 +323,7 @@ void VirtualHostTime::unlook() {
 
 void VirtualHostTime::BusWaiter::wait_until(Tick tick) {
   VirtualScheduler::Wait w;
+  w.call = "a spidev transfer's bus time";
   w.deadline = tick;
   w.interruptible = false;  // a spidev transfer finishes whatever signal arrives
   int cancel_state;          // and ioctl is no cancellation point

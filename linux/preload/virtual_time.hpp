@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 
 #include "board/board_config.hpp"
 #include "linux/device_board.hpp"
@@ -16,8 +17,24 @@
 
 namespace l6470emu::preload {
 
+/// The kernel's largest time, KTIME_MAX (ns): a timeout that reaches it never ends, and no
+/// virtual clock reads past it.
+inline constexpr std::int64_t kKtimeMax = INT64_MAX;
+
+/// Whether `ts` is a timespec the kernel takes (timespec64_valid: tv_sec >= 0, 0 <= tv_nsec < 10^9).
+bool kernel_valid(const timespec& ts);
+/// A valid `ts` in ns, saturated at kKtimeMax as the kernel's timespec64_to_ktime does.
+std::int64_t saturated_ns(const timespec& ts);
+/// a + b (both >= 0) saturated at kKtimeMax, as the kernel's ktime_add_safe.
+std::int64_t add_saturated(std::int64_t a, std::int64_t b);
+
 /// The process's virtual time: clock conversions, covered waits, the busy-wait rule, and the
 /// board's wait for bus time.
+///
+/// Time ends where the kernel's does: every virtual clock (REALTIME and TAI, which read the
+/// most, included) stays at most KTIME_MAX, so time never goes past last_tick() (about 236 years
+/// after the program's start). A timeout that lies past it is no timeout (kNever), as a kernel
+/// timer saturated at KTIME_MAX never fires; clocks saturate rather than wrap.
 class VirtualHostTime {
  public:
   /// Makes `board`'s time the program's; `config` gives the idle grace. Counts the threads that
@@ -34,12 +51,16 @@ class VirtualHostTime {
   static bool is_virtual_clock(clockid_t clock);
   /// What `clock` (a virtual one) reads now, ns.
   std::int64_t now_ns(clockid_t clock) const;
-  /// What `clock` reads at `tick`, ns.
+  /// What `clock` reads at `tick`, ns (at most kKtimeMax).
   std::int64_t ns_at(clockid_t clock, Tick tick) const;
-  /// The first tick at which `clock` reads `ns` or later (an absolute deadline on that clock).
+  /// The first tick at which `clock` reads `ns` or later (an absolute deadline on that clock);
+  /// kNever when that lies past last_tick().
   Tick tick_at(clockid_t clock, std::int64_t ns) const;
-  /// The first tick at least `ns` from now (a relative timeout; <= 0 is now).
+  /// The first tick at least `ns` from now (a relative timeout; <= 0 is now); kNever when that
+  /// lies past last_tick().
   Tick tick_after(std::int64_t ns) const;
+  /// The last tick at which every virtual clock reads at most KTIME_MAX.
+  Tick last_tick() const { return last_tick_; }
 
   /// The tick of the first event queued on emulated line `fd` (kNever: none queued). The board
   /// stamps an edge a spidev message causes with the message's end, and queues it before the
@@ -80,11 +101,16 @@ class VirtualHostTime {
   };
 
   std::int64_t offset_ns(clockid_t clock) const;
+  VirtualScheduler::Hooks scheduler_hooks();
+  std::string describe_fd(int fd) const;
+  std::string describe_board();
+  [[noreturn]] void end_deadlocked(const std::string& report);
 
   DeviceBoard& board_;
   BoardTime& time_;
   std::int64_t boottime_offset_ns_;  // real BOOTTIME - MONOTONIC at the start
   std::int64_t tai_offset_ns_;       // real TAI - REALTIME at the start
+  Tick last_tick_;
   VirtualScheduler scheduler_;
   BusWaiter bus_waiter_{*this};
 };
@@ -138,6 +164,8 @@ void thread_table_after_fork();
 void fire_virtual_timerfd(int fd);
 /// intercept_timerfd.cpp: whether any virtual timerfd exists (cheap).
 bool virtual_timerfds_exist();
+/// intercept_timerfd.cpp: whether `fd` is a virtual timerfd (and, if so, whether it is armed).
+bool is_virtual_timerfd(int fd, bool* armed = nullptr);
 /// intercept_timerfd.cpp: read() of a virtual timerfd. False: `fd` is not one.
 bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result);
 /// intercept_timerfd.cpp: `fd` was closed (or replaced by dup2): forget its timer.

@@ -8,6 +8,8 @@ The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spide
 fixtures; preload_library() finds libl6470emu-preload.so for running unmodified programs.
 """
 from ._l6470emu import (
+    DEFAULT_MAX_FRAMES,
+    MAX_MOTION_POINTS,
     TICKS_PER_SECOND,
     Bridge,
     Chain,
@@ -36,6 +38,8 @@ from ._paths import preload_library, program
 from ._status import Status
 
 __all__ = [
+    "DEFAULT_MAX_FRAMES",
+    "MAX_MOTION_POINTS",
     "TICKS_PER_SECOND",
     "Bridge",
     "Chain",

@@ -21,6 +21,9 @@ SECONDS_PER_TICK = 1.0 / _l6470emu.TICKS_PER_SECOND
 STEPS_PER_S_PER_SPEED_UNIT = _l6470emu.TICKS_PER_SECOND / 2.0**28
 #: Command labels are written next to their markers when a picture has at most this many.
 MAX_LABELLED_COMMANDS = 40
+#: The bounds of motion(): the most samples per chip, and the most frames a trace may hold by default.
+MAX_POINTS = _l6470emu.MAX_MOTION_POINTS
+DEFAULT_MAX_FRAMES = _l6470emu.DEFAULT_MAX_FRAMES
 #: The file types plot() writes.
 FORMATS = (".png", ".svg")
 
@@ -89,7 +92,8 @@ class TerminalProgress:
         self._drawn = True
 
 
-def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress=None):
+def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress=None,
+               max_frames=DEFAULT_MAX_FRAMES):
     """l6470emu.motion() of a Motion (as is), a Chain recording into memory, a Trace or a path."""
     if isinstance(source, _l6470emu.Motion):
         return source
@@ -100,7 +104,8 @@ def _motion_of(source, chain, chips, start, end, format, select, max_points, num
             end = source.now_seconds  # a live chain: up to its present
         source = source.trace if source.trace is not None else source.record_path
     return _l6470emu.motion(source, chain, format=format, select=select, chips=chips, start=start, end=end,
-                            max_points=max_points, number_from=number_from, progress=progress)
+                            max_points=max_points, number_from=number_from, progress=progress,
+                            max_frames=max_frames)
 
 
 def _time_scale(motion) -> tuple:
@@ -115,7 +120,7 @@ def _time_scale(motion) -> tuple:
 def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
            title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None,
-           number_from: str = "miso", progress=None):
+           number_from: str = "miso", progress=None, max_frames: int = DEFAULT_MAX_FRAMES):
     """The picture as a matplotlib Figure (not shown, not saved; pyplot is not used).
 
     source: a trace file (any format the l6470emu program reads), a Trace, a Chain made with
@@ -128,7 +133,8 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
     import numpy as np
     from matplotlib.figure import Figure
 
-    motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress)
+    motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress,
+                        max_frames)
     scale, unit = _time_scale(motion)
     pos_unit, per_unit = position_unit if position_unit is not None else ("microsteps", 1.0)
     if not per_unit > 0:
@@ -226,7 +232,10 @@ def _arguments(argv):
     p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480); default: the trace's own")
     p.add_argument("--format", default=None, help="input format (default: recognised from the content)")
     p.add_argument("--select", default="", help="the stream to take when the file has several")
-    p.add_argument("--max-points", type=int, default=4000, help="most samples per chip (default 4000)")
+    p.add_argument("--max-points", type=int, default=4000,
+                   help=f"most samples per chip (default 4000, at most {MAX_POINTS})")
+    p.add_argument("--max-frames", type=int, default=DEFAULT_MAX_FRAMES,
+                   help=f"the most frames the trace may hold (default {DEFAULT_MAX_FRAMES}; 0 = no limit)")
     p.add_argument("--title", help="the picture's title (default: the file and the chain)")
     p.add_argument("--size", default="10x7.5", help="width x height in inches (default 10x7.5)")
     p.add_argument("--dpi", type=int, default=100, help="PNG resolution (default 100)")
@@ -252,8 +261,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 raise ValueError
         except ValueError:
             raise PlotError(f"--size {args.size!r}: WIDTHxHEIGHT in inches, e.g. 10x7.5") from None
-        if args.max_points < 64:
-            raise PlotError(f"--max-points {args.max_points}: at least 64")
+        if args.max_points < 64 or args.max_points > MAX_POINTS:
+            raise PlotError(f"--max-points {args.max_points}: from 64 to {MAX_POINTS} "
+                            "(samples per chip; a picture has a few thousand columns)")
+        if args.max_frames < 0:
+            raise PlotError(f"--max-frames {args.max_frames}: a number of frames, 0 for no limit")
         if args.dpi < 10 or args.dpi > 1200:
             raise PlotError(f"--dpi {args.dpi}: from 10 to 1200")
         if args.number_from.lower() not in ("miso", "mosi"):
@@ -271,7 +283,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         bar = TerminalProgress(Path(args.trace).name)
         try:
             out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
-                       format=args.format, select=args.select, max_points=args.max_points, title=args.title,
+                       format=args.format, select=args.select, max_points=args.max_points,
+                       max_frames=args.max_frames, title=args.title,
                        size=(width, height), dpi=args.dpi, number_from=args.number_from, progress=bar)
         finally:
             bar.clear()

@@ -1,6 +1,8 @@
 // The l6470emu._l6470emu extension module: the emulator for Python (bindings over daisychain/,
 // spi/ traces and the tools' trace input). The package's __init__.py re-exports it.
 #include "bindings.hpp"
+#include "daisychain/motion_series.hpp"
+#include "spi/trace.hpp"
 
 PYBIND11_MODULE(_l6470emu, m) {
   m.doc() =
@@ -8,6 +10,10 @@ PYBIND11_MODULE(_l6470emu, m) {
       "L6482, powerSTEP01): daisy chains in virtual time, byte-exact SPI, pins, faults, traces.";
   m.attr("__version__") = L6470EMU_VERSION;
   m.attr("TICKS_PER_SECOND") = 4'000'000;
+  // The bounds on the work a trace may ask for (max_frames=, max_points=): spi/trace.hpp and
+  // daisychain/motion_series.hpp hold them.
+  m.attr("DEFAULT_MAX_FRAMES") = l6470emu::kDefaultMaxTraceFrames;
+  m.attr("MAX_MOTION_POINTS") = l6470emu::kMaxMotionPoints;
   l6470emu::python::bind_registers(m);
   l6470emu::python::bind_chain(m);
   l6470emu::python::bind_trace(m);

@@ -152,8 +152,8 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
   m.def(
       "motion",
       [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
-         py::handle end, std::size_t max_points, std::size_t max_commands, const std::string& number_from,
-         py::handle progress) {
+         py::handle end, py::handle max_points, std::size_t max_commands, const std::string& number_from,
+         py::handle progress, py::handle max_frames) {
         if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
           throw py::type_error("progress: a function progress(stage, done, total, unit), or None");
         PyProgress told(progress);
@@ -165,7 +165,8 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
         }
         o.from = tick_from_seconds(start, "start", 0);
         o.to = tick_from_seconds(end, "end", kNever);
-        o.max_points = max_points;
+        o.max_points = static_cast<std::size_t>(
+            int_in_range(max_points, "max_points", 0, static_cast<long long>(kMaxMotionPoints)));
         o.max_commands = max_commands;
         if (!chips.is_none()) {
           if (!py::isinstance<py::sequence>(chips) || py::isinstance<py::str>(chips))
@@ -176,7 +177,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
         PyMotion result;
         result.number_from = to_string(o.number_from);
         result.numbering = describe_numbering(o.number_from);
-        const Source source = source_of(trace, chain, format, select);
+        const Source source = source_of(trace, chain, format, select, max_frames_arg(max_frames));
         result.how = source.how;
         {
           py::gil_scoped_release unlocked;
@@ -200,7 +201,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("select") = "", py::arg("chips") = py::none(), py::arg("start") = py::none(), py::arg("end") = py::none(),
       py::arg("max_points") = 4000, py::arg("max_commands") = 2000, py::arg("number_from") = "miso",
-      py::arg("progress") = py::none(),
+      py::arg("progress") = py::none(), py::arg("max_frames") = kDefaultMaxTraceFrames,
       R"(Replays a trace through a fresh emulated chain and samples what each chip did.
 
 trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
@@ -212,14 +213,20 @@ still going). Samples are the chips' exact states at their ticks: at the window'
 after every event that touches a chip, at every change of the motion rule (the ends of
 acceleration, constant speed and deceleration: MOT_STATUS and BUSY edges to the tick) and
 on a grid of about max_points / 4 steps; long runs are thinned to at most max_points per
-chip. progress, if given, is called as progress(stage, done, total, unit) while the trace is
+chip (at most 100000, ValueError beyond; fewer than 64 are taken as 64). max_frames: the most frames a trace file may hold
+(native repeat lines counted as the frames they stand for; 0: no limit): a file asking for
+more raises TraceError at once. progress, if given, is called as progress(stage, done, total, unit) while the trace is
 read ("reading": finding its end) and replayed ("replaying"): done and total count "bytes" of
 the file or "events" (total 0: not known), done never goes back within a stage, and each
 stage ends with done == total; at most about 10 calls a second (format_progress() draws a
 bar of them). Raises ValueError for chips outside the chain or an empty window, TraceError for
 malformed traces.)");
 
-  m.def("format_progress", &format_progress, py::arg("label"), py::arg("done"), py::arg("total"), py::arg("unit"),
+  m.def("format_progress",
+        [](std::string_view label, std::uint64_t done, std::uint64_t total, std::string_view unit, std::size_t width) {
+          return format_progress(label, done, total, unit, width);
+        },
+        py::arg("label"), py::arg("done"), py::arg("total"), py::arg("unit"),
         py::arg("width") = 80,
         R"(One line of progress, width characters at most, as the l6470emu program draws it on a
 terminal: "replaying run.trace [#####-----]  50% 12.0 of 24.0 MB". unit "bytes" is shown in

@@ -120,29 +120,37 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def(py::init<>(), "An empty trace.")
       .def_static(
           "load",
-          [](py::handle path, py::object format, std::string select) {
+          [](py::handle path, py::object format, std::string select, py::handle max_frames) {
             const std::string p = path_from(path, "path");
             TraceInputOptions options;
             options.format = format_arg(format);
             options.import.select = select;
+            options.import.max_frames = max_frames_arg(max_frames);
             py::gil_scoped_release unlocked;
             return std::make_shared<Trace>(TraceFile(p, options).load());
           },
-          py::arg("path"), py::arg("format") = py::none(), py::arg("select") = "",
+          py::arg("path"), py::arg("format") = py::none(), py::arg("select") = "", py::kw_only(),
+          py::arg("max_frames") = kDefaultMaxTraceFrames,
           "Reads a trace file; format (\"native\", \"saleae\", \"umockdev\", \"ftrace\", \"sigrok\", \"vcd\") is "
-          "recognised from the content when None; select picks one stream of a file that holds several.")
+          "recognised from the content when None; select picks one stream of a file that holds several. A file "
+          "holding more than max_frames frames (native repeat lines counted as the frames they stand for; 0: no "
+          "limit) is refused with a TraceError.")
       .def_static(
           "parse",
-          [](const std::string& text, std::string name, py::object format) {
+          [](const std::string& text, std::string name, py::object format, py::handle max_frames) {
             TraceFormat f = format_arg(format);
             if (f == TraceFormat::unknown) f = detect_trace_format(text, name);
             if (f == TraceFormat::unknown)
               throw TraceError(name, 0, "unknown trace format (native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON)");
             if (f == TraceFormat::vcd) throw TraceError(name, 0, "a VCD capture needs sigrok-cli: use Trace.load(path)");
-            return std::make_shared<Trace>(import_trace(text, name, f));
+            ImportOptions options;
+            options.max_frames = max_frames_arg(max_frames);
+            return std::make_shared<Trace>(import_trace(text, name, f, options));
           },
-          py::arg("text"), py::arg("name") = "<text>", py::arg("format") = py::none(),
-          "Reads a trace from text (any text format; recognised from the content when format is None).")
+          py::arg("text"), py::arg("name") = "<text>", py::arg("format") = py::none(), py::kw_only(),
+          py::arg("max_frames") = kDefaultMaxTraceFrames,
+          "Reads a trace from text (any text format; recognised from the content when format is None); at most "
+          "max_frames frames (0: no limit).")
       .def("save", [](const Trace& t, py::handle path) {
              const std::string p = path_from(path, "path");
              const std::string text = to_native_text(t);
@@ -234,10 +242,10 @@ text; a Chain made with record=True gives one as Chain.trace.)")
   m.def(
       "replay",
       [](py::handle trace, py::handle chain, py::handle format, bool keep_going, std::size_t max_reports,
-         bool compare_pins, const std::string& number_from) {
+         bool compare_pins, const std::string& number_from, py::handle max_frames) {
         ReplayOptions o;
         o.number_from = number_from_arg(number_from);
-        const Source s = source_of(trace, chain, format);
+        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames));
         o.keep_going = keep_going;
         o.max_reports = max_reports;
         o.compare_pins = compare_pins;
@@ -252,20 +260,22 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("keep_going") = false, py::arg("max_reports") = 100, py::arg("compare_pins") = true,
-      py::arg("number_from") = "miso",
+      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames,
       R"(Drives a trace's MOSI into a fresh emulated chain with the captured timing and compares every
 MISO byte (and BUSY/FLAG observation). trace: a Trace or a file path. chain: the chain
 (default: the trace's own; for a file without one, guessed from its frame lengths), chip 0
 at the MISO end as in trace files. number_from: which end the reports call chip 0, "miso"
-(chip 0 drives MISO, the default) or "mosi" (chip 0 reads the host's MOSI).)");
+(chip 0 drives MISO, the default) or "mosi" (chip 0 reads the host's MOSI). max_frames: the
+most frames a trace file may hold (native repeat lines counted as the frames they stand for;
+0: no limit); a file asking for more raises TraceError at once.)");
 
   m.def(
       "decode",
       [](py::handle trace, py::handle chain, py::handle format, bool show_nops, std::size_t max_repeats,
-         py::object only_chip, const std::string& number_from) {
+         py::object only_chip, const std::string& number_from, py::handle max_frames) {
         DecodeOptions o;
         o.number_from = number_from_arg(number_from);
-        const Source s = source_of(trace, chain, format);
+        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames));
         o.show_nops = show_nops;
         o.max_repeats = max_repeats;
         if (!only_chip.is_none())
@@ -285,10 +295,11 @@ at the MISO end as in trace files. number_from: which end the reports call chip 
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("show_nops") = false, py::arg("max_repeats") = 10, py::arg("only_chip") = py::none(),
-      py::arg("number_from") = "miso",
+      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames,
       R"(Explains a trace: every command and answer per chip, with protocol diagnostics (as `l6470emu decode`).
 number_from: which end the log calls chip 0, "miso" (chip 0 drives MISO, the default) or "mosi"
-(chip 0 reads the host's MOSI); only_chip is a number in the same convention.)");
+(chip 0 reads the host's MOSI); only_chip is a number in the same convention. max_frames: as
+for replay().)");
 }
 
 }  // namespace l6470emu::python

@@ -1,5 +1,7 @@
 #include "trace_source.hpp"
 
+#include <limits>
+
 #include "convert.hpp"
 #include "daisychain/chain_spec.hpp"
 #include "spi/trace_import.hpp"
@@ -15,7 +17,12 @@ TraceFormat format_arg(const py::object& format) {
   return f;
 }
 
-Source source_of(py::handle trace, py::handle chain, py::handle format, const std::string& select) {
+std::uint64_t max_frames_arg(py::handle max_frames) {
+  return static_cast<std::uint64_t>(int_in_range(max_frames, "max_frames", 0, std::numeric_limits<long long>::max()));
+}
+
+Source source_of(py::handle trace, py::handle chain, py::handle format, const std::string& select,
+                 std::uint64_t max_frames) {
   Source s;
   std::string spec;
   if (!chain.is_none()) spec = chain_spec_from(chain);
@@ -44,6 +51,7 @@ Source source_of(py::handle trace, py::handle chain, py::handle format, const st
   TraceInputOptions options;
   options.format = format_arg(py::reinterpret_borrow<py::object>(format));
   options.import.select = select;
+  options.import.max_frames = max_frames;
   {
     py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
     s.file = std::make_unique<TraceFile>(path, options);

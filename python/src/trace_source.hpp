@@ -27,9 +27,15 @@ struct Source {
   std::unique_ptr<TraceReader> reader() const { return trace ? trace->reader() : file->read(); }
 };
 
+/// A max_frames= argument: the most frames a trace file may hold, 0 for no limit (ValueError
+/// when negative, TypeError when not an int).
+std::uint64_t max_frames_arg(py::handle max_frames);
+
 /// `trace` (a Trace or a path) with `chain` (None: the trace's own), `format` and, for files
-/// holding several streams, `select`. Raises ValueError for a trace without a chain or a bad
-/// chain, TraceError for a file that cannot be read.
-Source source_of(py::handle trace, py::handle chain, py::handle format, const std::string& select = "");
+/// holding several streams, `select`; a file may hold at most `max_frames` frames (0: no limit).
+/// Raises ValueError for a trace without a chain or a bad chain, TraceError for a file that
+/// cannot be read or holds too many frames.
+Source source_of(py::handle trace, py::handle chain, py::handle format, const std::string& select = "",
+                 std::uint64_t max_frames = kDefaultMaxTraceFrames);
 
 }  // namespace l6470emu::python

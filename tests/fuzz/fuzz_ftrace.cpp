@@ -9,11 +9,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::count_input(size);
   for (FtraceFraming framing :
        {FtraceFraming::automatic, FtraceFraming::cs, FtraceFraming::transfer, FtraceFraming::message}) {
-    fuzz::run_reader(data, size, "fuzz.txt", [framing](std::string_view text, const std::string& name) {
-      ImportOptions options;
-      options.ftrace_framing = framing;
-      return import_ftrace(text, name, options);
-    });
+    ImportOptions options;
+    options.ftrace_framing = framing;
+    fuzz::run_reader(
+        data, size, "fuzz.txt",
+        [&options](std::string_view text, const std::string& name) { return import_ftrace(text, name, options); },
+        TraceFormat::ftrace, options);
   }
   return 0;
 }

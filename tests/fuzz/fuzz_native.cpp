@@ -14,19 +14,6 @@ using namespace l6470emu;
 
 namespace {
 
-/// The input as a file (a memfd, named through /proc) for the streaming reader.
-std::string as_file(const std::uint8_t* data, std::size_t size, int& fd) {
-  fd = memfd_create("fuzz.trace", MFD_CLOEXEC);
-  if (fd < 0) return {};
-  std::size_t done = 0;
-  while (done < size) {
-    const ssize_t n = ::write(fd, data + done, size - done);
-    if (n <= 0) break;
-    done += static_cast<std::size_t>(n);
-  }
-  return "/proc/self/fd/" + std::to_string(fd);
-}
-
 /// Events read before the harness stops: a `repeat` line may stand for 10^12 frames, which
 /// the reader hands out lazily; the harness does not wait for them all.
 constexpr std::size_t kMaxEvents = 20'000;
@@ -46,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (starts_with_gzip_magic(text)) {
     // gzip is read from files only: zlib on damaged, cut or lying compressed data.
     int fd = -1;
-    const std::string path = as_file(data, size, fd);
+    const std::string path = fuzz::as_file(data, size, fd);
     if (path.empty()) return 0;
     try {
       NativeTraceReader r(path);
@@ -71,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   // The streaming reader on the same bytes.
   int fd = -1;
-  const std::string path = as_file(data, size, fd);
+  const std::string path = fuzz::as_file(data, size, fd);
   if (!path.empty()) {
     std::string file_error;
     Trace from_file;

@@ -8,6 +8,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::count_input(size);
   fuzz::run_reader(data, size, "fuzz.csv", [](std::string_view text, const std::string& name) {
     return import_saleae_csv(text, name);
-  });
+  }, TraceFormat::saleae);
   return 0;
 }

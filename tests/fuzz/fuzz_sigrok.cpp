@@ -9,6 +9,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   fuzz::count_input(size);
   fuzz::run_reader(data, size, "fuzz.json", [](std::string_view text, const std::string& name) {
     return import_sigrok_json(text, name);
-  });
+  }, TraceFormat::sigrok);
   return 0;
 }

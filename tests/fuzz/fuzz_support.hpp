@@ -3,6 +3,9 @@
 // decode and replay" for the trace-reader harnesses. Header-only; harnesses only.
 #pragma once
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdarg>
 #include <cstdint>
@@ -19,6 +22,7 @@
 #include "daisychain/replay.hpp"
 #include "spi/trace.hpp"
 #include "spi/trace_import.hpp"
+#include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu::fuzz {
@@ -173,19 +177,62 @@ inline void check_native_round_trip(const Trace& t) {
   }
 }
 
+/// The input as a file (a memfd, named through /proc) for the readers that stream a file; `fd`
+/// gets the descriptor to close. Empty when no memfd could be made.
+inline std::string as_file(const std::uint8_t* data, std::size_t size, int& fd) {
+  fd = memfd_create("fuzz.input", MFD_CLOEXEC);
+  if (fd < 0) return {};
+  std::size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n <= 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  return "/proc/self/fd/" + std::to_string(fd);
+}
+
 /// Runs one reader over the input: a trace (checked, written back, decoded and replayed) or
-/// a one-line TraceError naming the file. Anything else escapes and is a crash.
+/// a one-line TraceError naming the file. Anything else escapes and is a crash. The same bytes
+/// are also read as a file, streamed a chunk at a time (import_trace_file with `format` and
+/// `options`, as the l6470emu program reads them): the same events or the same error, and a
+/// gzip input goes through zlib there.
 template <class Import>
-void run_reader(const std::uint8_t* data, std::size_t size, const std::string& name, Import import) {
+void run_reader(const std::uint8_t* data, std::size_t size, const std::string& name, Import import, TraceFormat format,
+                const ImportOptions& options = {}) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   (void)detect_trace_format(text.substr(0, 64 * 1024), name);
   Trace t;
+  std::string memory_error;
   try {
     t = import(text, name);
   } catch (const TraceError& e) {
     check_error_line(e, name);
-    return;
+    memory_error = e.what();
   }
+
+  int fd = -1;
+  const std::string path = as_file(data, size, fd);
+  if (!path.empty()) {
+    Trace from_file;
+    std::string file_error;
+    try {
+      from_file = import_trace_file(path, format, options);
+    } catch (const TraceError& e) {
+      check_error_line(e, path);
+      file_error = e.what();
+    }
+    ::close(fd);
+    if (starts_with_gzip_magic(text)) {
+      if (file_error.empty()) check_trace(from_file);  // what the text was compressed from
+    } else {
+      auto strip = [](const std::string& m, const std::string& n) { return m.rfind(n, 0) == 0 ? m.substr(n.size()) : m; };
+      FUZZ_CHECK(strip(memory_error, name) == strip(file_error, path),
+                 "reading from memory and from a file differ:\n  %.300s\n  %.300s", memory_error.c_str(),
+                 file_error.c_str());
+      if (memory_error.empty()) check_same_events(t, from_file, "memory vs file");
+    }
+  }
+  if (!memory_error.empty()) return;
   check_trace(t);
   check_native_round_trip(t);
   decode_and_replay(t);

@@ -4,6 +4,7 @@
 #include "linux/virtual_scheduler.hpp"
 
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
@@ -66,12 +67,14 @@ class Worker {
     s_.thread_started();
     t_ = std::thread([this, body] {
       body();
+      exited_ = true;
       s_.thread_exited(this);
     });
   }
   void join() {
     VirtualScheduler::Wait w;
     w.object = this;
+    w.try_now = [this] { return exited_.load(); };  // as pthread_join's: a thread gone already is no wait
     s_.wait_in(w, [this] { t_.join(); });
   }
   ~Worker() {
@@ -81,6 +84,7 @@ class Worker {
 
  private:
   VirtualScheduler& s_;
+  std::atomic<bool> exited_{false};
   std::thread t_;
 };
 
@@ -342,6 +346,134 @@ TEST(VirtualScheduler, ManyThreadsSleepingInALoopSeeTheSameTimesEveryRun) {
       EXPECT_EQ(std::stoul(l.substr(2)) % static_cast<unsigned long>(k * 7), 0u) << l;
     }
   }
+}
+
+TEST(VirtualScheduler, MoreEdgesThanOneDecisionTakesBeforeADeadlineAreWorkedThroughNotLeftHanging) {
+  // An edge at every tick that wakes nobody (a line nobody waits on toggling): one decision stops
+  // after 10^5 of them, and the waiter takes the decision up again until its deadline comes.
+  FakeBoard board;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.next_edge = [&board] { return board.now.load() + 1; };
+  VirtualScheduler s(std::move(h), 0, 1);
+  VirtualScheduler::Wait w;
+  w.deadline = 250'000;
+  w.watches_board = true;
+  EXPECT_EQ(s.wait(w), End::timed_out);
+  EXPECT_EQ(board.now.load(), 250'000u);
+}
+
+/// A pipe whose read end the waiters of the deadlock tests poll: writing to it ends their waits.
+struct WakePipe {
+  int fd[2] = {-1, -1};
+  WakePipe() { EXPECT_EQ(pipe(fd), 0); }
+  ~WakePipe() {
+    close(fd[0]);
+    close(fd[1]);
+  }
+  void wake() const { [[maybe_unused]] const ssize_t n = ::write(fd[1], "w", 1); }
+};
+
+/// Two threads (the test's own and a worker) wait on `pipe` with no deadline, `hooks` as given.
+/// Returns the deadlock reports the hook got.
+std::vector<std::string> both_wait_on(FakeBoard& board, VirtualScheduler::Hooks hooks, const WakePipe& pipe,
+                                      bool outside = false) {
+  std::vector<std::string> reports;
+  hooks.deadlock = [&](const std::string& report) {
+    reports.push_back(report);
+    pipe.wake();  // the hook must end the process; this one ends the waits instead
+  };
+  VirtualScheduler s(std::move(hooks), 0, 1);
+  // A thread the scheduler does not count (another process, as far as it knows) wakes them
+  // when no deadlock ends the waits.
+  std::thread outsider([&] {
+    for (int i = 0; i < 200 && s.waiting() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    pipe.wake();
+  });
+  const pollfd p{pipe.fd[0], POLLIN, 0};
+  auto wait_on_pipe = [&](const char* call) {
+    VirtualScheduler::Wait w;
+    w.call = call;
+    w.fds = std::span<const pollfd>(&p, 1);
+    w.outside = outside;
+    return s.wait(w);
+  };
+  Worker worker(s, [&] { EXPECT_EQ(wait_on_pipe("read"), End::ready); });
+  wait_until_waiting(s, 1);
+  EXPECT_EQ(wait_on_pipe("poll"), End::ready);
+  worker.join();
+  outsider.join();
+  EXPECT_TRUE(board.jumps.empty());
+  return reports;
+}
+
+TEST(VirtualSchedulerDeadlock, EveryThreadWaitingOnWhatOnlyTheProcessCouldEndIsReportedWithWhatEachWaitsOn) {
+  FakeBoard board;
+  WakePipe pipe;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.inside_fd = [&](int fd) { return fd == pipe.fd[0]; };
+  h.describe_fd = [](int fd) { return "fd " + std::to_string(fd) + " (a line request)"; };
+  h.describe_board = [] { return std::string("chip 0 BUSY high\nno edge to come"); };
+  const std::vector<std::string> reports = both_wait_on(board, h, pipe);
+  ASSERT_EQ(reports.size(), 1u);
+  const std::string& r = reports[0];
+  EXPECT_EQ(r.rfind("virtual time: deadlock at t=0.000000 s: every thread waits and nothing can wake any of them", 0), 0u)
+      << r;
+  EXPECT_NE(r.find("the run ends with exit status 86"), std::string::npos) << r;
+  const std::string fd = "fd " + std::to_string(pipe.fd[0]) + " (a line request), no timeout";
+  EXPECT_NE(r.find("): read() on " + fd), std::string::npos) << r;
+  EXPECT_NE(r.find("): poll() on " + fd), std::string::npos) << r;
+  EXPECT_NE(r.find("\n  chip 0 BUSY high\n  no edge to come"), std::string::npos) << r;
+}
+
+TEST(VirtualSchedulerDeadlock, IsNotDeclaredWhileAWaitCouldBeEndedFromOutsideTheProcess) {
+  WakePipe pipe;
+  {
+    FakeBoard board;  // a descriptor another process may write to
+    VirtualScheduler::Hooks h = board.hooks();
+    h.inside_fd = [](int) { return false; };
+    EXPECT_TRUE(both_wait_on(board, h, pipe).empty());
+  }
+  char drain[8];
+  [[maybe_unused]] ssize_t n = ::read(pipe.fd[0], drain, sizeof drain);
+  {
+    FakeBoard board;  // a process-shared semaphore or condition variable
+    VirtualScheduler::Hooks h = board.hooks();
+    h.inside_fd = [](int) { return true; };
+    EXPECT_TRUE(both_wait_on(board, h, pipe, true).empty());
+  }
+  n = ::read(pipe.fd[0], drain, sizeof drain);
+  {
+    FakeBoard board;  // an armed alarm: its signal may come (said once)
+    VirtualScheduler::Hooks h = board.hooks();
+    h.inside_fd = [](int) { return true; };
+    h.outside_wakeup = [] { return std::string("an alarm() is armed"); };
+    EXPECT_TRUE(both_wait_on(board, h, pipe).empty());
+    ASSERT_EQ(board.log.size(), 1u);
+    EXPECT_NE(board.log[0].find("but an alarm() is armed: waiting for its signal in real time"), std::string::npos);
+  }
+}
+
+TEST(VirtualSchedulerDeadlock, IsNotDeclaredWhileAThreadRunsOrAWakeUpIsToCome) {
+  FakeBoard board;
+  std::vector<std::string> reports;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.inside_fd = [](int) { return true; };
+  h.deadlock = [&](const std::string& r) { reports.push_back(r); };
+  VirtualScheduler s(std::move(h), 0, 1);
+  int object = 0;
+  Worker waiter(s, [&] {
+    VirtualScheduler::Wait w;  // no deadline: only notify() ends it
+    w.object = &object;
+    EXPECT_EQ(s.wait(w), End::notified);
+  });
+  wait_until_waiting(s, 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // this thread runs: no verdict
+  EXPECT_EQ(sleep_until(s, 500), End::timed_out);  // a deadline to come: time jumps instead
+  EXPECT_EQ(s.notify(&object, false), 1);
+  waiter.join();
+  EXPECT_TRUE(reports.empty());
+  EXPECT_EQ(board.jumps, (std::vector<Tick>{500}));
 }
 
 }  // namespace

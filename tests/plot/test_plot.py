@@ -110,6 +110,10 @@ def test_a_long_run_is_bounded_and_keeps_its_extremes():
     ([], "required"),
     (["{three}", "-o", "/nonexistent-dir/x.png"], "No such file or directory"),
     (["{garbage}", "-o", "x.png"], "unknown trace format"),
+    (["{three}", "-o", "x.png", "--max-points", "4611686018427387904"], "--max-points 4611686018427387904: from 64 to 100000"),
+    (["{three}", "-o", "x.png", "--max-points", "10000000"], "--max-points 10000000: from 64 to 100000"),
+    (["{three}", "-o", "x.png", "--max-frames", "10"], "three_chips.trace:"),
+    (["{three}", "-o", "x.png", "--max-frames", "-1"], "--max-frames -1: a number of frames"),
 ])
 def test_bad_input_is_one_line_and_exit_status_2(tmp_path, args, says):
     garbage = tmp_path / "garbage.bin"

@@ -181,3 +181,51 @@ def test_save_names_the_file_and_the_reason(tmp_path):
     trace.save(tmp_path / "t.trace.gz")
     assert (tmp_path / "t.trace.gz").read_bytes()[:2] == b"\x1f\x8b"
     assert len(l6470emu.Trace.load(tmp_path / "t.trace.gz")) == len(trace)
+
+
+BOMB = ("l6470emu-trace 1\nchain L6470\n0.00000000 frame 0.25us 00 | 00\n"
+        "1000000.00000000 repeat 1 frame 1000000000000 times every 1.00us\n")
+
+
+@pytest.mark.parametrize("call", [l6470emu.replay, l6470emu.decode, l6470emu.motion, l6470emu.Trace.load])
+def test_a_trace_asking_for_a_trillion_frames_is_refused_at_once_with_the_line(tmp_path, call):
+    bomb = tmp_path / "bomb.trace"
+    bomb.write_text(BOMB)
+    with pytest.raises(l6470emu.TraceError) as e:
+        call(bomb)
+    assert str(e.value) == (f"{bomb}:4: repeat: 1000000000000 repetitions of 1 frame make the trace 1000000000001 "
+                            "frames long: more than 10000000 frames, the limit (raise it with --max-frames N, or "
+                            "max_frames=N in Python; 0 = no limit)")
+    assert e.value.line == 4
+    with pytest.raises(l6470emu.TraceError, match="more than 999 frames, the limit"):
+        call(bomb, max_frames=999)
+
+
+@pytest.mark.parametrize("call", [l6470emu.replay, l6470emu.decode, l6470emu.motion])
+def test_max_frames_raises_the_limit_and_counts_repeated_frames(tmp_path, call):
+    path = tmp_path / "t.trace"
+    path.write_text("l6470emu-trace 1\nchain L6470\n0 frame 0.25us 00 | 00\n0.00000100 frame 0.25us 00 | 00\n"
+                    "0.00020100 repeat 2 frames 20 times every 10.00us\n")
+    with pytest.raises(l6470emu.TraceError, match=r":5: repeat: 20 repetitions of 2 frames make the trace 42 frames"):
+        call(path, max_frames=41)
+    call(path, max_frames=42)
+    call(path, max_frames=0)  # no limit
+    with pytest.raises(ValueError, match="max_frames"):
+        call(path, max_frames=-1)
+    assert l6470emu.DEFAULT_MAX_FRAMES == 10_000_000
+
+
+def test_parse_takes_the_same_bound():
+    with pytest.raises(l6470emu.TraceError, match=r"bomb:4: repeat: .* more than 10000000 frames"):
+        l6470emu.Trace.parse(BOMB, "bomb")
+    with pytest.raises(l6470emu.TraceError, match=r"t.csv:\d+: the trace holds more than 2 frames"):
+        rows = "".join(f'"SPI","enable",0.{i}1,2e-08,,\n"SPI","result",0.{i}2,1e-06,0xD0,0x00\n'
+                       f'"SPI","disable",0.{i}3,2e-08,,\n' for i in range(1, 5))
+        l6470emu.Trace.parse('name,type,start_time,duration,"mosi","miso"\n' + rows, "t.csv", max_frames=2)
+
+
+@pytest.mark.parametrize("points", [2**62, 2**80, 100_001, -1])
+def test_motion_refuses_more_points_than_a_picture_can_use(points):
+    with pytest.raises(ValueError, match=r"max_points .* out of range 0\.\.100000"):
+        l6470emu.motion(FIXTURES / "three_chips.trace", max_points=points)
+    assert len(l6470emu.motion(FIXTURES / "three_chips.trace", max_points=l6470emu.MAX_MOTION_POINTS).chips) == 3

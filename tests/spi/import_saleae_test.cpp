@@ -210,10 +210,14 @@ TEST(SaleaeImport, AcceptsTimesWithALeadingDotAsSaleaeWritesThem) {
 
 TEST(SaleaeImport, QuotesAHugeBadValueShortAndEscaped) {
   const std::string open = "\"SPI\",\"enable\",0.1,2e-08,,\n";
-  const std::string huge(10'000'000, 'Z');
+  const std::string huge(5'000'000, 'Z');
   const std::string e = error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0x" + huge + ",0x00\n");
   EXPECT_LT(e.size(), 200u);
   EXPECT_EQ(e, "capture.csv:3: MOSI \"0x" + std::string(58, 'Z') + "\u2026\" is not a byte");
+  // A line longer than any trace needs is refused as such.
+  EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0x" + huge + huge + ",0x00\n"),
+            "capture.csv:3: a line longer than 8388608 bytes (a frame holds at most 1048576 bytes: not a trace, or a "
+            "damaged one)");
   EXPECT_EQ(error_of(kHeader + open + "\"SPI\",\"result\",0.10000001,1e-06,0x\x1b[2J\x07,0x00\n"),
             "capture.csv:3: MOSI \"0x\\x1B[2J\\x07\" is not a byte");
 }

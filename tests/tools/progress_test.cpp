@@ -88,5 +88,28 @@ TEST(ProgressReader, PassesEveryEventThrough) {
   EXPECT_EQ(r.header().name, "t");
 }
 
+TEST(ProgressLine, SaysHowManyFramesWentBySoALongRepeatLineStillMovesIt) {
+  EXPECT_EQ(format_progress("replaying r.trace", 100, 200, "bytes", 80, 12'345'678),
+            "replaying r.trace [############-------------]  50% 100 B of 200 B, 12.3 M frames");
+  EXPECT_EQ(format_progress("r", 1, 2, "bytes", 60, 5), "r [###############---------------]  50% 1 B of 2 B, 5 frames");
+  EXPECT_EQ(format_progress("r", 1, 2, "bytes", 60, 0), format_progress("r", 1, 2, "bytes", 60));
+}
+
+TEST(ProgressReader, CountsTheFramesARepeatLineHandsOutOnTheBar) {
+  // 10 000 frames from 4 lines: the bytes stand still at the repeat line, the frames do not.
+  const std::string text =
+      "l6470emu-trace 1\n0 frame 00 | 00\n0.001 frame 00 | 00\n9.999 repeat 1 frame 9998 times every 1000.00us\n";
+  NativeTraceReader in(text, "t");
+  std::ostringstream err;
+  ProgressBar bar(err, true, "t");
+  ProgressTraceReader r(in, bar);
+  TraceEvent e;
+  usleep(210'000);  // the first update after this draws
+  int n = 0;
+  while (r.next(e)) ++n;
+  EXPECT_EQ(n, 10'000);
+  EXPECT_NE(err.str().find(", 4095 frames"), std::string::npos) << err.str();
+}
+
 }  // namespace
 }  // namespace l6470emu
