@@ -75,10 +75,15 @@ def figures(path):
         if m:
             f[f"SPI {int(m[1]):>3} chips, frames/s"] = float(m[2]) * SI[m[3]]
             f[f"SPI {int(m[1]):>3} chips, bytes/s"] = float(m[4]) * SI[m[5]]
+            cpu = re.search(r"x\s+(\d+)%", line)  # "on CPU" (since the column exists)
+            if cpu and int(cpu[1]) > 0:
+                f[f"SPI {int(m[1]):>3} chips, bytes per CPU s"] = float(m[4]) * SI[m[5]] * 100 / int(cpu[1])
             continue
-        m = re.match(r"\s+(fast|fast\+axes|reference)\s+([\d.]+)x\s", line)
+        m = re.match(r"\s+(fast|fast\+axes|reference)\s+([\d.]+)x\s+(?:(\d+)%)?", line)
         if m:
             f[f"motion 64 chips, {m[1]}, x real time"] = float(m[2])
+            if m[3] and int(m[3]) > 0:
+                f[f"motion 64 chips, {m[1]}, x real time per CPU s"] = float(m[2]) * 100 / int(m[3])
         m = re.search(r"costs ([\d.]+)x the time without axes", line)
         if m:
             f["axes: time with / without (lower)"] = float(m[1])
@@ -129,4 +134,6 @@ for k in names:
     ratio = f"{n / o:.2f}x" if o and n is not None else ""
     print(f"  {k:<44} {os_:>26} {ns:>26} {ratio:>8}")
 print("  (lower) marks figures where less is better; elsewhere a ratio above 1 means the new build is faster")
+print("  'per CPU s' divides by the share of wall time the benchmark ran (its 'on CPU' column, where it has one):")
+print("  what an idle machine would show")
 EOF
