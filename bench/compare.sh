@@ -127,12 +127,12 @@ print(f"l6470emu headline figures, side by side: {rounds} alternating run(s) of 
 print(f"  old: {old_desc}")
 print(f"  new: {new_desc}")
 print(f"  load average (1/5/15 min) on {cpus} CPUs: {load_before} before, {load_after} after")
-print(f"  {'figure':<44} {'old: median (range)':>26} {'new: median (range)':>26} {'new/old':>8}")
+print(f"  {'figure':<52} {'old: median (range)':>26} {'new: median (range)':>26} {'new/old':>8}")
 for k in names:
     o, os_ = column(old, k)
     n, ns = column(new, k)
     ratio = f"{n / o:.2f}x" if o and n is not None else ""
-    print(f"  {k:<44} {os_:>26} {ns:>26} {ratio:>8}")
+    print(f"  {k:<52} {os_:>26} {ns:>26} {ratio:>8}")
 print("  (lower) marks figures where less is better; elsewhere a ratio above 1 means the new build is faster")
 print("  'per CPU s' divides by the share of wall time the benchmark ran (its 'on CPU' column, where it has one):")
 print("  what an idle machine would show")

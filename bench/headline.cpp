@@ -282,10 +282,10 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < axes.chips(); ++k) lost += axes.chain().chip(k).axis()->lost_steps() != 0;
     const double cost = fast_results[0].ratio() / r.ratio();
     std::printf("  %-10s  %13.0fx  %6s  %9.3f  %9.3f  %6llu  %5llu  (%zu of %zu axes lost steps; costs %.2fx the time without"
-                " axes; goal <= %.2fx %s)\n",
+                " axes; goal <= %.2fx%s%s)\n",
                 "fast+axes", r.ratio(), percent(r.cpu_seconds / r.wall_seconds).c_str(), r.sim_seconds, r.wall_seconds,
                 static_cast<unsigned long long>(r.stats.moves_done), static_cast<unsigned long long>(r.stats.runs_done), lost,
-                axes.chips(), cost, kGoalAxisCost, verdict(cost <= kGoalAxisCost));
+                axes.chips(), cost, kGoalAxisCost, g_verdicts ? " " : "", verdict(cost <= kGoalAxisCost));
   }
   // The fast row only counts if the fast engine did the same work: replay the reference run's
   // simulated time with the fast engine and compare every chip's motion state and STATUS.
