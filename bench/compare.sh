@@ -84,7 +84,7 @@ def figures(path):
             f[f"motion 64 chips, {m[1]}, x real time"] = float(m[2])
             if m[3] and int(m[3]) > 0:
                 f[f"motion 64 chips, {m[1]}, x real time per CPU s"] = float(m[2]) * 100 / int(m[3])
-        m = re.search(r"costs ([\d.]+)x the time without axes", line)
+        m = re.search(r"costs ([\d.]+)x the (?:CPU )?time without axes", line)
         if m:
             f["axes: time with / without (lower)"] = float(m[1])
         m = re.search(r"cross-check: .*: (.*)$", line)
