@@ -153,12 +153,14 @@ board=$("$board_bench" --benchmark_filter='BM_BoardMessage/1$' --benchmark_forma
 echo
 echo "A virtual-time driver test, end to end: one L6470 (time=virtual), GetStatus polled in a tight loop,"
 echo "one CS frame per byte (0xD0, 0x00, 0x00: three SPI_IOC_MESSAGE(1) round trips per poll);"
-echo "load average $(cut -d' ' -f1-3 /proc/loadavg)"
-printf '%-34s %14s %18s %14s %14s\n' "client" "round trips/s" "host s per wall s" "wall ns/trip" "CPU ns/trip"
+echo "load average $(cut -d' ' -f1-3 /proc/loadavg); on a busy machine the CPU figures are what an idle one shows"
+printf '%-34s %14s %18s %17s %14s %14s\n' "client" "round trips/s" "host s per wall s" "host s per CPU s" "wall ns/trip" \
+  "CPU ns/trip"
 row() {  # row NAME "COUNT WALL_S PER_WALL_S HOST_S CPU_S"
   if [ "$2" = "n/a" ]; then printf '%-34s %14s\n' "$1" "n/a (no python3-spidev)"; return; fi
   awk -v name="$1" -v line="$2" 'BEGIN { split(line, f)
-    printf "%-34s %14.0f %18.1f %14.0f %14.0f\n", name, f[3], f[4] / f[2], f[2] / f[1] * 1e9, f[5] / f[1] * 1e9 }'
+    printf "%-34s %14.0f %18.1f %17.1f %14.0f %14.0f\n", name, f[3], f[4] / f[2], f[4] / f[5], f[2] / f[1] * 1e9,
+      f[5] / f[1] * 1e9 }'
 }
 row "C (l6470emu_preload_roundtrips)" "$c_poll"
 row "Python 3 + python3-spidev (xfer2)" "$py_poll"
