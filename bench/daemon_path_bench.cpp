@@ -1,8 +1,10 @@
-// Where a daemon round trip's time goes (bench/preload_bench.sh measures the whole): the board
-// serving one SPI_IOC_MESSAGE(1) packet (serve_request), the same through a shared region
-// (serve_shared_request: copy-in, dispatch, reply), and the region's hand-off between two threads
-// with a trivial server (the cross-core latency a preload client and the daemon pay on top).
-// All on a virtual-time board, one L6470; no preload library, no second process.
+// Where a preload or daemon round trip's time goes (bench/preload_bench.sh measures the whole):
+// the board alone running one SPI_IOC_MESSAGE(1) of one byte (DeviceBoard::spi_message, the board's
+// share of every round trip, the in-process preload's too), the board serving the same as a
+// packet (serve_request), the same through a shared region (serve_shared_request: copy-in,
+// dispatch, reply), and the region's hand-off between two threads with a trivial server (the
+// cross-core latency a preload client and the daemon pay on top).
+// All on a virtual-time board, one L6470 in SPI mode 3 at 5 MHz; no preload library, no second process.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -10,6 +12,8 @@
 #include <cstring>
 #include <thread>
 #include <vector>
+
+#include <linux/spi/spidev.h>
 
 #include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
@@ -21,7 +25,13 @@ using namespace l6470emu;
 
 struct VirtualBoard {
   VirtualBoard() : board(*parse_board_config("bus=0 cs=0 chips=L6470; time=virtual", "bench").config, log),
-                   file(board.open(0, true)) {}
+                   file(board.open(0, true)) {
+    // As a driver of these chips sets the bus (and as bench/preload_roundtrips.c does).
+    std::uint8_t mode = SPI_MODE_3;
+    std::uint32_t hz = 5'000'000;
+    board.ioctl(file.handle, SPI_IOC_WR_MODE, {&mode, 1}, nullptr);
+    board.ioctl(file.handle, SPI_IOC_WR_MAX_SPEED_HZ, {reinterpret_cast<std::uint8_t*>(&hz), sizeof hz}, nullptr);
+  }
   ~VirtualBoard() { close(file.fd); }
   DiagnosticLog log{"off"};
   DeviceBoard board;
@@ -40,6 +50,26 @@ std::vector<std::uint8_t> nop_packet(std::uint64_t handle) {
   std::memcpy(p.data() + sizeof h, &x, sizeof x);
   return p;
 }
+
+/// The board's share of a round trip: one 1-byte message, a NOP or a poll's bytes (0xD0, 0, 0 in
+/// turn, one CS frame each), straight into DeviceBoard::spi_message.
+void BM_BoardMessage(benchmark::State& state) {
+  VirtualBoard b;
+  spi_ioc_transfer x{};
+  x.tx_buf = 1;
+  x.rx_buf = 1;
+  x.len = 1;
+  std::uint8_t tx = 0, rx = 0;
+  const bool poll = state.range(0) != 0;
+  std::uint64_t i = 0;
+  for (auto _ : state) {
+    tx = poll && i++ % 3 == 0 ? 0xD0 : 0x00;
+    benchmark::DoNotOptimize(b.board.spi_message(b.file.handle, {&x, 1}, {&tx, 1}, {&rx, 1}));
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(poll ? "getstatus" : "nop");
+}
+BENCHMARK(BM_BoardMessage)->Arg(0)->Arg(1);
 
 void BM_ServeRequest(benchmark::State& state) {
   VirtualBoard b;

@@ -52,10 +52,14 @@ inline AxisSpec bench_axis() {
   return spec;
 }
 
-/// Host-side view of one axis: what the host last told it to do.
+/// Host-side view of one axis: what the host last told it to do, and what it waits for.
 struct Axis {
   enum class Phase : std::uint8_t { idle, moving, running, stopping } phase = Phase::idle;
   Tick run_until = 0;  ///< running: when to send SoftStop
+  // The next step is due when (STATUS & wake_mask) == wake_value or at wake_at (kNever: no
+  // time): the phase's condition below, kept so that a poll that changes nothing costs little.
+  std::uint16_t wake_mask = 0, wake_value = 0;
+  Tick wake_at = kNever;
 };
 
 /// What the host saw; lets a benchmark show that the motors really moved.
@@ -163,34 +167,64 @@ class MotionWorkload {
   /// one round of frames, right-aligned (shorter commands padded with NOPs in front).
   void command_round() {
     std::size_t longest = 0;
-    for (std::size_t k = 0; k < chips(); ++k) {
+    const std::size_t n = chips();
+    const Tick now = chain_.now();
+    std::uint64_t errors = 0;
+    for (std::size_t k = 0; k < n; ++k) {
       const std::uint16_t st = status_[k];
-      const bool busy = (st & busy_bit_) == 0;  // BUSY is active low
-      const bool stopped = ((st >> mot_shift_) & 3u) == 0;
-      if (st & error_bits_) ++stats_.cmd_errors;
-      Axis& a = axes_[k];
-      switch (a.phase) {
-        case Axis::Phase::moving:
-          if (!busy) { ++stats_.moves_done; a.phase = Axis::Phase::idle; }
-          break;
-        case Axis::Phase::running:
-          if (chain_.now() >= a.run_until) {
-            longest = std::max(longest, put_command(k, {0xB0}));  // SoftStop
-            a.phase = Axis::Phase::stopping;
-          }
-          break;
-        case Axis::Phase::stopping:
-          if (!busy && stopped) { ++stats_.runs_done; a.phase = Axis::Phase::idle; }
-          break;
-        case Axis::Phase::idle:
-          break;
-      }
-      if (a.phase == Axis::Phase::idle) longest = std::max(longest, start_random_motion(k));
+      errors += (st & error_bits_) != 0;
+      const Axis& a = axes_[k];
+      if ((st & a.wake_mask) == a.wake_value || now >= a.wake_at) longest = std::max(longest, next_step(k, st));
     }
+    stats_.cmd_errors += errors;
     if (longest == 0) return;
     for (std::size_t f = cmd_.size() - longest; f < cmd_.size(); ++f) {
       frame(cmd_[f], rx_);
       std::fill(cmd_[f].begin(), cmd_[f].end(), 0x00);
+    }
+  }
+
+  /// What axis k does on STATUS `st` (the axis's wake condition holds); returns the length of
+  /// the command it queued, 0 for none.
+  std::size_t next_step(std::size_t k, std::uint16_t st) {
+    const bool busy = (st & busy_bit_) == 0;  // BUSY is active low
+    const bool stopped = ((st >> mot_shift_) & 3u) == 0;
+    std::size_t longest = 0;
+    Axis& a = axes_[k];
+    switch (a.phase) {
+      case Axis::Phase::moving:
+        if (!busy) { ++stats_.moves_done; set_phase(a, Axis::Phase::idle); }
+        break;
+      case Axis::Phase::running:
+        if (chain_.now() >= a.run_until) {
+          longest = put_command(k, {0xB0});  // SoftStop
+          set_phase(a, Axis::Phase::stopping);
+        }
+        break;
+      case Axis::Phase::stopping:
+        if (!busy && stopped) { ++stats_.runs_done; set_phase(a, Axis::Phase::idle); }
+        break;
+      case Axis::Phase::idle:
+        break;
+    }
+    if (a.phase == Axis::Phase::idle) longest = std::max(longest, start_random_motion(k));
+    return longest;
+  }
+
+  /// Enters `phase` with its wake condition: a Move ends when BUSY is released, a Run is
+  /// stopped at run_until, a stop ends when BUSY is released with MOT_STATUS stopped, and an
+  /// idle axis gets a new motion at once.
+  void set_phase(Axis& a, Axis::Phase phase) const {
+    a.phase = phase;
+    a.wake_at = kNever;
+    switch (phase) {
+      case Axis::Phase::idle: a.wake_mask = a.wake_value = 0; break;
+      case Axis::Phase::moving: a.wake_mask = a.wake_value = busy_bit_; break;
+      case Axis::Phase::running: a.wake_mask = 0, a.wake_value = 1, a.wake_at = a.run_until; break;
+      case Axis::Phase::stopping:
+        a.wake_mask = static_cast<std::uint16_t>(busy_bit_ | 3u << mot_shift_);
+        a.wake_value = busy_bit_;
+        break;
     }
   }
 
@@ -200,13 +234,13 @@ class MotionWorkload {
     const bool forward = std::uniform_int_distribution<int>(0, 1)(rng_) == 1;
     if (std::uniform_int_distribution<int>(0, 1)(rng_) == 0) {
       const std::uint32_t steps = std::uniform_int_distribution<std::uint32_t>(2'000, 200'000)(rng_);
-      a.phase = Axis::Phase::moving;
+      set_phase(a, Axis::Phase::moving);
       return put_command(k, {static_cast<std::uint8_t>(0x40 | forward), steps});
     }
     const std::uint32_t top = max_speed_[k] << 10;  // MAX_SPEED in SPEED units (2^-28 step/tick)
     const std::uint32_t spd = std::uniform_int_distribution<std::uint32_t>(top / 8, top)(rng_);
-    a.phase = Axis::Phase::running;
     a.run_until = chain_.now() + ticks_from_ms(std::uniform_int_distribution<std::uint64_t>(20, 300)(rng_));
+    set_phase(a, Axis::Phase::running);
     return put_command(k, {static_cast<std::uint8_t>(0x50 | forward), spd});
   }
 

@@ -9,13 +9,19 @@
 # daemon, beyond a real 5 MHz bus's ~416 000 one-byte frames/s). Emulator speed is measured in
 # virtual time: on the wall clock every message takes its bus time, as on a real bus (printed
 # too, for scale). Each figure is the best of three runs; the machine's load is printed with them.
+# Last, the end-to-end cost of a virtual-time driver test: a C client and Debian's python3-spidev
+# polling GetStatus in a tight loop through the preload, host seconds per wall second, and each
+# round trip's cost split into the client (Python), the preload library and the board
+# (l6470emu_daemon_path_bench's BM_BoardMessage); goal: the preload's share <= 150 ns.
 set -euo pipefail
 build=${1:-build}
 build=$(cd "$build" && pwd)
 client=$build/bench/l6470emu_preload_roundtrips
 preload=$build/libl6470emu-preload.so
 emu=$build/l6470emu
-for f in "$client" "$preload" "$emu"; do
+board_bench=$build/bench/l6470emu_daemon_path_bench
+python_client=$(cd "$(dirname "$0")" && pwd)/preload_poll.py
+for f in "$client" "$preload" "$emu" "$board_bench"; do
   [ -x "$f" ] || [ -f "$f" ] || { echo "preload_bench: $f is missing; build the l6470emu_benchmarks target" >&2; exit 1; }
 done
 work=$(mktemp -d)
@@ -120,3 +126,50 @@ if [[ "$cuse" =~ ^[0-9.]+$ ]]; then
 else
   printf '%-46s %14s\n' "on this host" "$cuse"
 fi
+
+# ---- a virtual-time driver test, end to end: GetStatus polled in a tight loop ----------------
+# Each client prints "COUNT WALL_S PER_WALL_S HOST_S CPU_S", timed inside the loop (wall time by
+# the raw system call, which the preload does not see); the best of three runs by wall time.
+best_of_three() {
+  local best="" line
+  for _ in 1 2 3; do
+    line=$("$@")
+    if [ -z "$best" ] || awk -v a="$line" -v b="$best" 'BEGIN { split(a, x); split(b, y); exit !(x[2] / x[1] < y[2] / y[1]) }'; then
+      best=$line
+    fi
+  done
+  echo "$best"
+}
+poll_env=(env L6470EMU_CHAIN="bus=0 cs=0 chips=L6470; time=virtual" LD_PRELOAD="$preload")
+c_poll=$(best_of_three "${poll_env[@]}" "$client" /dev/spidev0.0 3000000 getstatus)
+py_poll="n/a"
+if /usr/bin/python3 -c "import spidev" 2>/dev/null; then
+  py_poll=$(best_of_three "${poll_env[@]}" /usr/bin/python3 "$python_client" /dev/spidev0.0 600000)
+fi
+# The board alone: DeviceBoard::spi_message of the same 1-byte messages (real and CPU ns).
+board=$("$board_bench" --benchmark_filter='BM_BoardMessage/1$' --benchmark_format=csv 2>/dev/null |
+  awk -F, '/BM_BoardMessage/ { print $3, $4 }')
+
+echo
+echo "A virtual-time driver test, end to end: one L6470 (time=virtual), GetStatus polled in a tight loop,"
+echo "one CS frame per byte (0xD0, 0x00, 0x00: three SPI_IOC_MESSAGE(1) round trips per poll);"
+echo "load average $(cut -d' ' -f1-3 /proc/loadavg); on a busy machine the CPU figures are what an idle one shows"
+printf '%-34s %14s %18s %17s %14s %14s\n' "client" "round trips/s" "host s per wall s" "host s per CPU s" "wall ns/trip" \
+  "CPU ns/trip"
+row() {  # row NAME "COUNT WALL_S PER_WALL_S HOST_S CPU_S"
+  if [ "$2" = "n/a" ]; then printf '%-34s %14s\n' "$1" "n/a (no python3-spidev)"; return; fi
+  awk -v name="$1" -v line="$2" 'BEGIN { split(line, f)
+    printf "%-34s %14.0f %18.1f %17.1f %14.0f %14.0f\n", name, f[3], f[4] / f[2], f[4] / f[5], f[2] / f[1] * 1e9,
+      f[5] / f[1] * 1e9 }'
+}
+row "C (l6470emu_preload_roundtrips)" "$c_poll"
+row "Python 3 + python3-spidev (xfer2)" "$py_poll"
+awk -v c="$c_poll" -v p="$py_poll" -v b="$board" 'BEGIN {
+  split(c, cf); split(b, bf)
+  cw = cf[2] / cf[1] * 1e9; cc = cf[5] / cf[1] * 1e9
+  printf "cost per round trip, wall ns (CPU ns):\n"
+  printf "  %-30s %6.0f (%3.0f)\n", "board (DeviceBoard::spi_message)", bf[1], bf[2]
+  printf "  %-30s %6.0f (%3.0f)   goal <= 150 ns\n", "preload (C client - board)", cw - bf[1], cc - bf[2]
+  if (p != "n/a") { split(p, pf); printf "  %-30s %6.0f (%3.0f)\n", "Python (Python - C client)", pf[2] / pf[1] * 1e9 - cw, pf[5] / pf[1] * 1e9 - cc }
+  printf "  (the C client\047s own loop, a few ns, counts in the preload\047s share)\n"
+}'

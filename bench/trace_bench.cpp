@@ -72,7 +72,7 @@ void BM_ReplayNativeTrace(benchmark::State& state) {
   record_trace(path, frames);
   ReplayResult r;
   for (auto _ : state) {
-    NativeTraceReader reader(path);
+    NativeTraceReader reader(path, /*max_frames=*/0);  // its own trace: no limit (the default stops at 10 M)
     Chain chain(kChips);
     r = replay_trace(reader, chain);
   }
@@ -166,7 +166,7 @@ void BM_RecordPollingHost(benchmark::State& state) {
   // The file reads back to every frame.
   std::uint64_t read = 0;
   {
-    NativeTraceReader reader(path);
+    NativeTraceReader reader(path, /*max_frames=*/0);  // its own trace: no limit (the default stops at 10 M)
     TraceEvent e;
     while (reader.next(e)) read += e.kind == TraceEventKind::frame;
   }
@@ -189,7 +189,7 @@ void BM_ReplayCompactPollingTrace(benchmark::State& state) {
   record_polling_host(path, NativeWriteOptions{false, true});
   ReplayResult r;
   for (auto _ : state) {
-    NativeTraceReader reader(path);
+    NativeTraceReader reader(path, /*max_frames=*/0);  // its own trace: no limit (the default stops at 10 M)
     Chain chain(1);
     r = replay_trace(reader, chain);
   }

@@ -21,12 +21,6 @@ std::int64_t floor_div(std::int64_t a, std::int64_t b) {
   return q;
 }
 
-MotionState after(const MotionState& s, const Profile& p, Tick i) {
-  MotionState c = s;
-  apply_uniform_ticks(c, p, i);
-  return c;
-}
-
 bool moving(const MotionState& s) { return motion_active(s) && !s.hiz; }
 
 }  // namespace
@@ -48,6 +42,7 @@ Axis::Axis(AxisSpec spec, std::int64_t travel)
   switches_.resize(spec_.switches.size());
   for (std::size_t i = 0; i < switches_.size(); ++i) {
     const SwitchSpec& sw = spec_.switches[i];
+    bouncing_ = bouncing_ || (sw.bounce_count > 0 && sw.bounce_ticks > 0);
     switches_[i].actuated = sw.above ? true_pos_ >= sw.position : true_pos_ <= sw.position;
     switches_[i].shown_closed = switches_[i].actuated != sw.normally_closed;
     if (switches_[i].shown_closed) sw_level_ = false;
@@ -57,13 +52,18 @@ Axis::Axis(AxisSpec spec, std::int64_t travel)
 void Axis::set_load(const LoadSpec& load) {
   if (spec_.load == load) return;
   spec_.load = load;
-  table_.clear();
+  forget_table();
 }
 
 void Axis::set_drive(const DriveInputs& drive) {
   if (drive_ == drive) return;
   drive_ = drive;
+  forget_table();
+}
+
+void Axis::forget_table() {
   table_.clear();
+  band_runs_.fill(BandRun{});
 }
 
 std::int64_t Axis::clamp(std::int64_t u) const {
@@ -72,7 +72,7 @@ std::int64_t Axis::clamp(std::int64_t u) const {
   return u;
 }
 
-std::uint8_t Axis::entry(DrivePhase phase, bool forward, std::uint32_t band) const {
+std::uint8_t Axis::compute_entry(DrivePhase phase, bool forward, std::uint32_t band) const {
   if (table_.empty()) table_.assign(std::size_t{8} * kSpeedBands, 0xFF);
   std::uint8_t& e = table_[(static_cast<std::size_t>(phase) * 2 + (forward ? 1 : 0)) * kSpeedBands + band];
   if (e != 0xFF) return e;
@@ -89,13 +89,6 @@ std::uint8_t Axis::entry(DrivePhase phase, bool forward, std::uint32_t band) con
   if (std::uint64_t{band} * 15625 <= std::uint64_t{spec_.pull_in_speed_steps_per_s} * 1024) v |= kPullIn;
   e = v;
   return e;
-}
-
-// The bits settle() acts on in the present state (synchronised or not, driven to move or not).
-std::uint8_t Axis::signature(std::uint8_t e, bool is_moving) const {
-  if (synced_) return static_cast<std::uint8_t>(e & ((is_moving ? kLost | kStallSync : 0) | kOcdSync));
-  const bool pull_in = (e & kPullIn) && !(e & kLost);
-  return static_cast<std::uint8_t>((pull_in ? kPullIn : 0) | (e & (kStallBlocked | kOcdBlocked)));
 }
 
 bool Axis::shown(const SwitchSpec& sw, const SwitchState& st, Tick now) const {
@@ -187,6 +180,7 @@ bool Axis::settle(const MotionState& s, const Profile& p, Tick now) {
 
 Tick Axis::next_time_event() const {
   Tick next = kNever;
+  if (!bouncing_) return next;
   for (std::size_t i = 0; i < switches_.size(); ++i) {
     const SwitchSpec& sw = spec_.switches[i];
     const SwitchState& st = switches_[i];
@@ -200,6 +194,19 @@ Tick Axis::next_time_event() const {
   return next;
 }
 
+std::uint32_t Axis::first_other_band(DrivePhase phase, bool forward, std::uint32_t b0, std::uint32_t bn) const {
+  // The run of bands around b0 whose signature is b0's, as far as earlier searches found it.
+  BandRun& run = band_runs_[(static_cast<std::size_t>(phase) * 2 + (forward ? 1 : 0)) * 2 + (synced_ ? 1 : 0)];
+  if (!(run.lo <= b0 && b0 <= run.hi)) run = {static_cast<std::uint16_t>(b0), static_cast<std::uint16_t>(b0)};
+  const std::uint8_t sig0 = signature(entry(phase, forward, b0), true);
+  if (bn > b0) {
+    while (run.hi < bn && signature(entry(phase, forward, run.hi + 1u), true) == sig0) ++run.hi;
+    return run.hi < bn ? run.hi + 1u : bn + 1;
+  }
+  while (run.lo > bn && signature(entry(phase, forward, run.lo - 1u), true) == sig0) --run.lo;
+  return run.lo > bn ? run.lo - 1u : bn - 1;
+}
+
 Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now) const {
   Tick best = n + 1;
   const Tick timed = next_time_event();
@@ -210,20 +217,15 @@ Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now)
   // A change of speed band that changes what settle() would decide.
   const DrivePhase phase = drive_phase(s, p);
   const std::uint32_t b0 = speed_band(s.speed);
-  const std::uint32_t bn = speed_band(after(s, p, m).speed);
+  const std::uint64_t vm = speed_after_uniform_ticks(s, p, m);
+  const std::uint32_t bn = speed_band(vm);
   if (bn != b0) {
-    const std::uint8_t sig0 = signature(entry(phase, s.dir, b0), true);
     const bool up = bn > b0;
-    for (std::uint32_t b = up ? b0 + 1 : b0 - 1;; b = up ? b + 1 : b - 1) {
-      if (signature(entry(phase, s.dir, b), true) != sig0) {
-        const Tick k = first_true(1, m, [&](Tick i) {
-          const std::uint32_t bi = speed_band(after(s, p, i).speed);
-          return up ? bi >= b : bi <= b;
-        });
-        best = std::min(best, k);
-        break;
-      }
-      if (b == bn) break;
+    const std::uint32_t b = first_other_band(phase, s.dir, b0, bn);
+    if (b != bn + (up ? 1 : -1)) {
+      // Band b begins at b * 2^22 (2^-40 step/tick); below band b + 1 is speed_band() <= b.
+      const std::uint64_t edge = std::uint64_t{up ? b : b + 1} << 22;
+      best = std::min(best, first_uniform_tick_at_speed(s, p, edge, up, m));
     }
   }
 
@@ -251,13 +253,14 @@ Tick Axis::first_event(const MotionState& s, const Profile& p, Tick n, Tick now)
         if (!fwd && act) consider(sw.position - sw.hysteresis - 1);
       }
     }
-    if (have) {
+    // The speed through the run lies between s.speed and vm, so in best - 1 ticks the motor
+    // travels at most this far (1/128 step): a goal beyond it is not reached, nothing to search.
+    const unsigned __int128 reach =
+        ((static_cast<unsigned __int128>(s.frac) + static_cast<unsigned __int128>(best - 1) * std::max(s.speed, vm)) >>
+         (40 - p.step_sel)) * p.el_increment();
+    if (have && reach >= static_cast<unsigned __int128>(fwd ? target - u : u - target)) {
       const std::int64_t goal = target - offset_;  // commanded travel at which it happens
-      const Tick k = first_true(1, best - 1, [&](Tick i) {
-        const std::int64_t t = after(s, p, i).travel;
-        return fwd ? t >= goal : t <= goal;
-      });
-      best = std::min(best, k);
+      best = std::min(best, first_uniform_tick_at_travel(s, p, goal, best - 1));
     }
   }
   return best;

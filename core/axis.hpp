@@ -4,6 +4,7 @@
 // Chip calls it after every tick it performs and asks it where its next event is.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -86,14 +87,37 @@ class Axis {
   };
   enum Bits : std::uint8_t { kLost = 1, kStallSync = 2, kOcdSync = 4, kStallBlocked = 8, kOcdBlocked = 16, kPullIn = 32 };
 
-  std::uint8_t entry(DrivePhase phase, bool forward, std::uint32_t band) const;
-  std::uint8_t signature(std::uint8_t e, bool moving) const;
+  /// The Bits of (phase, direction, speed band), worked out the first time they are asked for.
+  std::uint8_t entry(DrivePhase phase, bool forward, std::uint32_t band) const {
+    if (!table_.empty()) {
+      const std::uint8_t e = table_[(static_cast<std::size_t>(phase) * 2 + (forward ? 1 : 0)) * kSpeedBands + band];
+      if (e != 0xFF) return e;
+    }
+    return compute_entry(phase, forward, band);
+  }
+  std::uint8_t compute_entry(DrivePhase phase, bool forward, std::uint32_t band) const;
+  /// Moving from band b0 toward band bn (!= b0): the first band whose signature differs from
+  /// b0's, or the band one past bn when none does.
+  std::uint32_t first_other_band(DrivePhase phase, bool forward, std::uint32_t b0, std::uint32_t bn) const;
+  void forget_table();
+  /// The bits settle() acts on in the present state (synchronised or not, driven to move or not).
+  std::uint8_t signature(std::uint8_t e, bool is_moving) const {
+    if (synced_) return static_cast<std::uint8_t>(e & ((is_moving ? kLost | kStallSync : 0) | kOcdSync));
+    const bool pull_in = (e & kPullIn) && !(e & kLost);
+    return static_cast<std::uint8_t>((pull_in ? kPullIn : 0) | (e & (kStallBlocked | kOcdBlocked)));
+  }
   std::int64_t clamp(std::int64_t u) const;
   bool shown(const SwitchSpec& sw, const SwitchState& st, Tick now) const;
 
   AxisSpec spec_;
   DriveInputs drive_{};
   mutable std::vector<std::uint8_t> table_;  // per (phase, direction, band): Bits, 0xFF = not yet computed
+  /// Bands lo..hi of one (phase, direction) share one signature (synchronised or not, moving):
+  /// what first_event() has learnt, so that a ramp is searched band by band once.
+  struct BandRun {
+    std::uint16_t lo = 1, hi = 0;  // empty
+  };
+  mutable std::array<BandRun, 16> band_runs_{};  // per (phase, direction, synchronised)
   std::int64_t cmd0_ = 0;     // commanded travel when attached
   std::int64_t cmd_ = 0;      // commanded travel as of the last look
   std::int64_t offset_ = 0;   // synchronised: true = clamp(cmd + offset)
@@ -101,6 +125,7 @@ class Axis {
   std::int64_t true_pos_ = 0;
   bool synced_ = true;
   std::vector<SwitchState> switches_;
+  bool bouncing_ = false;     // some switch bounces (has timed events)
   bool sw_level_ = true;
   bool stall_ = false;
   bool ocd_ = false;

@@ -36,15 +36,15 @@ void Chip::reset_logic() {
   touched();
   table_ = variant_;
   for (const auto& r : variant_->registers) regs_[r.address] = r.reset;
+  drive_stale_ = true;
   const std::int64_t travel = motion_.travel;  // the shaft does not move with a reset
   motion_ = MotionState{};
   motion_.travel = travel;
   refresh_profile();
-  collecting_ = false;
+  set_collecting(false);
   args_seen_ = 0;
   arg_ = 0;
   response_ = 0;
-  response_left_ = 0;
   ocd_shutdown_ = false;
   switch_act_ = false;
   // Any logic reset forces the UVLO flag active; ongoing faults show at once.
@@ -66,17 +66,12 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
   // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
   // the flags, which cannot have changed, so polling does not work the motion out.
-  if (byte == 0xD0 && !collecting_) {
-    // GetStatus, the polling command, straight through.
-    load_response(status(), 2);
-    clear_status_on_get_status();
-    return next_response_byte();
-  }
+  if (byte == 0xD0 && !collecting_) return get_status(status());  // the polling command, straight through
   sync();
   if (collecting_) {
     arg_ = (arg_ << 8) | byte;
     if (++args_seen_ == pending_.arg_bytes) {
-      collecting_ = false;
+      set_collecting(false);
       execute(pending_, arg_);
       if (axis_) axis_after_change();
     }
@@ -101,7 +96,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
     default:
       if (op.arg_bytes > 0) {
         pending_ = op;
-        collecting_ = true;
+        set_collecting(true);
         args_seen_ = 0;
         arg_ = 0;
       } else {
@@ -276,6 +271,7 @@ void Chip::write_register(const RegisterInfo& r, std::uint32_t value) {
   }
   regs_[r.address] = value;
   refresh_profile();
+  drive_stale_ = true;
 }
 
 void Chip::refresh_profile() {
@@ -326,12 +322,27 @@ std::uint16_t Chip::status_slow() const {
     live_bits_ = encode_live(layout_, live_status());
     live_bits_known_ = true;
   }
-  return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+  status_word_ = static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+  // Cached only with nothing latched to clear, so that a GetStatus from the cache is a read.
+  status_until_ = latched_clean_ && status_known_without_sync() ? status_horizon() : 0;
+  return status_word_;
+}
+
+Tick Chip::status_horizon() const {
+  Tick until = kNever;
+  if (motion_active(motion_)) {
+    // Known while now_ - motion_now_ <= run_.left; uniform ticks keep motion_now_ + run_.left.
+    if (run_.left < kNever - 1 - motion_now_) until = motion_now_ + run_.left + 1;
+    if (axis_) until = std::min(until, axis_event_at_);
+  } else if (axis_) {
+    until = axis_->next_time_event();
+  }
+  return until;
 }
 
 void Chip::latched_changed() {
   latched_bits_ = encode_latched(layout_, latched_);
-  latched_clean_ = false;
+  latches_dirty();
 }
 
 
@@ -372,11 +383,11 @@ void Chip::sync() const {
   motion_now_ = now_;
   if (!motion_active(motion_)) return;
   if (engine_ == MotionEngine::reference) {
-    live_bits_known_ = false;
+    forget_live_bits();
     reference_advance(motion_, profile_, left);
     return;
   }
-  if (fast_advance(motion_, profile_, left, run_)) live_bits_known_ = false;
+  if (fast_advance(motion_, profile_, left, run_)) forget_live_bits();
 }
 
 Tick Chip::next_event_tick() const {
@@ -501,7 +512,7 @@ void Chip::set_undervoltage(bool active) {
   sync();
   touched();
   condition_.uvlo = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_) return;
   if (active) latched_.uvlo = true;
   latched_changed();
@@ -511,7 +522,7 @@ void Chip::set_undervoltage(bool active) {
 
 void Chip::set_adc_undervoltage(bool active) {
   condition_.uvlo_adc = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (stby_level_ && active) latched_.uvlo_adc = true;
   latched_changed();
 }
@@ -522,7 +533,7 @@ void Chip::set_thermal(Thermal t) {
   // Shutdown has hysteresis: it only ends once the die is back below the warning level.
   if (condition_.thermal >= Thermal::bridge_shutdown && t == Thermal::warning) t = condition_.thermal;
   condition_.thermal = t;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_) return;
   latched_.thermal = std::max(latched_.thermal, t);
   latched_changed();
@@ -534,7 +545,7 @@ void Chip::set_overcurrent(bool active) {
   sync();
   touched();
   condition_.ocd = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_ || !active) return;
   latched_.ocd = true;
   latched_changed();
@@ -544,7 +555,7 @@ void Chip::set_overcurrent(bool active) {
 
 void Chip::set_stall(Bridge bridge, bool active) {
   (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
-  latched_clean_ = false;
+  latches_dirty();
   if (!stby_level_ || !active) return;
   (bridge == Bridge::A ? latched_.stall_a : latched_.stall_b) = true;
   latched_changed();
@@ -593,10 +604,11 @@ void Chip::attach_axis(const AxisSpec& spec) {
   sync();
   touched();
   axis_ = ValuePtr<Axis>(std::make_unique<Axis>(spec, motion_.travel));
+  drive_stale_ = true;
   axis_sw_ = sw_level_;
   axis_stall_ = false;
   axis_ocd_ = false;
-  axis_event_known_ = false;
+  forget_axis_event();
   axis_after_change();
 }
 
@@ -618,7 +630,7 @@ void Chip::set_axis_load(const LoadSpec& load) {
   sync();
   touched();
   axis_->set_load(load);
-  axis_event_known_ = false;
+  forget_axis_event();
   axis_settle(now_);
 }
 
@@ -658,8 +670,11 @@ DriveInputs Chip::drive_inputs() const {
 }
 
 void Chip::axis_after_change() {
-  axis_->set_drive(drive_inputs());
-  axis_event_known_ = false;
+  if (drive_stale_) {
+    axis_->set_drive(drive_inputs());
+    drive_stale_ = false;
+  }
+  forget_axis_event();
   axis_settle(now_);
 }
 
@@ -667,7 +682,7 @@ void Chip::axis_settle(Tick at) {
   // The axis's outputs are the chip's SW pin, stall and overcurrent inputs; a change of them can
   // change the motion (a switch stops a GoUntil, OC_SD disables the bridges), so settle again.
   for (int round = 0; round < 8; ++round) {
-    if (axis_->settle(motion_, profile_, at)) axis_event_known_ = false;
+    if (axis_->settle(motion_, profile_, at)) forget_axis_event();
     bool drove = false;
     if (axis_->sw_level() != axis_sw_) {
       axis_sw_ = axis_->sw_level();
@@ -689,7 +704,7 @@ void Chip::axis_settle(Tick at) {
       drove = true;
     }
     if (!drove) return;
-    axis_event_known_ = false;
+    forget_axis_event();
   }
 }
 
@@ -709,7 +724,7 @@ void Chip::sync_with_axis() {
       if (e == kNever || e > t + left) break;
       left -= e - t;
       t = e;
-      live_bits_known_ = false;
+      forget_live_bits();
       axis_settle(t);
       continue;
     }
@@ -717,14 +732,14 @@ void Chip::sync_with_axis() {
       reference_tick(motion_, profile_);
       ++t;
       --left;
-      live_bits_known_ = false;
+      forget_live_bits();
       axis_settle(t);
       continue;
     }
     if (!run_.known) {
       run_.left = uniform_ticks(motion_, profile_, kNever - 1);
       run_.known = true;
-      axis_event_known_ = false;
+      forget_axis_event();
     }
     if (!axis_event_known_) {
       axis_event_at_ = t + axis_->first_event(motion_, profile_, std::min(run_.left, kAxisHorizon), t);
@@ -737,8 +752,8 @@ void Chip::sync_with_axis() {
       run_.left -= to_event;
       left -= to_event;
       t += to_event;
-      live_bits_known_ = false;
-      axis_event_known_ = false;
+      forget_live_bits();
+      forget_axis_event();
       axis_settle(t);
       continue;
     }
@@ -751,7 +766,7 @@ void Chip::sync_with_axis() {
     --left;
     ++t;
     run_.known = false;
-    live_bits_known_ = false;
+    forget_live_bits();
     axis_settle(t);
   }
 }

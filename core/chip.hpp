@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <string>
 
@@ -25,7 +26,8 @@ namespace l6470emu {
 enum class Bridge : std::uint8_t { A, B };
 
 /// A chip of the family, from power-up on. Copying a chip copies its whole state.
-class Chip {
+/// Aligned to a cache line, so that the fields a SPI byte touches share one.
+class alignas(64) Chip {
  public:
   /// A chip just out of power-up: registers at reset, bridges HiZ, UVLO latched, FLAG low.
   explicit Chip(const Variant& variant = l6470(), Quirks quirks = {});
@@ -45,8 +47,41 @@ class Chip {
   /// return the byte the chip loads for the next transfer (0x00 with no response
   /// pending). In standby the byte is ignored and 0x00 is returned.
   std::uint8_t on_byte(std::uint8_t byte) {
-    if (byte == 0x00 && !collecting_ && stby_level_) return next_response_byte();  // NOP
+    if (byte == 0x00 && ready_for_command_) return next_response_byte();  // NOP
     return decode_byte(byte);
+  }
+
+  /// on_byte() for a byte decoded at tick `now` >= now() (a chain's CS rising edge): the chip
+  /// is first brought to `now` unless the byte is a NOP outside a command, which only clocks an
+  /// answer on and needs no up-to-date state. Equal to advance_to(now) then on_byte(byte).
+  std::uint8_t on_byte_at(Tick now, std::uint8_t byte) {
+    if (ready_for_command_) {
+      if (byte == 0x00) return next_response_byte();  // NOP
+      assert(now >= now_);
+      now_ = now;
+      // GetStatus, the polling command, while its answer is known without working the motion out.
+      if (byte == 0xD0 && now < status_until_) {
+        const std::uint16_t status = cached_status();  // nothing latched to clear: a plain read
+        response_ = status & 0xFFu;
+        return static_cast<std::uint8_t>(status >> 8);
+      }
+      return decode_byte(byte);
+    }
+    advance_to(now);
+    return decode_byte(byte);
+  }
+
+  /// on_byte_at(now, 0x00), a NOP, that also ORs into `noise` something nonzero unless the chip
+  /// is left quiet: ready for an opcode with no answer byte left, so that further NOPs change
+  /// nothing and shift out 0x00 until some other byte, a pin or a fault reaches it.
+  std::uint8_t on_nop_at(Tick now, std::uint32_t& noise) {
+    if (ready_for_command_) {
+      const std::uint8_t out = next_response_byte();
+      noise |= response_;
+      return out;
+    }
+    noise |= 1;
+    return on_byte_at(now, 0x00);
   }
 
   /// Whether the decoder is in the middle of a command (collecting argument bytes).
@@ -76,7 +111,10 @@ class Chip {
   /// The next tick at which the chip changes on its own (kNever when idle).
   Tick next_event_tick() const;
   /// Chooses the motion engine: the event-driven one (default) or the tick-by-tick reference.
-  void set_motion_engine(MotionEngine e) { engine_ = e; }
+  void set_motion_engine(MotionEngine e) {
+    engine_ = e;
+    touched();  // the engines remember different things
+  }
   MotionEngine motion_engine() const { return engine_; }
 
   // ---- pins (the physical world; host programs only see SPI and these) ------
@@ -134,8 +172,8 @@ class Chip {
   /// STATUS as GetParam(STATUS) reads it, without clearing anything.
   std::uint16_t status() const {
     if (!stby_level_) return 0;
-    if (!status_known_without_sync()) return status_slow();
-    return static_cast<std::uint16_t>(latched_bits_ | live_bits_);
+    if (now_ < status_until_) return cached_status();
+    return status_slow();
   }
   /// ABS_POS as a signed number of (micro)steps.
   std::int32_t position() const { return motion().abs_pos; }
@@ -157,19 +195,34 @@ class Chip {
  private:
   std::uint8_t decode_byte(std::uint8_t byte);
   std::uint8_t next_response_byte() {
-    if (response_left_ == 0) return 0x00;
-    --response_left_;
-    return static_cast<std::uint8_t>(response_ >> (8 * response_left_));
+    const auto byte = static_cast<std::uint8_t>(response_);
+    response_ >>= 8;
+    return byte;
   }
   std::uint16_t status_slow() const;
+  /// STATUS while now_ < status_until_.
+  std::uint16_t cached_status() const {
+    assert(status_known_without_sync() && latched_clean_ && status_word_ == (latched_bits_ | live_bits_));
+    return status_word_;
+  }
+  /// GetStatus with STATUS = `status`: the answer is loaded, the latches cleared, the MSB returned.
+  std::uint8_t get_status(std::uint16_t status) {
+    response_ = status & 0xFFu;  // the LSB comes next
+    clear_status_on_get_status();
+    return static_cast<std::uint8_t>(status >> 8);
+  }
   void reset_logic();
+  void set_collecting(bool c) {
+    collecting_ = c;
+    ready_for_command_ = stby_level_ && !c;
+  }
   void come_out_of_reset();
   void execute(const Opcode& op, std::uint32_t arg);
   void exec_set_param(std::uint8_t address, std::uint32_t value);
   void write_register(const RegisterInfo& r, std::uint32_t value);
   void load_response(std::uint32_t value, std::uint8_t bytes) {
-    response_ = value;
-    response_left_ = bytes;
+    response_ = 0;
+    for (std::uint8_t i = 0; i < bytes; ++i) response_ |= ((value >> (8 * i)) & 0xFFu) << (8 * (bytes - 1 - i));
   }
   void refresh_profile();
   void clear_status_on_get_status() {
@@ -192,18 +245,23 @@ class Chip {
   std::uint32_t& reg(Reg id) { return regs_[table_->find(id)->address]; }
   std::uint32_t reg(Reg id) const { return regs_[table_->find(id)->address]; }
 
-  const Variant* variant_;
-  const Variant* table_;  // variant_ or variant_->current_mode
-  // Fields every SPI byte or GetStatus touches come first, to share cache lines.
+  // Fields every SPI byte or GetStatus touches come first, in the chip's first cache line.
   Tick now_ = 0;
-  std::uint32_t response_ = 0;
-  std::uint8_t response_left_ = 0;
+  // STATUS is status_word_ (= latched_bits_ | live_bits_, with nothing latched to clear) at every
+  // now_ < status_until_ (0: not known). Set by status_slow() from status_known_without_sync();
+  // anything that could shorten it, or latch a flag, resets it.
+  mutable Tick status_until_ = 0;
+  mutable std::uint16_t status_word_ = 0;
+  std::uint32_t response_ = 0;  // answer bytes still to shift out, the next in the low byte (then 0x00s)
   bool collecting_ = false;
   bool stby_level_ = true;
+  bool ready_for_command_ = true;  // stby_level_ && !collecting_: the next byte is an opcode
   mutable bool live_bits_known_ = false;
   mutable std::uint16_t live_bits_ = 0;
   std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
   bool latched_clean_ = false;      // latched_ == condition_ is known (GetStatus has nothing to clear)
+  const Variant* variant_;
+  const Variant* table_;  // variant_ or variant_->current_mode
   mutable UniformRun run_;  // fast engine: uniform ticks left from motion_now_
   mutable Tick motion_now_ = 0;
   Quirks quirks_;
@@ -218,8 +276,6 @@ class Chip {
   std::uint8_t args_seen_ = 0;
   std::uint32_t arg_ = 0;
 
-  // response being shifted out, MSB first
-
   // Motion state as of motion_now_ (<= now_); sync() brings it up to now_.
   mutable MotionState motion_{};
   Profile profile_{};
@@ -228,19 +284,38 @@ class Chip {
   /// Works the motion out up to now_.
   void sync() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
+  /// The first tick at which it would stop being so, as the state stands, is status_horizon().
   bool status_known_without_sync() const {
     if (!live_bits_known_ || (axis_ && !axis_quiet_through_now())) return false;
     return !motion_active(motion_) || (run_.known && now_ - motion_now_ <= run_.left);
   }
   /// With an axis: whether no mechanical event can have happened between the last sync and now().
   bool axis_quiet_through_now() const;
+  /// Given status_known_without_sync(): the first tick at which it is false as the state stands
+  /// (the end of the cached run, the axis's next event); kNever when that never comes.
+  Tick status_horizon() const;
+  /// The cached live STATUS bits are out of date.
+  void forget_live_bits() const {
+    live_bits_known_ = false;
+    status_until_ = 0;
+  }
+  /// The axis's next event must be searched again.
+  void forget_axis_event() const {
+    axis_event_known_ = false;
+    status_until_ = 0;
+  }
   /// Something outside the passage of time changed the chip: forget the cached run and STATUS.
   void touched() const {
     run_.known = false;
-    live_bits_known_ = false;
+    forget_live_bits();
   }
 
   void latched_changed();
+  /// Something may have latched: the next GetStatus has to look (and the STATUS cache is void).
+  void latches_dirty() {
+    latched_clean_ = false;
+    status_until_ = 0;
+  }
 
   AlarmFlags latched_{};   // what STATUS shows
   AlarmFlags condition_{}; // what is physically going on (events are never conditions)
@@ -258,6 +333,7 @@ class Chip {
   mutable Tick axis_event_at_ = 0;       // absolute tick of the axis's next event in the cached run
   mutable bool axis_event_known_ = false;
   bool axis_sw_ = true, axis_stall_ = false, axis_ocd_ = false;  // what the axis last drove
+  bool drive_stale_ = true;  // the registers drive_inputs() reads changed since the axis got them
   /// sync() with an axis: the same engines, stopping at every mechanical event.
   void sync_with_axis();
   /// Lets the axis apply its rules at tick `at` and passes its outputs to the chip's inputs.

@@ -125,34 +125,53 @@ Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit) {
   return 0;
 }
 
-void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
-  if (n == 0 || !motion_active(s)) return;
+namespace {
+
+/// The rule of the uniform ticks ahead of `s` (motion active), without the cap (as the
+/// closed forms below use it: an invalid rule, never applied over a tick, reads as constant).
+Rule uniform_rule(const MotionState& s, const Profile& p) {
   const std::uint64_t floor = p.floor_speed();
-  Rule r;
   switch (s.activity) {
     case Activity::stopping:
-      r = ramp(s.speed, floor, p, false);
-      break;
+      return ramp(s.speed, floor, p, false);
     case Activity::run:
     case Activity::go_until:
     case Activity::release_sw:
-      r = s.reversing ? ramp(s.speed, floor, p, false) : ramp(s.speed, constant_speed_target(s, p), p, false);
-      break;
+      return s.reversing ? ramp(s.speed, floor, p, false) : ramp(s.speed, constant_speed_target(s, p), p, false);
     case Activity::position:
-      if (s.reversing)
-        r = ramp(s.speed, floor, p, false);
-      else if (s.braking)
-        r = s.speed > floor ? ramp(s.speed, floor, p, false) : Rule{true, 0, 0, kNever};
-      else
-        r = ramp(s.speed, p.max_speed, p, false);
-      break;
+      if (s.reversing) return ramp(s.speed, floor, p, false);
+      if (s.braking) return s.speed > floor ? ramp(s.speed, floor, p, false) : Rule{true, 0, 0, kNever};
+      return ramp(s.speed, p.max_speed, p, false);
     default:
-      return;
+      return Rule{};
   }
+}
+
+/// Microsteps made by n uniform ticks under `r`, and the fraction of a microstep left.
+struct Steps {
+  u128 steps;
+  std::uint64_t frac;
+};
+Steps steps_after(const MotionState& s, const Profile& p, const Rule& r, Tick n) {
   const u128 total = s.frac + distance_after(s.speed, r, n);
   const unsigned shift = 40u - p.step_sel;  // a microstep is 2^shift
-  const u128 steps = total >> shift;
-  s.frac = static_cast<std::uint64_t>(total) & (p.microstep() - 1);
+  return {total >> shift, static_cast<std::uint64_t>(total) & (p.microstep() - 1)};
+}
+
+/// Travel (1/128 step) of `steps` microsteps in the current direction.
+std::int64_t travel_of(const MotionState& s, const Profile& p, u128 steps) {
+  const std::int64_t moved = static_cast<std::int64_t>(steps) * p.el_increment();
+  return s.dir ? moved : -moved;
+}
+
+}  // namespace
+
+void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return;
+  const Rule r = uniform_rule(s, p);
+  const Steps made = steps_after(s, p, r, n);
+  const u128 steps = made.steps;
+  s.frac = made.frac;
   s.speed = speed_after(s.speed, r, n);
   if (steps == 0) return;
   const std::uint32_t mod22 = static_cast<std::uint32_t>(steps & 0x3FFFFF);
@@ -161,9 +180,55 @@ void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n) {
   s.abs_pos = sign_extend(pos & 0x3FFFFF, 22);
   const std::uint32_t el = mod512 * p.el_increment();
   s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? el : 512u * 128u - el)) & 0x1FF);
-  const std::int64_t moved = static_cast<std::int64_t>(steps) * p.el_increment();
-  s.travel += s.dir ? moved : -moved;
+  s.travel += travel_of(s, p, steps);
   if (s.activity == Activity::position && !s.reversing) s.steps_left -= static_cast<std::uint32_t>(steps);
+}
+
+std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return s.speed;
+  return speed_after(s.speed, uniform_rule(s, p), n);
+}
+
+Tick first_uniform_tick_at_speed(const MotionState& s, const Profile& p, std::uint64_t speed, bool up, Tick n) {
+  // After i uniform ticks the speed is v + i*delta (sign +1), v - i*delta (sign -1) or v (0),
+  // exactly as speed_after() computes it; solved for the first i in 1..n.
+  const Rule r = motion_active(s) ? uniform_rule(s, p) : Rule{};
+  const std::uint64_t v = s.speed;
+  Tick i = n + 1;  // none
+  if (up) {  // the first i with speed_i >= speed; the speed does not fall
+    if (r.sign < 0 && r.delta != 0) return first_true(1, n, [&](Tick k) { return speed_after(v, r, k) >= speed; });
+    if (v + r.delta >= speed) i = 1;
+    else if (r.delta != 0) i = ceil_div(speed - v, r.delta);
+  } else {  // the first i with speed_i < speed; the speed does not rise
+    if (r.sign > 0 && r.delta != 0) return first_true(1, n, [&](Tick k) { return speed_after(v, r, k) < speed; });
+    if (v - r.delta < speed) i = 1;  // (delta <= v - floor: no wrap)
+    else if (r.delta != 0) i = (v - speed) / r.delta + 1;
+  }
+  return i > n ? n + 1 : i;
+}
+
+Tick first_uniform_tick_at_travel(const MotionState& s, const Profile& p, std::int64_t travel, Tick n) {
+  const Rule r = motion_active(s) ? uniform_rule(s, p) : Rule{};
+  const auto reached = [&](Tick i) {
+    const std::int64_t t = travel_after_uniform_ticks(s, p, i);
+    return s.dir ? t >= travel : t <= travel;
+  };
+  if (r.delta != 0) return first_true(1, n, reached);  // a ramp: searched
+  // Constant speed v: after i ticks the microsteps made are (frac + i*v) >> shift, each moving
+  // the travel by el_increment() in the motor's direction; solved for the first i.
+  const std::int64_t gap = s.dir ? travel - s.travel : s.travel - travel;
+  if (gap <= 0) return n >= 1 ? 1 : n + 1;
+  const std::uint64_t el = p.el_increment();
+  const u128 steps = (static_cast<std::uint64_t>(gap) + el - 1) / el;  // microsteps needed
+  const u128 need = (steps << (40u - p.step_sel)) - s.frac;              // distance, 2^-40 step
+  if (s.speed == 0) return n + 1;
+  const u128 i = (need + s.speed - 1) / s.speed;
+  return i > n ? n + 1 : static_cast<Tick>(i);
+}
+
+std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n) {
+  if (n == 0 || !motion_active(s)) return s.travel;
+  return s.travel + travel_of(s, p, steps_after(s, p, uniform_rule(s, p), n).steps);
 }
 
 bool fast_advance(MotionState& s, const Profile& p, Tick ticks, UniformRun& run) {

@@ -24,6 +24,19 @@ Tick uniform_ticks(const MotionState& s, const Profile& p, Tick limit);
 /// Applies `n` uniform ticks (n <= uniform_ticks()) in closed form.
 void apply_uniform_ticks(MotionState& s, const Profile& p, Tick n);
 
+/// The speed apply_uniform_ticks(s, p, n) would leave, without working the rest out.
+std::uint64_t speed_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
+/// The first i in 1..n (n <= uniform_ticks()) after which speed_after_uniform_ticks(s, p, i) is
+/// at least `speed` (`up`) or below it (!up), n + 1 when there is none: solved, not searched.
+/// (The speed moves one way through uniform ticks; asked the other way, it is searched.)
+Tick first_uniform_tick_at_speed(const MotionState& s, const Profile& p, std::uint64_t speed, bool up, Tick n);
+/// The first i in 1..n (n <= uniform_ticks()) after which travel_after_uniform_ticks(s, p, i) has
+/// reached `travel` going the motor's way (at or beyond it), n + 1 when it does not: solved at
+/// constant speed, searched on a ramp.
+Tick first_uniform_tick_at_travel(const MotionState& s, const Profile& p, std::int64_t travel, Tick n);
+/// The travel (1/128 step) apply_uniform_ticks(s, p, n) would leave, without working the rest out.
+std::int64_t travel_after_uniform_ticks(const MotionState& s, const Profile& p, Tick n);
+
 /// What the event-driven engine remembers between calls: how many uniform ticks are left
 /// from the current state. Forget it (known = false) whenever the state or the profile is
 /// changed by anything but the passage of time.

@@ -55,39 +55,85 @@ std::uint8_t Chain::exchange(std::uint8_t mosi) {
   return miso;
 }
 
-void Chain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  const std::size_t n = ring_.size();
-  if (!selected_ || (standby_in_frame_ && tx.size() < n)) {
+void Chain::exchange_slow(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  if (!selected_ || tx.size() < ring_.size()) {
     for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
     return;
   }
-  if (standby_in_frame_ && exchange_through_standby(tx, rx)) return;
-  // The common case: a plain shift of the ring buffer, a run of bytes at a time
-  // (what leaves the ring goes to MISO, what enters it comes from MOSI).
-  std::uint8_t* ring = ring_.data();
-  std::size_t head = head_;
-  if (tx.size() >= n) {
-    // At least a whole chain's worth: MISO is the ring's bytes then tx delayed by n, and the
-    // ring keeps tx's last n bytes, wherever the head ends up.
-    const std::size_t size = tx.size();
-    for (std::size_t i = 0; i < n; ++i) rx[i] = ring[(head + i) % n];
-    std::memcpy(rx.data() + n, tx.data(), size - n);
-    const std::size_t new_head = (head + size) % n;
-    for (std::size_t i = 0; i < n; ++i) ring[(new_head + i) % n] = tx[size - n + i];
-    head_ = new_head;
-    bytes_in_frame_ += size;
+  if (exchange_through_standby(tx, rx)) return;
+  shift_bytes(tx, rx);  // STBY rose since the frame began: a plain shift
+}
+
+namespace {
+
+/// Copies `count` bytes between distinct buffers; a few chips' worth without a library call.
+inline void copy_bytes(std::uint8_t* dst, const std::uint8_t* src, std::size_t count) {
+  const auto two = [&](auto word) {  // two possibly overlapping words cover 1-2 words' worth
+    constexpr std::size_t w = sizeof word;
+    decltype(word) a, b;
+    std::memcpy(&a, src, w);
+    std::memcpy(&b, src + count - w, w);
+    std::memcpy(dst, &a, w);
+    std::memcpy(dst + count - w, &b, w);
+  };
+  if (count > 16) std::memcpy(dst, src, count);
+  else if (count >= 8) two(std::uint64_t{});
+  else if (count >= 4) two(std::uint32_t{});
+  else if (count >= 2) two(std::uint16_t{});
+  else if (count == 1) *dst = *src;
+}
+
+}  // namespace
+
+void Chain::shift_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  const std::size_t n = ring_.size();
+  if (tx.size() == n && head_ == 0) {
+    // A frame of the chain's length from slot 0 (the usual frame): the registers' bytes out,
+    // tx's in; a short chain's byte by byte, a long one's in two copies.
+    std::uint8_t* const ring = ring_.data();
+    if (n <= 16) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::uint8_t out = ring[i];
+        ring[i] = tx[i];
+        rx[i] = out;
+      }
+    } else {
+      std::memcpy(rx.data(), ring, n);
+      std::memcpy(ring, tx.data(), n);
+    }
+    bytes_in_frame_ += n;
     return;
   }
-  for (std::size_t i = 0; i < tx.size();) {
-    const std::size_t run = std::min(tx.size() - i, n - head);
-    std::memcpy(rx.data() + i, ring + head, run);
-    std::memcpy(ring + head, tx.data() + i, run);
+  shift_runs(tx, rx);
+}
+
+void Chain::shift_runs(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  // What leaves the ring goes to MISO, what enters it comes from MOSI, a run of bytes at a time.
+  const std::size_t n = ring_.size();
+  const std::size_t size = tx.size();
+  std::uint8_t* const ring = ring_.data();
+  std::size_t head = head_;
+  bytes_in_frame_ += size;
+  if (size >= n) {
+    // At least a whole chain's worth: MISO is the ring's bytes then tx delayed by n, and the
+    // ring keeps tx's last n bytes. Only the logical order of the ring matters, so it restarts
+    // at slot 0: two copies out, one copy in, no division per byte.
+    copy_bytes(rx.data(), ring + head, n - head);
+    copy_bytes(rx.data() + (n - head), ring, head);
+    copy_bytes(rx.data() + n, tx.data(), size - n);
+    copy_bytes(ring, tx.data() + (size - n), n);
+    head_ = 0;
+    return;
+  }
+  for (std::size_t i = 0; i < size;) {
+    const std::size_t run = std::min(size - i, n - head);
+    copy_bytes(rx.data() + i, ring + head, run);
+    copy_bytes(ring + head, tx.data() + i, run);
     i += run;
     head += run;
     if (head == n) head = 0;
   }
   head_ = head;
-  bytes_in_frame_ += tx.size();
 }
 
 bool Chain::exchange_through_standby(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
@@ -120,16 +166,38 @@ void Chain::deselect() {
   selected_ = false;
   // A CS pulse without clocks leaves the shift registers as they are: nothing is decoded.
   if (bytes_in_frame_ == 0) return;
+  decode_shift_registers();
+}
+
+void Chain::decode_shift_registers() {
+  // Chip i decodes logical register i, ring_[(head_ + i) % n]: chips 0 .. n-head-1 read the
+  // ring from head_ on, the others from slot 0. Each chip's answer byte replaces its register.
+  Chip* const chips = chips_.data();
+  std::uint8_t* const ring = ring_.data();
   const std::size_t n = chips_.size();
-  std::size_t slot = head_;
-  for (std::size_t i = 0; i < n; ++i) {
-    Chip& c = chips_[i];
-    const std::uint8_t byte = ring_[slot];
-    // A NOP outside a command only clocks an answer on; it needs no up-to-date state.
-    if (byte != 0x00 || c.collecting_arguments()) c.advance_to(now_);
-    ring_[slot] = c.on_byte(byte);
-    slot = slot + 1 == n ? 0 : slot + 1;
+  const std::size_t head = head_;
+  const Tick now = now_;
+  std::uint8_t any = 0;
+  for (std::size_t i = 0; i < n; ++i) any |= ring[i];
+  if (any == 0) {
+    // A frame of NOPs. On a quiet chain it changes nothing: every chip shifts out 0x00, which
+    // is what its register holds already. Otherwise each chip clocks an answer byte on.
+    if (quiet_) return;
+    std::uint32_t noise = 0;
+    const auto nops = [now, &noise](Chip* chip, std::uint8_t* slot, std::size_t count) {
+      for (std::size_t i = 0; i < count; ++i) slot[i] = chip[i].on_nop_at(now, noise);
+    };
+    nops(chips, ring + head, n - head);
+    if (head != 0) nops(chips + (n - head), ring, head);
+    quiet_ = noise == 0;
+    return;
   }
+  quiet_ = false;
+  const auto decode = [now](Chip* chip, std::uint8_t* slot, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) slot[i] = chip[i].on_byte_at(now, slot[i]);
+  };
+  decode(chips, ring + head, n - head);
+  if (head != 0) decode(chips + (n - head), ring, head);
 }
 
 void Chain::advance_to(Tick tick) {

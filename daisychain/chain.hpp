@@ -31,6 +31,7 @@ class Chain final : public SpiDevice {
   Chip& chip(std::size_t i) const {
     Chip& c = chips_.at(i);
     chips_touched_ = true;
+    quiet_ = false;
     c.advance_to(now_);
     return c;
   }
@@ -38,7 +39,10 @@ class Chain final : public SpiDevice {
   // SpiDevice
   void select() override;
   std::uint8_t exchange(std::uint8_t mosi) override;
-  void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override;
+  void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override {
+    if (!selected_ || standby_in_frame_) return exchange_slow(tx, rx);
+    shift_bytes(tx, rx);
+  }
   void deselect() override;
   bool selected() const override { return selected_; }
   Tick now() const override { return now_; }
@@ -107,6 +111,17 @@ class Chain final : public SpiDevice {
  private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
+  /// The CS rising edge of a frame that clocked bytes: every chip decodes its register (SPI
+  /// mode 3, whole bytes) and loads its answer byte into it. A frame of NOPs to a quiet chain
+  /// (see quiet_) is known to change nothing.
+  void decode_shift_registers();
+  /// The byte fast path (SPI mode 3, whole bytes, CS low, no chip in standby): the ring shifts
+  /// by tx.size() bytes. A frame of the chain's length from slot 0 is swapped whole; anything
+  /// else goes through shift_runs(), a run of bytes at a time.
+  void shift_bytes(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  void shift_runs(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  /// exchange() with CS high or chips in standby.
+  void exchange_slow(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   /// false (nothing done) when no chip is in standby any more.
   bool exchange_through_standby(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
@@ -118,6 +133,9 @@ class Chain final : public SpiDevice {
   bool selected_ = false;
   bool standby_in_frame_ = false;  // some chip was in standby at the CS falling edge
   mutable bool chips_touched_ = true;  // chip() handed out a chip since the last look at STBY pins
+  // Every chip is ready for an opcode with no answer byte left (Chip::on_nop_at), as the last
+  // frame of NOPs left them and nothing reached them since: the next frame of NOPs changes nothing.
+  mutable bool quiet_ = false;
   bool any_standby_ = false;
   std::uint64_t bytes_in_frame_ = 0;
   Tick now_ = 0;

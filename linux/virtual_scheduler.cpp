@@ -27,8 +27,11 @@ constexpr std::int64_t kFallbackPollNs = 1'000'000;
 thread_local bool t_holds_lock = false;
 
 // The calling thread's wake-up descriptor: the scheduler writes it to end the thread's wait.
+// It also keeps the thread's id, asked for once: a gettid() system call in every wait was half
+// the cost of a virtual-time spidev round trip.
 struct ThreadWakeFd {
   int fd = -1;
+  pid_t tid = 0;
   ~ThreadWakeFd() {
     if (fd >= 0) ::close(fd);
     fd = -1;  // a wait after this (another key's destructor) makes a new one, never reuses the number
@@ -40,7 +43,12 @@ struct ThreadWakeFd {
   void renew() {
     if (fd >= 0) ::close(fd);
     fd = -1;
+    tid = 0;  // (after fork: the child's thread has an id of its own)
     get();
+  }
+  pid_t thread_id() {
+    if (tid == 0) tid = ::gettid();
+    return tid;
   }
   void drain() const {
     std::uint64_t v;
@@ -103,7 +111,7 @@ std::string seconds_of(Tick t) {
 struct VirtualScheduler::Waiter {
   const Wait* w = nullptr;
   pthread_t owner = pthread_self();
-  pid_t tid = ::gettid();
+  pid_t tid = t_wake.thread_id();
   int fd = -1;  // the waiting thread's wake-up eventfd
   std::uint64_t seq = 0;
   std::atomic<bool> done{false};

@@ -26,6 +26,19 @@ case "$what" in
     }
     stage "set up and build (RelWithDebInfo)" scripts/setup.sh build
     stage "tests (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j"$(nproc)"
+    # The headline figures, so that a regression shows in every run's log. Numbers only: no
+    # pass/fail on timing (machines are noisy; --no-verdicts leaves out "met" / "NOT MET");
+    # bench/compare.sh REV compares two revisions side by side. About 30 s of CPU to build
+    # (the model's libraries at -O3, ccache when present) and 2 s to run.
+    headline() {
+      local launcher=()
+      command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+      cmake -S . -B build-bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DL6470EMU_TESTS=OFF "${launcher[@]}" >/dev/null
+      cmake --build build-bench -j"$(nproc)" --target l6470emu_bench >/dev/null
+      echo "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?'), load average $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) CPUs"
+      build-bench/bench/l6470emu_bench --no-verdicts 0.1
+    }
+    stage "headline benchmark (Release, 0.1 s per figure, printed only)" headline
     # The sanitized tree is built by clang (the normal one by gcc): the whole project builds with
     # both compilers at no extra stage, and clang's UBSan also checks float-to-integer overflow.
     stage "build with AddressSanitizer + UndefinedBehaviorSanitizer (clang)" \

@@ -166,7 +166,8 @@ TEST_F(Daemon, TwoClientsOnOneBusAreSerialisedMessageByMessage) {
   // daemon let the two programs' transfers interleave, answers would come back torn.
   Background a({client("spidev_reader"), "/dev/spidev0.0", "20000", "0x03", "0x12345"}, env());
   Background b({client("spidev_reader"), "/dev/spidev0.0", "20000", "0x03", "0x12345"}, env());
-  const RunResult ra = a.wait(30), rb = b.wait(30);
+  // 17 s at a load average of 26, 48 s in a full ctest run at 33: the limit only catches a hang.
+  const RunResult ra = a.wait(180), rb = b.wait(180);
   EXPECT_EQ(ra.out, "reads=20000 torn=0\n") << ra.err;
   EXPECT_EQ(rb.out, "reads=20000 torn=0\n") << rb.err;
 }
