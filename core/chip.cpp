@@ -45,6 +45,7 @@ void Chip::reset_logic() {
   args_seen_ = 0;
   arg_ = 0;
   response_ = 0;
+  response_left_ = 0;
   ocd_shutdown_ = false;
   switch_act_ = false;
   // Any logic reset forces the UVLO flag active; ongoing faults show at once.

@@ -63,6 +63,7 @@ class alignas(64) Chip {
       if (byte == 0xD0 && now < status_until_) {
         const std::uint16_t status = cached_status();  // nothing latched to clear: a plain read
         response_ = status & 0xFFu;
+        response_left_ = 1;
         return static_cast<std::uint8_t>(status >> 8);
       }
       return decode_byte(byte);
@@ -77,7 +78,7 @@ class alignas(64) Chip {
   std::uint8_t on_nop_at(Tick now, std::uint32_t& noise) {
     if (ready_for_command_) {
       const std::uint8_t out = next_response_byte();
-      noise |= response_;
+      noise |= response_ | response_left_;
       return out;
     }
     noise |= 1;
@@ -197,6 +198,7 @@ class alignas(64) Chip {
   std::uint8_t next_response_byte() {
     const auto byte = static_cast<std::uint8_t>(response_);
     response_ >>= 8;
+    response_left_ -= response_left_ != 0;
     return byte;
   }
   std::uint16_t status_slow() const;
@@ -208,6 +210,7 @@ class alignas(64) Chip {
   /// GetStatus with STATUS = `status`: the answer is loaded, the latches cleared, the MSB returned.
   std::uint8_t get_status(std::uint16_t status) {
     response_ = status & 0xFFu;  // the LSB comes next
+    response_left_ = 1;
     clear_status_on_get_status();
     return static_cast<std::uint8_t>(status >> 8);
   }
@@ -222,6 +225,7 @@ class alignas(64) Chip {
   void write_register(const RegisterInfo& r, std::uint32_t value);
   void load_response(std::uint32_t value, std::uint8_t bytes) {
     response_ = 0;
+    response_left_ = bytes;
     for (std::uint8_t i = 0; i < bytes; ++i) response_ |= ((value >> (8 * i)) & 0xFFu) << (8 * (bytes - 1 - i));
   }
   void refresh_profile();
@@ -253,6 +257,7 @@ class alignas(64) Chip {
   mutable Tick status_until_ = 0;
   mutable std::uint16_t status_word_ = 0;
   std::uint32_t response_ = 0;  // answer bytes still to shift out, the next in the low byte (then 0x00s)
+  std::uint8_t response_left_ = 0;  // how many of them are the answer (0x00 bytes included; the sanitizer's)
   bool collecting_ = false;
   bool stby_level_ = true;
   bool ready_for_command_ = true;  // stby_level_ && !collecting_: the next byte is an opcode
