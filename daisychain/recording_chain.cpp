@@ -10,6 +10,7 @@ RecordingChain::RecordingChain(Chain& chain, TraceSink& sink, RecordOptions opti
   TraceHeader h;
   h.format = "native";
   h.chain = chain_spec_of(chain_);
+  h.board = options_.board;
   sink_.write_header(h);
   if (options_.observe_outputs) {
     busy_.assign(chain_.size(), 2);  // 2 = not seen yet: the first look records the level
@@ -77,12 +78,33 @@ void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_
     emit(e);  // an observation, made between frames
     return;
   }
+  stimulus(e);
+}
+
+void RecordingChain::stimulus(const TraceEvent& e) {
   if (chain_.selected()) {
     deferred_.push_back(e);
     return;
   }
   emit(e);
   observe_outputs();
+}
+
+void RecordingChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
+  chain_.chip(chip).set_axis_load(load);
+  TraceEvent e;
+  e.kind = TraceEventKind::load;
+  e.tick = chain_.now();
+  e.chip = static_cast<std::uint16_t>(chip);
+  e.load = load;
+  stimulus(e);
+}
+
+void RecordingChain::mark_advance() {
+  TraceEvent e;
+  e.kind = TraceEventKind::advance;
+  e.tick = chain_.now();
+  stimulus(e);
 }
 
 void RecordingChain::set_sw_pin(std::size_t chip, bool level) {

@@ -20,6 +20,10 @@ struct RecordOptions {
   /// Look at every chip's BUSY and FLAG after each frame and event, and record changes
   /// (replay then checks them). Costs a motion update per chip per frame.
   bool observe_outputs = true;
+  /// The board description of the chain (board/board_config.hpp's text: variants, axes,
+  /// numbering, quirks, checks), written as the header's `board` lines so that a replay builds
+  /// the same world. Empty: only the `chain` line (the variants).
+  std::string board;
 };
 
 /// Records what happens to a Chain through it.
@@ -49,6 +53,11 @@ class RecordingChain final : public SpiDevice {
   void set_thermal(std::size_t chip, Thermal t);
   void set_overcurrent(std::size_t chip, bool active);
   void set_stall(std::size_t chip, Bridge bridge, bool active);
+  /// The load on chip `chip`'s axis changes (no effect on the chip without an axis, but recorded).
+  void set_axis_load(std::size_t chip, const LoadSpec& load);
+  /// Records that time was moved on to now() with nothing else happening (`ctl advance`), so
+  /// that a replay lets the chips run as far.
+  void mark_advance();
 
   /// Records BUSY/FLAG levels that changed since they were last seen (done after every
   /// frame and event; call it to catch a change between frames, e.g. a move ending).
@@ -59,6 +68,7 @@ class RecordingChain final : public SpiDevice {
 
  private:
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
+  void stimulus(const TraceEvent& e);
   void emit(const TraceEvent& e);
 
   Chain& chain_;

@@ -54,6 +54,13 @@ void Trace::write(const TraceEvent& e) {
   s.kind = e.kind;
   s.value = e.value;
   s.what = e.kind == TraceEventKind::pin ? static_cast<std::uint8_t>(e.pin) : static_cast<std::uint8_t>(e.fault);
+  if (e.kind == TraceEventKind::load) {
+    // The load's three numbers go to the byte pool (rare events: Stored stays small).
+    s.offset = bytes_.size();
+    const std::uint32_t words[3] = {e.load.inertia_g_mm2, e.load.friction_uNm, static_cast<std::uint32_t>(e.load.force_uNm)};
+    for (std::uint32_t w : words)
+      for (int b = 0; b < 4; ++b) bytes_.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+  }
   if (e.kind == TraceEventKind::frame) {
     if ((!e.miso.empty() && e.miso.size() != e.mosi.size()) ||
         (!e.miso_known.empty() && e.miso_known.size() != e.mosi.size()))
@@ -87,6 +94,14 @@ TraceEvent Trace::operator[](std::size_t i) const {
   e.value = s.value;
   if (s.kind == TraceEventKind::pin) e.pin = static_cast<TracePin>(s.what);
   if (s.kind == TraceEventKind::fault) e.fault = static_cast<TraceFault>(s.what);
+  if (s.kind == TraceEventKind::load) {
+    std::uint32_t words[3] = {};
+    for (int w = 0; w < 3; ++w)
+      for (int b = 0; b < 4; ++b) words[w] |= std::uint32_t{bytes_[s.offset + 4 * w + b]} << (8 * b);
+    e.load.inertia_g_mm2 = words[0];
+    e.load.friction_uNm = words[1];
+    e.load.force_uNm = static_cast<std::int32_t>(words[2]);
+  }
   if (s.kind == TraceEventKind::frame) {
     const std::uint8_t* p = bytes_.data() + s.offset;
     e.mosi = {p, s.length};

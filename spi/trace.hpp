@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/axis_spec.hpp"
 #include "core/tick.hpp"
 
 namespace l6470emu {
@@ -42,6 +43,8 @@ enum class TraceEventKind : std::uint8_t {
   frame,  ///< one CS frame: CS falls, bytes are exchanged, CS rises
   pin,    ///< a pin changed level (inputs SW, STCK, STBY) or was observed (outputs BUSY, FLAG)
   fault,  ///< a backdoor event: a fault condition starts or ends, or the ADCIN level changes
+  load,   ///< the load on a chip's mechanical axis changes (inertia, friction, force: TraceEvent::load)
+  advance,  ///< time was moved on with nothing else happening (`ctl advance`): the chips run up to here
 };
 
 /// The chip pins a trace can carry, by datasheet name.
@@ -82,6 +85,7 @@ struct TraceEvent {
   TracePin pin = TracePin::SW;               ///< pin events
   TraceFault fault = TraceFault::UVLO;       ///< fault events
   std::uint8_t value = 0;                    ///< pin: level 0/1; fault: see TraceFault
+  LoadSpec load;                             ///< load events: the axis's new load
   std::uint64_t line = 0;                    ///< line in the source file (0 = none)
   std::uint64_t repetition = 0;              ///< native `repeat` lines: which repetition (1..), else 0
   double source_time = std::numeric_limits<double>::quiet_NaN();  ///< seconds as in the source file
@@ -102,6 +106,12 @@ struct TraceHeader {
   std::string format;         ///< "native", "saleae", "umockdev", "ftrace", "sigrok"
   std::string chain;          ///< the chain the trace was taken from ("3*L6470"); empty = not known
   std::uint64_t chain_line = 0;      ///< where `chain` was written (for error messages)
+  /// The board description of the chain the trace was recorded on (native version 2 `board`
+  /// lines, one clause per line, as board/board_config.hpp parses it): variants, axes, quirks,
+  /// numbering, checks. Empty = not known (captures, version 1 files).
+  std::string board;
+  std::uint64_t board_line = 0;      ///< where the first `board` line was written
+  int version = 0;                   ///< native format version read (0: not a native trace)
   std::vector<std::string> notes;    ///< importer remarks: guessed framing, missing channels...
 };
 

@@ -39,7 +39,7 @@ struct PyTraceEvent {
 };
 
 PyTraceEvent event_of(const TraceEvent& e) {
-  static constexpr const char* kKinds[] = {"frame", "pin", "fault"};
+  static constexpr const char* kKinds[] = {"frame", "pin", "fault", "load", "advance"};
   PyTraceEvent p;
   p.kind = kKinds[static_cast<int>(e.kind)];
   p.tick = e.tick;
@@ -96,7 +96,8 @@ void bind_trace(py::module_& m) {
   });
 
   py::class_<PyTraceEvent>(m, "TraceEvent", "One event of a trace: a CS frame, a pin level or a backdoor fault.")
-      .def_readonly("kind", &PyTraceEvent::kind, "\"frame\", \"pin\" or \"fault\"")
+      .def_readonly("kind", &PyTraceEvent::kind,
+                    "\"frame\", \"pin\", \"fault\", \"load\" (an axis load change: see .text) or \"advance\" (time moved on)")
       .def_readonly("tick", &PyTraceEvent::tick, "frame: CS falling edge; pin/fault: when (250 ns ticks)")
       .def_readonly("duration", &PyTraceEvent::duration, "frame: ticks from CS falling to rising edge")
       .def_property_readonly("end", [](const PyTraceEvent& e) { return e.tick + e.duration; }, "frame: the CS rising edge")
