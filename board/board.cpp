@@ -4,6 +4,7 @@
 #include <climits>
 #include <sstream>
 
+#include "board/board_chain.hpp"
 #include "board/board_internal.hpp"
 
 namespace l6470emu {
@@ -12,15 +13,9 @@ namespace l6470emu {
 constexpr std::uint64_t kDiagnosticRepeats = 10;
 
 Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
-    : log_(std::move(log)), time_(config.time, host), numbering_(config.numbering) {
+    : log_(std::move(log)), time_(config.time, host), numbering_(config.numbering), config_(config) {
   for (const ChainConfig& cc : config.chains) {
-    std::vector<Chip> chips;
-    chips.reserve(cc.chips.size());
-    for (const Variant* v : cc.chips) chips.emplace_back(*v);
-    // axis.K counts chips as the board's numbering= does.
-    const ChipNumbering axis_numbers(numbering_, chips.size());
-    for (const auto& [k, spec] : cc.axes) chips.at(axis_numbers.index_of(k)).attach_axis(spec);
-    auto cs = std::make_unique<ChainState>(cc, std::move(chips));
+    auto cs = std::make_unique<ChainState>(cc, build_chips(cc, numbering_));
     cs->name = cc.path.substr(cc.path.rfind('/') + 1);
     cs->index = chains_.size();
     cs->wired = cc.gpiochip.has_value();
@@ -29,14 +24,18 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     initial[static_cast<unsigned>(Pin::STCK)] = false;  // SW open (pulled up), STBY_RST high (running), STCK low
     cs->wire.assign(cs->chain.size(), initial);
     cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
+    cs->chip_logs.resize(cs->chain.size());  // never resized again: the sinks point into it
     for (std::size_t k = 0; k < cs->chain.size(); ++k) {
-      const std::string where = cs->name + ": " + ChipNumbering(numbering_, cs->chain.size()).label(k) + ": ";
+      ChainState::ChipLog* chip_log = &cs->chip_logs[k];
+      chip_log->where = cs->name + ": " + ChipNumbering(numbering_, cs->chain.size()).label(k) + ": ";
       // A driver looping on a bad command must not flood the log: each kind is shown
       // kDiagnosticRepeats times per chip, then counted, with a tally at every power of ten.
-      cs->chain.chip(k).set_diagnostic_sink([this, where, seen = std::array<std::uint64_t, 3>{}](const Diagnostic& d) mutable {
+      // The sink holds two pointers (no allocation when a chip is copied to look ahead).
+      cs->chain.chip(k).set_diagnostic_sink([this, chip_log](const Diagnostic& d) {
+        const std::string& where = chip_log->where;
         const std::size_t i = d.kind == DiagnosticKind::wrong_cmd ? 0 : d.kind == DiagnosticKind::notperf_cmd ? 1 : 2;
         const char* kind = i == 0 ? "WRONG_CMD" : i == 1 ? "NOTPERF_CMD" : "ignored";
-        const std::uint64_t n = ++seen[i];
+        const std::uint64_t n = ++chip_log->seen[i];
         if (n < kDiagnosticRepeats) {
           log_(where + kind + ": " + d.message);
         } else if (n == kDiagnosticRepeats) {
@@ -89,6 +88,7 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
   ChainState& c = state(chain);
   catch_up(c);
   f(c.chain);
+  if (c.recorder) c.recorder->outputs_may_have_changed();
   emit_changes(c, c.chain.now());
 }
 
@@ -100,6 +100,7 @@ SpiDevice& Board::begin_transfer(std::size_t chain) {
   const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
   if (start > c.chain.now()) advance_chain(c, start);
   record_outputs(c);
+  c.touched = true;
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
     if (other.get() != &c && other->config.bus == c.config.bus && other->chain.selected()) spi_of(*other).deselect();
@@ -218,8 +219,10 @@ Tick Board::first_change(ChainState& c, std::size_t chip, Pin pin, bool level, T
 }
 
 void Board::advance_chain(ChainState& c, Tick target) {
+  // Through the recording when there is one: it records every BUSY and FLAG edge at its tick.
+  SpiDevice& dev = spi_of(c);
   if (c.watched.empty()) {
-    c.chain.advance_to(target);
+    dev.advance_to(target);
     return;
   }
   // Step from edge to edge so that every edge carries the tick it happened at.
@@ -232,13 +235,13 @@ void Board::advance_chain(ChainState& c, Tick target) {
                                            c.chain.now(), target));
     }
     if (first == kNever) {
-      c.chain.advance_to(target);
+      dev.advance_to(target);
       break;
     }
-    c.chain.advance_to(first);
+    dev.advance_to(first);
     emit_changes(c, first);
   }
-  if (c.chain.now() < target) c.chain.advance_to(target);
+  if (c.chain.now() < target) dev.advance_to(target);
 }
 
 Tick Board::predict_next_edge(ChainState& c) {
@@ -262,7 +265,15 @@ Tick Board::predict_next_edge(ChainState& c) {
   return best;
 }
 
-bool Board::advance(Tick ticks) { return time_.is_virtual() && advance_to(time_.now() + ticks); }
+bool Board::advance(Tick ticks) {
+  if (!time_.is_virtual() || !advance_to(time_.now() + ticks)) return false;
+  for (auto& c : chains_)
+    if (c->recorder) {
+      c->recorder->mark_advance();
+      record_outputs(*c);
+    }
+  return true;
+}
 
 bool Board::advance_to(Tick tick) {
   if (!time_.is_virtual()) return false;

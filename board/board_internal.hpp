@@ -21,6 +21,12 @@ struct Board::ChainState {
     auto operator<=>(const WatchedPin&) const = default;
   };
 
+  /// How one chip's diagnostics are logged: its name in the log and how many of each kind came.
+  struct ChipLog {
+    std::string where;  // "spidev0.0: chip 1: "
+    std::array<std::uint64_t, 3> seen{};
+  };
+
   ChainConfig config;
   Chain chain;
   std::string name;                   // "spidev0.0"
@@ -30,6 +36,8 @@ struct Board::ChainState {
   std::vector<PinLevels> last;        // watched pins: the level last reported
   std::vector<WatchedPin> watched;    // sorted
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
+  std::vector<ChipLog> chip_logs;     // one per chip; the chips' diagnostic sinks point into it
+  bool touched = false;               // a transfer or a stimulus has reached the chips since power-up
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

@@ -249,33 +249,63 @@ std::string line_too_long() {
          std::to_string(kMaxTraceFrameBytes) + " bytes: not a trace, or a damaged one)";
 }
 
+namespace {
+
+/// Appends `v` in decimal, at least `width` digits (zeros in front).
+void append_decimal(std::string& out, std::uint64_t v, int width = 1) {
+  char buf[24];
+  char* p = buf + sizeof buf;
+  do {
+    *--p = static_cast<char>('0' + v % 10);
+    v /= 10;
+  } while (v != 0);
+  while (buf + sizeof buf - p < width) *--p = '0';
+  out.append(p, static_cast<std::size_t>(buf + sizeof buf - p));
+}
+
+}  // namespace
+
+void append_seconds(std::string& out, Tick t) {
+  append_decimal(out, t / kTicksPerSecond);
+  out += '.';
+  append_decimal(out, (t % kTicksPerSecond) * 25, 8);
+}
+
+void append_microseconds(std::string& out, Tick t) {
+  append_decimal(out, t / kTicksPerMicrosecond);
+  out += '.';
+  append_decimal(out, (t % kTicksPerMicrosecond) * 25, 2);
+}
+
+void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) out += ' ';
+    if (!known.empty() && !known[i]) {
+      out += "??";
+      continue;
+    }
+    out += kHex[bytes[i] >> 4];
+    out += kHex[bytes[i] & 15];
+  }
+}
+
 std::string format_seconds(Tick t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%llu.%08llu", static_cast<unsigned long long>(t / kTicksPerSecond),
-                static_cast<unsigned long long>((t % kTicksPerSecond) * 25));
-  return buf;
+  std::string s;
+  append_seconds(s, t);
+  return s;
 }
 
 std::string format_microseconds(Tick t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%llu.%02llu", static_cast<unsigned long long>(t / kTicksPerMicrosecond),
-                static_cast<unsigned long long>((t % kTicksPerMicrosecond) * 25));
-  return buf;
+  std::string s;
+  append_microseconds(s, t);
+  return s;
 }
 
 std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
-  static constexpr char kHex[] = "0123456789ABCDEF";
   std::string s;
   s.reserve(bytes.size() * 3);
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    if (i) s += ' ';
-    if (!known.empty() && !known[i]) {
-      s += "??";
-      continue;
-    }
-    s += kHex[bytes[i] >> 4];
-    s += kHex[bytes[i] & 15];
-  }
+  append_hex_bytes(s, bytes, known);
   return s;
 }
 

@@ -233,6 +233,9 @@ bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out);
 std::string format_seconds(Tick t);
 /// Ticks as microseconds with 2 decimals, exact ("1.75").
 std::string format_microseconds(Tick t);
+/// format_seconds / format_microseconds appended to `out` (no allocation when it has room).
+void append_seconds(std::string& out, Tick t);
+void append_microseconds(std::string& out, Tick t);
 
 // ---- bytes -------------------------------------------------------------------
 
@@ -246,5 +249,7 @@ constexpr int hex_digit_value(char c) {
 
 /// Bytes as upper-case hex separated by spaces ("D0 00 7E"); unknown MISO bytes as "??".
 std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
+/// hex_bytes appended to `out`.
+void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
 
 }  // namespace l6470emu

@@ -583,6 +583,18 @@ bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
   return true;
 }
 
+bool NativeTraceWriter::Held::same_bytes(const TraceEvent& e) const {
+  // As same_bytes(Held) with `e` held (without copying it).
+  const bool e_has_miso = !e.miso.empty();
+  if (duration != e.duration || has_miso != e_has_miso || !std::equal(mosi.begin(), mosi.end(), e.mosi.begin(), e.mosi.end()) ||
+      !std::equal(known.begin(), known.end(), e.miso_known.begin(), e.miso_known.end()))
+    return false;
+  if (miso.size() != e.miso.size()) return false;
+  for (std::size_t i = 0; i < miso.size(); ++i)
+    if ((known.empty() || known[i]) && miso[i] != e.miso[i]) return false;
+  return true;
+}
+
 TraceEvent NativeTraceWriter::Held::event() const {
   TraceEvent e;
   e.kind = TraceEventKind::frame;
@@ -681,7 +693,8 @@ void NativeTraceWriter::write_header(const TraceHeader& header) {
 }
 
 void NativeTraceWriter::write_line(const TraceEvent& e) {
-  line_ = format_event(e);
+  line_.clear();
+  append_event(line_, e);
   line_ += '\n';
   put(line_);
 }
@@ -717,10 +730,15 @@ std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group,
 
 namespace {
 
-/// The count of an open repeat line: 6 characters, right-aligned.
-std::string open_count_field(std::uint64_t count) {
-  std::string digits = std::to_string(count);
-  return std::string(digits.size() < 6 ? 6 - digits.size() : 0, ' ') + digits;
+/// The count of an open repeat line (at most kMaxOpenRepeatCount): 6 characters, right-aligned,
+/// and the newline.
+std::string_view open_count_field(std::uint64_t count, char (&buf)[7]) {
+  for (int i = 5; i >= 0; --i) {
+    buf[i] = count != 0 || i == 5 ? static_cast<char>('0' + count % 10) : ' ';
+    count /= 10;
+  }
+  buf[6] = '\n';
+  return {buf, 7};
 }
 
 }  // namespace
@@ -729,26 +747,30 @@ std::string open_count_field(std::uint64_t count) {
 /// (after which it may start a run).
 void NativeTraceWriter::frame(const TraceEvent& e) {
   if (in_run_) {
-    const Held& model = run_[partial_.size()];
-    Held h;
-    h.assign(e);
+    const Held& model = run_[partial_];
     // A repeat line stands for at most kMaxRepeatCount repetitions (an open one for
     // kMaxOpenRepeatCount): a longer run starts anew.
     const std::uint64_t max_count = open_runs() ? kMaxOpenRepeatCount : kMaxRepeatCount;
-    if (e.tick == model.tick + run_period_ && h.same_bytes(model) && line_count_ < max_count) {
-      partial_.push_back(std::move(h));
-      if (partial_.size() < run_group_) {
-        if (open_runs()) write_line(e);  // a killed process leaves it; taken into the count below
+    if (e.tick == model.tick + run_period_ && model.same_bytes(e) && line_count_ < max_count) {
+      if (++partial_ < run_group_) {
+        if (open_runs()) {
+          // A killed process leaves it; taken into the count below. Only its time is new.
+          line_.clear();
+          append_seconds(line_, e.tick);
+          line_ += run_bodies_[partial_ - 1];
+          put(line_);
+        }
         return;
       }
-      // A whole repetition more.
-      run_.swap(partial_);
-      partial_.clear();
+      // A whole repetition more: the group moves on by one period.
+      for (Held& h : run_) h.tick += run_period_;
+      partial_ = 0;
       ++line_count_;
       if (open_runs()) {
         // The count and the end of its line, in the 8-byte word that also holds the first byte
         // of the frame lines after it: one store makes them the repetition's count instead.
-        out_->replace_tail(count_offset_, open_count_field(line_count_) + "\n");
+        char field[7];
+        out_->replace_tail(count_offset_, open_count_field(line_count_, field));
         if (line_count_ == kMaxOpenRepeatCount) end_run();
       } else if (options_.flush_each_event &&
                  (line_count_ >= kCheckpointRepetitions || run_.back().tick - checkpoint_tick_ >= kCheckpointTicks)) {
@@ -759,10 +781,12 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     end_run();
   }
   write_line(e);
-  Held h;
-  h.assign(e);
-  recent_.push_back(std::move(h));
-  if (recent_.size() > 3 * kMaxRepeatGroup) recent_.erase(recent_.begin());
+  if (recent_.size() == 3 * kMaxRepeatGroup) {
+    std::rotate(recent_.begin(), recent_.begin() + 1, recent_.end());  // reuses the oldest one's buffers
+    recent_.back().assign(e);
+  } else {
+    recent_.emplace_back().assign(e);
+  }
   look_for_run();
 }
 
@@ -787,7 +811,13 @@ void NativeTraceWriter::look_for_run() {
     run_group_ = k;
     run_period_ = period;
     run_.assign(recent_.end() - static_cast<std::ptrdiff_t>(k), recent_.end());
-    partial_.clear();
+    partial_ = 0;
+    run_bodies_.resize(k);
+    for (std::size_t j = 0; j < k; ++j) {
+      run_bodies_[j].clear();
+      append_event_body(run_bodies_[j], run_[j].event());
+      run_bodies_[j] += '\n';
+    }
     line_count_ = 0;
     line_base_ = run_.back().tick;
     checkpoint_tick_ = run_.back().tick;
@@ -807,8 +837,8 @@ void NativeTraceWriter::write_open_repeat_line() {
   field = (field + 7) / 8 * 8;
   line_.append(static_cast<std::size_t>(field - start - line_.size()), ' ');
   count_offset_ = field;
-  line_ += open_count_field(0);
-  line_ += '\n';
+  char count[7];
+  line_ += open_count_field(0, count);
   put(line_);
 }
 
@@ -826,34 +856,47 @@ void NativeTraceWriter::write_repeat_line() {
 /// (an open line has them already), and they are the recent frames from now on.
 void NativeTraceWriter::end_run() {
   in_run_ = false;
+  // The frames of the unfinished repetition: the group's first ones, one period on.
+  std::vector<Held> partial(run_.begin(), run_.begin() + static_cast<std::ptrdiff_t>(partial_));
+  for (Held& h : partial) h.tick += run_period_;
   if (!open_runs()) {
     write_repeat_line();
-    for (const Held& h : partial_) write_line(h.event());
+    for (const Held& h : partial) write_line(h.event());
   }
   recent_ = std::move(run_);
-  for (Held& h : partial_) recent_.push_back(std::move(h));
+  for (Held& h : partial) recent_.push_back(std::move(h));
   run_.clear();
-  partial_.clear();
+  partial_ = 0;
   // A new run may start right away among these frames (but not one that includes the old run's
   // group twice: that would have continued the run).
 }
 
 std::string NativeTraceWriter::format_event(const TraceEvent& e) {
-  std::string s = format_seconds(e.tick);
+  std::string s;
+  append_event(s, e);
+  return s;
+}
+
+void NativeTraceWriter::append_event(std::string& s, const TraceEvent& e) {
+  append_seconds(s, e.tick);
+  append_event_body(s, e);
+}
+
+void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
   switch (e.kind) {
     case TraceEventKind::frame:
       s += " frame ";
-      s += format_microseconds(e.duration);
+      append_microseconds(s, e.duration);
       s += "us";
       if (!e.mosi.empty()) {
         s += ' ';
-        s += hex_bytes(e.mosi);
+        append_hex_bytes(s, e.mosi);
       }
       if (!e.miso.empty()) {
         s += " |";
         if (!e.mosi.empty()) {
           s += ' ';
-          s += hex_bytes(e.miso, e.miso_known);
+          append_hex_bytes(s, e.miso, e.miso_known);
         }
       }
       break;
@@ -877,7 +920,6 @@ std::string NativeTraceWriter::format_event(const TraceEvent& e) {
       s += " advance";
       break;
   }
-  return s;
 }
 
 std::string to_native_text(const Trace& trace, bool compact) {

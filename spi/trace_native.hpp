@@ -158,6 +158,10 @@ class NativeTraceWriter final : public TraceSink {
 
   /// One event as its native line, without the newline.
   static std::string format_event(const TraceEvent& e);
+  /// The same, appended to `out`.
+  static void append_event(std::string& out, const TraceEvent& e);
+  /// The line without its time (" frame 1.75us D0 | 00"), appended to `out`.
+  static void append_event_body(std::string& out, const TraceEvent& e);
   /// The `repeat` line, without the newline, saying that the last `group` frames (the last
   /// of them at `last_frame`) repeat `count` times, each repetition `period` after the one before.
   static std::string format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period);
@@ -169,6 +173,7 @@ class NativeTraceWriter final : public TraceSink {
     std::vector<std::uint8_t> mosi, miso, known;
     void assign(const TraceEvent& e);
     bool same_bytes(const Held& o) const;
+    bool same_bytes(const TraceEvent& e) const;
     TraceEvent event() const;
   };
   void put(const std::string& text);
@@ -196,7 +201,8 @@ class NativeTraceWriter final : public TraceSink {
   std::size_t run_group_ = 0;
   Tick run_period_ = 0;
   std::vector<Held> run_;
-  std::vector<Held> partial_;
+  std::size_t partial_ = 0;  // frames of the repetition under way (the group's first ones, a period on)
+  std::vector<std::string> run_bodies_;  // open runs: each group frame's line after its time, with the newline
   std::uint64_t line_count_ = 0;  // repetitions the run's repeat line stands for
   Tick line_base_ = 0;            // tick of the group's last frame as the file has it before that line
   std::uint64_t count_offset_ = 0;  // open line: where its count field starts in the output
