@@ -87,6 +87,7 @@ int Board::find_chain(const std::string& name) const {
 void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) {
   ChainState& c = state(chain);
   catch_up(c);
+  c.prediction_valid = false;
   f(c.chain);
   if (c.recorder) c.recorder->outputs_may_have_changed();
   emit_changes(c, c.chain.now());
@@ -96,6 +97,7 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
 
 SpiDevice& Board::begin_transfer(std::size_t chain) {
   ChainState& c = state(chain);
+  c.prediction_valid = false;
   // The use starts when the bus is free: now, or when the use before it on this bus ends.
   const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
   if (start > c.chain.now()) advance_chain(c, start);
@@ -118,6 +120,58 @@ Tick Board::transfer(std::size_t chain, std::span<const SpiTransfer> transfers, 
   return end_transfer(chain);
 }
 
+void Board::drive_chip_select(std::size_t chain, bool selected) {
+  ChainState& c = state(chain);
+  catch_up(c);
+  c.prediction_valid = false;
+  c.touched = true;
+  SpiDevice& dev = spi_of(c);
+  if (selected)
+    dev.select();
+  else
+    dev.deselect();
+  emit_changes(c, c.chain.now());
+}
+
+bool Board::chip_selected(std::size_t chain) const { return state(chain).chain.selected(); }
+
+namespace {
+std::uint8_t reversed(std::uint8_t b) {
+  b = static_cast<std::uint8_t>((b & 0xF0) >> 4 | (b & 0x0F) << 4);
+  b = static_cast<std::uint8_t>((b & 0xCC) >> 2 | (b & 0x33) << 2);
+  return static_cast<std::uint8_t>((b & 0xAA) >> 1 | (b & 0x55) << 1);
+}
+}  // namespace
+
+Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                        const BusSettings& settings) {
+  Tick start = time_.now();
+  for (const std::size_t i : chains) start = std::max(start, bus_free_[state(i).config.bus]);
+  const Tick per_byte = transfer_ticks(1, settings.speed_hz);
+  const Tick end = start + per_byte * tx.size();
+  bool any = false;
+  for (const std::size_t i : chains) {
+    ChainState& c = state(i);
+    if (!c.chain.selected()) continue;
+    c.prediction_valid = false;
+    c.touched = true;
+    if (start > c.chain.now()) advance_chain(c, start);
+    record_outputs(c);
+    SpiDevice& dev = spi_of(c);
+    for (std::size_t k = 0; k < tx.size(); ++k) {
+      dev.advance_to(dev.now() + per_byte);
+      std::uint8_t in = dev.exchange(settings.lsb_first ? reversed(tx[k]) : tx[k]);
+      if (settings.lsb_first) in = reversed(in);
+      rx[k] = any ? static_cast<std::uint8_t>(rx[k] & in) : in;
+    }
+    any = true;
+    emit_changes(c, c.chain.now());
+    bus_free_[c.config.bus] = end;
+  }
+  if (!any) std::fill(rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()), std::uint8_t{0});
+  return end;
+}
+
 // ---------------------------------------------------------------- pins
 
 bool Board::level_of(const ChainState& c, std::size_t chip, Pin pin) const {
@@ -135,6 +189,7 @@ bool Board::set_input(std::size_t chain, std::size_t chip, Pin pin, bool level) 
   if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
   ChainState& c = *chains_[chain];
   if (chip >= c.chain.size()) return false;
+  c.prediction_valid = false;
   if (c.wired) {
     bool& wire = c.wire[chip][static_cast<unsigned>(pin)];
     if (wire == level) return true;
@@ -162,6 +217,7 @@ bool Board::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
 
 void Board::watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched) {
   ChainState& c = state(chain);
+  c.prediction_valid = false;
   const ChainState::WatchedPin w{chip, pin};
   auto it = std::lower_bound(c.watched.begin(), c.watched.end(), w);
   if (!watched) {
@@ -221,8 +277,8 @@ Tick Board::first_change(ChainState& c, std::size_t chip, Pin pin, bool level, T
 void Board::advance_chain(ChainState& c, Tick target) {
   // Through the recording when there is one: it records every BUSY and FLAG edge at its tick.
   SpiDevice& dev = spi_of(c);
-  if (c.watched.empty()) {
-    dev.advance_to(target);
+  if (c.watched.empty() || (c.prediction_valid && target < c.predicted_edge)) {
+    dev.advance_to(target);  // nothing watched changes before `target`
     return;
   }
   // Step from edge to edge so that every edge carries the tick it happened at.
@@ -245,8 +301,9 @@ void Board::advance_chain(ChainState& c, Tick target) {
 }
 
 Tick Board::predict_next_edge(ChainState& c) {
-  Tick best = kNever;
   const Tick now = c.chain.now();
+  if (c.prediction_valid && c.predicted_edge > now) return c.predicted_edge;
+  Tick best = kNever;
   for (const ChainState::WatchedPin& w : c.watched) {
     if (!pin_is_chip_output(w.pin)) continue;
     if (c.chain.chip(w.chip).next_event_tick() == kNever) continue;
@@ -262,6 +319,8 @@ Tick Board::predict_next_edge(ChainState& c) {
       lo = hi;
     }
   }
+  c.prediction_valid = true;
+  c.predicted_edge = best;
   return best;
 }
 

@@ -34,6 +34,14 @@ struct PinEdge {
   Tick tick = 0;          ///< when it changed
 };
 
+/// How a controller clocks a bus for one use (a firmware front's SPI settings). Mode 3, MSB
+/// first is what the chips expect; docs/firmware.md says what reaches them otherwise.
+struct BusSettings {
+  std::uint32_t speed_hz = 5'000'000;  ///< SCK; each byte takes transfer_ticks(1, speed_hz)
+  std::uint8_t mode = 3;               ///< SPI mode: CPOL × 2 + CPHA
+  bool lsb_first = false;              ///< the bit order on the wire
+};
+
 /// Where the board's diagnostics go: one line per call, without "l6470emu: " or a newline.
 using LineSink = std::function<void(std::string_view)>;
 /// Where the board reports the edges of watched pins (called inside the board's operations).
@@ -99,6 +107,23 @@ class Board {
   Tick end_transfer(std::size_t chain);
   /// begin_transfer, run_message(transfers, timing), end_transfer. Returns the end tick.
   Tick transfer(std::size_t chain, std::span<const SpiTransfer> transfers, const BusTiming& timing = {});
+
+  // ---- SPI with the chip select on a pin: a firmware front drives CS and clocks bytes itself ----
+
+  /// Drives the chip select of chain `chain` now, as a microcontroller pin does: `selected`
+  /// (low) starts a frame, a rise ends it and the chips decode (recorded, edges reported).
+  void drive_chip_select(std::size_t chain, bool selected);
+  /// Whether chain `chain`'s chip select is low.
+  bool chip_selected(std::size_t chain) const;
+  /// Clocks `tx` on a bus whose chains are `chains`: every one of them whose chip select is low
+  /// receives the bytes; `rx` (as long as `tx`) gets MISO (0x00 when none is selected; several
+  /// selected chains drive MISO together, read as the AND of their bytes). The bytes start at
+  /// the board's time, or when the bus's last use ended if later, and each takes the bus time of
+  /// `settings.speed_hz`; LSB first reverses each byte on the wire. Returns the end tick (the
+  /// front moves the board's time there). The chips read the bytes as mode 3 whatever
+  /// `settings.mode` says (the front reports other modes).
+  Tick clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
+                   const BusSettings& settings);
 
   // ---- pins ---------------------------------------------------------------------
 

@@ -32,7 +32,7 @@ struct KeySpec {
 };
 
 // Every key, in the order the docs table lists them.
-constexpr std::array<KeySpec, 15> kKeys{{
+constexpr std::array<KeySpec, 26> kKeys{{
     {"chips", Scope::chain, "chips=2xL6470,L6480"},
     {"bus", Scope::chain, "bus=0"},
     {"cs", Scope::chain, "cs=1"},
@@ -41,6 +41,13 @@ constexpr std::array<KeySpec, 15> kKeys{{
     {"speed", Scope::chain, "speed=2000000"},
     {"mode", Scope::chain, "mode=3"},
     {"bufsiz", Scope::chain, "bufsiz=65536"},
+    {"cs_pin", Scope::chain, "cs_pin=D10"},
+    {"busy_pin", Scope::chain, "busy_pin=D3"},
+    {"flag_pin", Scope::chain, "flag_pin=D2"},
+    {"sw_pin", Scope::chain, "sw_pin=D5"},
+    {"stck_pin", Scope::chain, "stck_pin=D7"},
+    {"stby_rst_pin", Scope::chain, "stby_rst_pin=D6"},
+    {"spi", Scope::chain, "spi=SPI1"},
     {"time", Scope::board, "time=virtual"},
     {"scale", Scope::board, "scale=10"},
     {"idle", Scope::board, "idle=0.2"},
@@ -48,6 +55,10 @@ constexpr std::array<KeySpec, 15> kKeys{{
     {"socket", Scope::board, "socket=/tmp/l6470emu.sock"},
     {"trace", Scope::board, "trace=run.trace"},
     {"numbering", Scope::board, "numbering=mosi"},
+    {"call_time", Scope::board, "call_time=1us"},
+    {"loop_time", Scope::board, "loop_time=10us"},
+    {"limit", Scope::board, "limit=120s"},
+    {"apb_clock", Scope::board, "apb_clock=84000000"},
 }};
 
 const KeySpec* find_key(std::string_view name) {
@@ -58,8 +69,16 @@ const KeySpec* find_key(std::string_view name) {
 
 std::string key_list(Scope scope) {
   std::string out;
-  for (const KeySpec& k : kKeys)
-    if (k.scope == scope) out += (out.empty() ? "" : ", ") + std::string(k.name);
+  for (const KeySpec& k : kKeys) {
+    if (k.scope != scope) continue;
+    // The chip pins' keys, shortened: busy/flag/sw/stck/stby_rst_pin.
+    if (k.name.size() > 4 && k.name.substr(k.name.size() - 4) == "_pin" && k.name != "cs_pin") {
+      if (k.name != "busy_pin") continue;
+      out += ", busy/flag/sw/stck/stby_rst_pin";
+      continue;
+    }
+    out += (out.empty() ? "" : ", ") + std::string(k.name);
+  }
   return out;
 }
 
@@ -144,7 +163,12 @@ std::string_view key_alias(std::string_view key) {
       {"chip", "chips"},       {"variant", "chips"},  {"variants", "chips"},   {"device", "path"},
       {"dev", "path"},         {"node", "path"},      {"hz", "speed"},         {"speed_hz", "speed"},
       {"max_speed_hz", "speed"}, {"timescale", "scale"}, {"time-scale", "scale"}, {"time_scale", "scale"},
-      {"gpio", "gpiochip"},    {"record", "trace"},   {"cs_pin", "cs"},        {"chipselect", "cs"},
+      {"gpio", "gpiochip"},    {"record", "trace"},   {"chipselect", "cs"},    {"ss_pin", "cs_pin"},
+      {"ss", "cs_pin"},        {"nss", "cs_pin"},     {"busy", "busy_pin"},    {"flag", "flag_pin"},
+      {"sw", "sw_pin"},        {"stck", "stck_pin"},  {"stby", "stby_rst_pin"}, {"stby_pin", "stby_rst_pin"},
+      {"reset_pin", "stby_rst_pin"}, {"rst_pin", "stby_rst_pin"}, {"stbyrst_pin", "stby_rst_pin"},
+      {"spi_bus", "spi"},      {"controller", "spi"}, {"call_cost", "call_time"}, {"loop_cost", "loop_time"},
+      {"time_limit", "limit"}, {"run_limit", "limit"}, {"apb", "apb_clock"},  {"pclk", "apb_clock"},
   };
   const std::string k = lower(key);
   for (const auto& [alias, real] : kAliases)
@@ -202,6 +226,43 @@ std::string shortest(double v) {
   std::array<char, 32> buf{};
   const auto [p, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
   return ec == std::errc{} ? std::string(buf.data(), p) : std::to_string(v);
+}
+
+// A duration with its unit ("250ns", "1us", "1.5ms", "60s") as whole 250 ns ticks, from
+// `min` to `max` ticks; "" or what is wrong.
+std::string parse_duration(std::string_view s, Tick& out, Tick min, Tick max) {
+  static constexpr std::pair<std::string_view, long double> kUnits[] = {
+      {"ns", 1.0L}, {"us", 1e3L}, {"ms", 1e6L}, {"s", 1e9L}};
+  for (const auto& [unit, ns] : kUnits) {
+    if (s.size() <= unit.size() || s.substr(s.size() - unit.size()) != unit) continue;
+    const std::string_view digits = s.substr(0, s.size() - unit.size());
+    if (!digits.empty() && (digits.back() == 'n' || digits.back() == 'u' || digits.back() == 'm')) continue;  // "10ms" is not "10m" + "s"
+    double v = 0;
+    if (!parse_decimal(digits, v, 0, 1e15)) return "a number with a unit (ns, us, ms or s)";
+    const long double ticks = static_cast<long double>(v) * ns / 250.0L;
+    const long double whole = std::round(ticks);
+    if (std::fabs(ticks - whole) > 1e-6L * std::max(1.0L, whole)) return "a whole number of 250 ns ticks (the chip's tick)";
+    if (whole < static_cast<long double>(min) || whole > static_cast<long double>(max)) return "out of range";
+    out = static_cast<Tick>(whole);
+    return "";
+  }
+  return "a number with a unit (ns, us, ms or s)";
+}
+
+// `ticks` as parse_duration reads it back, in the largest unit that keeps it whole.
+std::string duration_text(Tick ticks) {
+  const std::uint64_t ns = ticks * 250;
+  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
+  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
+  if (ns % 1'000 == 0) return std::to_string(ns / 1'000) + "us";
+  return std::to_string(ns) + "ns";
+}
+
+// The shortest way to write a pin list (one pin for all chips, or one per chip with '-' for none).
+std::string pin_list_text(const ChipPinList& list) {
+  std::string out;
+  for (std::size_t i = 0; i < list.size(); ++i) out += (i ? "," : "") + (list[i] ? to_string(*list[i]) : std::string("-"));
+  return out;
 }
 
 // How the config file is read: at most this much (a board description is a few lines).
@@ -356,6 +417,18 @@ struct Parser {
       if (!from)
         return fail("numbering must be miso (chip 0 drives MISO) or mosi (chip 0 reads the host's MOSI), not " + q);
       cfg.numbering = *from;
+    } else if (k == "call_time" || k == "loop_time" || k == "limit") {
+      const bool limit = k == "limit";
+      Tick& ticks = limit ? cfg.firmware.limit_ticks : k == "call_time" ? cfg.firmware.call_ticks : cfg.firmware.loop_ticks;
+      const std::string range = limit ? "from 1ms to 1000000s" : "from 250ns to 1s";
+      const std::string example = " (e.g. " + std::string(key.example) + ")";
+      const std::string why = limit ? parse_duration(value, ticks, ticks_from_ms(1), Tick{1'000'000} * kTicksPerSecond)
+                                    : parse_duration(value, ticks, 1, kTicksPerSecond);
+      if (!why.empty())
+        return fail(k + " must be " + (why == "out of range" ? range : why + ", " + range) + example + ", not " + q);
+    } else if (k == "apb_clock") {
+      if (!parse_uint(value, cfg.firmware.apb_clock_hz, 1000, 1'000'000'000))
+        return fail("apb_clock must be a frequency in Hz from 1000 to 1000000000 (e.g. apb_clock=84000000), not " + q);
     }
     if ((k == "log" || k == "trace") && !cfg.trace.empty() && cfg.trace == cfg.log)
       return fail("log= and trace= name the same file " + q + ": diagnostics would be mixed into the trace");
@@ -400,6 +473,131 @@ struct Parser {
       if (!parse_uint(value, chain.mode, 0, 3)) return fail("mode must be an SPI mode from 0 to 3, not " + q);
     } else if (k == "bufsiz") {
       if (!parse_uint(value, chain.bufsiz, 1, 1u << 22)) return fail("bufsiz must be a number from 1 to 4194304, not " + q);
+    } else if (k == "cs_pin") {
+      const auto pin = parse_mcu_pin(value);
+      if (!pin) return fail(pin_error(k, value));
+      chain.pins.cs = *pin;
+    } else if (k == "spi") {
+      const auto name = parse_spi_controller(value);
+      if (!name)
+        return fail("spi must name an SPI controller: SPI, SPI1 to SPI9, HSPI, VSPI, FSPI, or hspi1 to hspi9 (an STM32 "
+                    "HAL handle), not " + q);
+      chain.pins.spi = *name;
+    } else {
+      for (unsigned p = 0; p < kPinsPerChip; ++p) {
+        if (k != pin_key(static_cast<Pin>(p))) continue;
+        ChipPinList list;
+        std::size_t start = 0;
+        while (start <= value.size()) {
+          std::size_t comma = value.find(',', start);
+          if (comma == std::string_view::npos) comma = value.size();
+          const std::string_view item = value.substr(start, comma - start);
+          start = comma + 1;
+          if (item == "-") {
+            list.emplace_back();
+            continue;
+          }
+          const auto pin = parse_mcu_pin(item);
+          if (!pin) return fail(pin_error(k, item) + (value.find(',') == std::string_view::npos ? "" : " in " + q));
+          list.emplace_back(*pin);
+          if (list.size() > kMaxChipsPerChain) return fail(std::string(k) + "= lists more pins than a chain has chips");
+        }
+        chain.pins.chip[p] = std::move(list);
+      }
+    }
+    return true;
+  }
+
+  static std::string pin_error(std::string_view key, std::string_view value) {
+    return std::string(key) + " must be a microcontroller pin: an Arduino pin (10, D10, A0 to A7, GPIO5; 0 to 127) or an " +
+           "STM32 port pin (PA0 to PK15), " + (key == "cs_pin" ? "" : "'-' for none, ") + "not " + quoted_text(value);
+  }
+
+  // The pin lists of a chain just read: one pin for every chip, or one per chip.
+  bool check_pin_lists(const ChainConfig& chain) {
+    for (unsigned p = 0; p < kPinsPerChip; ++p) {
+      const ChipPinList& list = chain.pins.chip[p];
+      if (list.size() <= 1 || list.size() == chain.chips.size()) continue;
+      const std::string k = pin_key(static_cast<Pin>(p));
+      return fail(k + "= lists " + std::to_string(list.size()) + " pins for a chain of " + std::to_string(chain.chips.size()) +
+                  " chip" + (chain.chips.size() == 1 ? "" : "s") +
+                  ": give one pin for all of them or one per chip, '-' for none (e.g. " + k + "=D3,D4,-)");
+    }
+    return true;
+  }
+
+  // No microcontroller pin drives two chip selects, a chip select and a chip pin, or a chip
+  // output (BUSY, FLAG: open drain, wired together) and a chip input (SW, STCK, STBY_RST).
+  bool check_pin_uses(const BoardConfig& cfg, const ChainConfig& chain) {
+    struct Use {
+      McuPin pin;
+      std::string key;
+      int kind;                 // 0 chip select, 1 chip output, 2 chip input
+      std::size_t chain;        // index; cfg.chains.size() = this chain
+    };
+    std::vector<Use> uses;
+    auto add = [&](const ChainConfig& c, std::size_t index) {
+      if (c.pins.cs) uses.push_back({*c.pins.cs, "cs_pin", 0, index});
+      for (unsigned p = 0; p < kPinsPerChip; ++p)
+        for (const auto& pin : c.pins.chip[p])
+          if (pin) uses.push_back({*pin, pin_key(static_cast<Pin>(p)), pin_is_chip_output(static_cast<Pin>(p)) ? 1 : 2, index});
+    };
+    for (std::size_t i = 0; i < cfg.chains.size(); ++i) add(cfg.chains[i], i);
+    const std::size_t first_new = uses.size();
+    add(chain, cfg.chains.size());
+    for (std::size_t b = first_new; b < uses.size(); ++b) {
+      for (std::size_t a = 0; a < b; ++a) {
+        const Use &x = uses[a], &y = uses[b];
+        if (x.pin != y.pin) continue;
+        const bool same_chain = x.chain == y.chain;
+        if (x.kind == y.kind && x.kind != 0) continue;  // outputs wired together, or one line driving several inputs
+        if (same_chain && x.key == y.key && x.kind != 0) continue;
+        const std::string where = same_chain ? "of this chain" : "of the chain in clause " + std::to_string(chain_clause[x.chain]);
+        const std::string why = x.kind == 0 || y.kind == 0
+                                    ? "a chip select is a pin of its own (one chain, nothing else)"
+                                    : "a chip output (BUSY, FLAG) and a chip input (SW, STCK, STBY_RST) cannot share a pin";
+        return fail("pin " + to_string(x.pin) + " is " + x.key + "= " + where + " and " + y.key + "= here: " + why);
+      }
+    }
+    return true;
+  }
+
+  // spi= without bus=: the bus of another chain on that controller, else a bus of its own. One
+  // bus, one controller name; a chain with cs_pin= and without cs= takes a free chip select.
+  bool place_on_bus(const BoardConfig& cfg, ChainConfig& chain, bool bus_given, bool cs_given) {
+    if (!chain.pins.spi.empty()) {
+      bool found = false;
+      for (std::size_t i = 0; i < cfg.chains.size() && !found; ++i) {
+        const ChainConfig& c = cfg.chains[i];
+        if (c.pins.spi != chain.pins.spi) continue;
+        found = true;
+        if (!bus_given)
+          chain.bus = c.bus;
+        else if (c.bus != chain.bus)
+          return fail("spi=" + chain.pins.spi + " is bus " + std::to_string(c.bus) + " in clause " +
+                      std::to_string(chain_clause[i]) + " and bus " + std::to_string(chain.bus) +
+                      " here: one controller drives one bus");
+      }
+      if (!found && !bus_given) {
+        std::set<unsigned> used;
+        for (const auto& c : cfg.chains) used.insert(c.bus);
+        chain.bus = 0;
+        while (used.count(chain.bus)) ++chain.bus;
+      }
+      for (std::size_t i = 0; i < cfg.chains.size(); ++i) {
+        const ChainConfig& c = cfg.chains[i];
+        if (c.bus == chain.bus && !c.pins.spi.empty() && c.pins.spi != chain.pins.spi)
+          return fail("bus " + std::to_string(chain.bus) + " is spi=" + c.pins.spi + " in clause " +
+                      std::to_string(chain_clause[i]) + " and spi=" + chain.pins.spi +
+                      " here: one bus has one controller (give this chain its own bus=)");
+      }
+    }
+    if (chain.pins.cs && !cs_given) {
+      std::set<unsigned> used;
+      for (const auto& c : cfg.chains)
+        if (c.bus == chain.bus) used.insert(c.cs);
+      chain.cs = 0;
+      while (used.count(chain.cs) && chain.cs < 255) ++chain.cs;
     }
     return true;
   }
@@ -452,7 +650,7 @@ struct Parser {
       if (spec == nullptr) {
         const std::string near = key_suggestion(key);
         return fail("unknown key " + quoted_text(key) + (near.empty() ? "" : ": did you mean " + near + "=?") +
-                    " (chain keys: " + key_list(Scope::chain) + "; board-wide keys: " + key_list(Scope::board) + ")");
+                    " (chain keys: " + key_list(Scope::chain) + "; board-wide: " + key_list(Scope::board) + ")");
       }
       if (auto it = in_clause.find(spec->name); it != in_clause.end())
         return fail(std::string(key) + "= is given twice in this clause (" + quoted_text(it->second) + ", then " +
@@ -475,6 +673,9 @@ struct Parser {
       if (!ok) return false;
     }
     if (!is_chain) return true;
+    if (!check_pin_lists(chain) || !place_on_bus(cfg, chain, in_clause.count("bus") != 0, in_clause.count("cs") != 0) ||
+        !check_pin_uses(cfg, chain))
+      return false;
     for (const auto& [k, spec] : axes)
       if (k >= chain.chips.size())
         return fail("axis." + std::to_string(k) + "= names chip " + std::to_string(k) + " but the chain has " +
@@ -616,6 +817,10 @@ std::string describe_board_config(const BoardConfig& config) {
       const std::string items = describe_axis_spec(spec);
       o << " axis." << k << "=" << (items.empty() ? "default" : items);
     }
+    if (c.pins.cs) o << " cs_pin=" << to_string(*c.pins.cs);
+    for (unsigned p = 0; p < kPinsPerChip; ++p)
+      if (!c.pins.chip[p].empty()) o << " " << pin_key(static_cast<Pin>(p)) << "=" << pin_list_text(c.pins.chip[p]);
+    if (!c.pins.spi.empty()) o << " spi=" << c.pins.spi;
     o << "\n";
   }
   // scale= only means something on the wall clock, idle= only in virtual time.
@@ -634,6 +839,14 @@ std::string describe_board_config(const BoardConfig& config) {
   if (!config.socket.empty()) o << "socket=" << config.socket << "\n";
   if (!config.trace.empty()) o << "trace=" << config.trace << "\n";
   if (config.numbering != NumberFrom::miso) o << "numbering=" << to_string(config.numbering) << "\n";
+  const FirmwareTiming fw_defaults;
+  const FirmwareTiming& fw = config.firmware;
+  std::string firmware;
+  if (fw.call_ticks != fw_defaults.call_ticks) firmware += " call_time=" + duration_text(fw.call_ticks);
+  if (fw.loop_ticks != fw_defaults.loop_ticks) firmware += " loop_time=" + duration_text(fw.loop_ticks);
+  if (fw.limit_ticks != fw_defaults.limit_ticks) firmware += " limit=" + duration_text(fw.limit_ticks);
+  if (fw.apb_clock_hz != fw_defaults.apb_clock_hz) firmware += " apb_clock=" + std::to_string(fw.apb_clock_hz);
+  if (!firmware.empty()) o << firmware.substr(1) << "\n";
   return o.str();
 }
 

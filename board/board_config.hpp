@@ -1,5 +1,6 @@
-// What an emulated board consists of: spidev chains (variants, bus, chip select, gpiochip),
-// the clock and the log, parsed from L6470EMU_CHAIN / a config file. No OS calls here.
+// What an emulated board consists of: spidev chains (variants, bus, chip select, gpiochip, the
+// microcontroller pins they are wired to), the clock, the log and a firmware run's timing,
+// parsed from L6470EMU_CHAIN / a config file. No OS calls here.
 #pragma once
 
 #include <cstddef>
@@ -9,7 +10,9 @@
 #include <string_view>
 #include <vector>
 
+#include "board/pin_map.hpp"
 #include "core/axis_spec.hpp"
+#include "core/tick.hpp"
 #include "core/variant.hpp"
 #include "daisychain/chip_numbering.hpp"
 
@@ -37,6 +40,17 @@ struct ChainConfig {
   std::uint32_t bufsiz = 4096;             ///< spidev's bufsiz module parameter
   /// axis.K=...: the mechanics behind chip K (board/axis_config.hpp), ascending K.
   std::vector<std::pair<std::size_t, AxisSpec>> axes;
+  /// cs_pin=, busy_pin=, ..., spi=: the microcontroller pins of a firmware run (board/pin_map.hpp).
+  ChainPins pins;
+};
+
+/// How a firmware run (firmware/) spends virtual time and where it ends (docs/firmware.md).
+struct FirmwareTiming {
+  Tick call_ticks = 4;                          ///< call_time=: what each HAL call costs (1 µs)
+  Tick loop_ticks = 40;                         ///< loop_time=: each loop() iteration's own cost (10 µs)
+  Tick limit_ticks = 60 * kTicksPerSecond;      ///< limit=: the run ends at this virtual time (60 s)
+  std::uint32_t apb_clock_hz = 84'000'000;      ///< apb_clock=: the clock an STM32 SPI prescaler divides
+  bool operator==(const FirmwareTiming&) const = default;
 };
 
 /// The whole emulated board.
@@ -47,6 +61,7 @@ struct BoardConfig {
   std::string socket;          ///< daemon socket (preload: forward to it instead of emulating in process)
   std::string trace;           ///< record every chain into this native trace file ("" = no recording)
   NumberFrom numbering = NumberFrom::miso;  ///< how diagnostics and `ctl` number the chips (numbering=)
+  FirmwareTiming firmware;                  ///< call_time=, loop_time=, limit=, apb_clock= (firmware runs)
 };
 
 /// A config error: one line saying where and what.
@@ -59,10 +74,13 @@ struct ConfigError {
 /// key=value, each key at most once per clause. A clause with chips= is a chain:
 ///   chips=L6470,2xL6480 [bus=0..32767] [cs=0..255] [path=/dev/NAME] [gpiochip=0..1023|none]
 ///   [speed=HZ] [mode=0..3] [bufsiz=N] [axis.K=ITEM,... (a motor, load, stops and switches behind chip K)]
+///   [cs_pin=PIN] [busy_pin=|flag_pin=|sw_pin=|stck_pin=|stby_rst_pin=PIN or PIN,PIN,... one per chip]
+///   [spi=SPI|SPI1..SPI9|HSPI|VSPI|FSPI|hspiN] (the microcontroller side of a firmware run)
 /// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
 /// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual
 /// time), log=stderr|off|FILE, socket=PATH, trace=FILE, numbering=miso|mosi (which end chip 0
-/// is at in diagnostics and `ctl`; chips= always lists the MISO end first). Every value is checked against its
+/// is at in diagnostics and `ctl`; chips= always lists the MISO end first), and for firmware runs
+/// call_time=, loop_time=, limit= (durations: 250ns, 1us, 10ms, 60s) and apb_clock=HZ. Every value is checked against its
 /// range; docs/linux.md has the table. `origin` names the source in error messages
 /// ("L6470EMU_CHAIN", a file name). Returns the config, or the first error, on one line:
 /// "l6470emu: config ORIGIN, clause N: what", user text quoted by quoted_text.

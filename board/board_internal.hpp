@@ -38,6 +38,11 @@ struct Board::ChainState {
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
   std::vector<ChipLog> chip_logs;     // one per chip; the chips' diagnostic sinks point into it
   bool touched = false;               // a transfer or a stimulus has reached the chips since power-up
+  // The next change of a watched BUSY/FLAG as predict_next_edge found it (kNever: none), valid
+  // until something other than time reaches the chain (a byte, a CS edge, an input, a fault,
+  // a new watch): until then the chain advances to any earlier tick without probing.
+  bool prediction_valid = false;
+  Tick predicted_edge = kNever;
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

@@ -12,6 +12,7 @@ SpiDevice& Board::spi_of(ChainState& c) {
 
 void Board::apply_input(ChainState& c, std::size_t chip, Pin pin, bool level) {
   c.touched = true;
+  c.prediction_valid = false;
   if (c.recorder) {
     c.recorder->set_input(chip, pin, level);
     return;
@@ -38,6 +39,7 @@ bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, 
   if (chip >= c.chain.size()) return false;
   catch_up(c);
   c.touched = true;
+  c.prediction_valid = false;
   if (c.recorder)
     c.recorder->fault(chip, fault, value);
   else
@@ -52,6 +54,7 @@ bool Board::set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& l
   if (chip >= c.chain.size() || c.chain.chip(chip).axis() == nullptr) return false;
   catch_up(c);
   c.touched = true;
+  c.prediction_valid = false;
   if (c.recorder)
     c.recorder->set_axis_load(chip, load);
   else

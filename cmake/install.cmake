@@ -1,5 +1,6 @@
 # Installation (GNUInstallDirs places): the model's static libraries with their public headers
-# under include/l6470emu/, exported as l6470emu::core/spi/daisychain/board/linux (find_package) and
+# under include/l6470emu/, exported as l6470emu::core/spi/daisychain/board/linux and the
+# firmware fronts l6470emu::firmware/arduino/stm32hal with l6470emu::ino (find_package) and
 # described in l6470emu.pc (pkg-config); the preload library in lib/l6470emu/; the l6470emu
 # program, its man page and the docs. The Python module installs itself (python/CMakeLists.txt).
 # The locations themselves are set in cmake/install_dirs.cmake (included first).
@@ -21,10 +22,25 @@ add_library(l6470emu_all INTERFACE)
 target_link_libraries(l6470emu_all INTERFACE l6470emu_linux)
 set_target_properties(l6470emu_all PROPERTIES EXPORT_NAME l6470emu)
 
+# The firmware fronts: their libraries, their headers (Arduino.h, SPI.h, stm32f4xx_hal.h, ...
+# keep their own names in include/l6470emu/firmware/{arduino,stm32}), the sketch preprocessor
+# (l6470emu::ino, in libexec) and the CMake functions that use them.
+foreach(front firmware arduino stm32hal)
+  set_target_properties(l6470emu_${front} PROPERTIES EXPORT_NAME ${front})
+endforeach()
+set_target_properties(l6470emu-ino PROPERTIES EXPORT_NAME ino)
+
 install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_board l6470emu_linux l6470emu_all
+                l6470emu_firmware l6470emu_arduino l6470emu_stm32hal l6470emu-ino
   EXPORT l6470emuTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+  RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/l6470emu)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/firmware DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
+  FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h"
+  PATTERN "*_internal.hpp" EXCLUDE
+  PATTERN "sketch_prep.hpp" EXCLUDE)
+install(FILES ${CMAKE_CURRENT_LIST_DIR}/l6470emuFirmware.cmake DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
 list(TRANSFORM layers PREPEND ${PROJECT_SOURCE_DIR}/ OUTPUT_VARIABLE layer_dirs)
 install(DIRECTORY ${layer_dirs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
   FILES_MATCHING PATTERN "*.hpp"

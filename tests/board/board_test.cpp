@@ -158,5 +158,88 @@ TEST(BoardSpi, TwoChainsOnOneBusTakeTurnsAndAChipSelectLeftLowIsReleasedWhileAno
   EXPECT_EQ(v.board.time().now(), Tick{0});
 }
 
+
+TEST(BoardPinChipSelect, BytesReachOnlyTheChainsWhoseChipSelectIsLowAndTakeTheirBusTime) {
+  VirtualBoard v("bus=0 cs=0 chips=L6470; bus=0 cs=1 chips=L6480; time=virtual");
+  const std::array<std::size_t, 2> bus{0, 1};
+  BusSettings settings;
+  settings.speed_hz = 4'000'000;  // 2 us a byte: 8 ticks
+  auto get_config = [&](std::size_t chain, std::uint8_t opcode) {
+    std::array<std::uint8_t, 3> mosi{opcode, 0, 0}, miso{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      v.board.drive_chip_select(chain, true);
+      v.board.advance_to(v.board.clock_bytes(bus, std::span(&mosi[i], 1), std::span(&miso[i], 1), settings));
+      v.board.drive_chip_select(chain, false);
+      v.board.advance(4);  // CS high for 1 us
+    }
+    return miso[1] << 8 | miso[2];
+  };
+  EXPECT_EQ(get_config(0, 0x38), 0x2E88);  // GetParam(CONFIG) of the L6470 (0x18)
+  EXPECT_EQ(get_config(1, 0x3A), 0x2C88);  // the L6480's CONFIG is at 0x1A
+  EXPECT_EQ(v.board.time().now(), Tick{6 * (8 + 4)});
+  // Nothing selected: the bytes take their time, MISO reads 0x00 and no chip sees them.
+  std::array<std::uint8_t, 2> mosi{0xD0, 0xD0}, miso{0xAA, 0xAA};
+  EXPECT_EQ(v.board.clock_bytes(bus, mosi, miso, settings), v.board.time().now() + 16);
+  EXPECT_EQ(miso, (std::array<std::uint8_t, 2>{0, 0}));
+  EXPECT_FALSE(v.board.chip_selected(0));
+}
+
+TEST(BoardPinChipSelect, LsbFirstReachesTheChipBitReversedAndTwoSelectedChainsShareMiso) {
+  VirtualBoard v("bus=0 cs=0 chips=L6470; bus=0 cs=1 chips=L6470; time=virtual");
+  const std::array<std::size_t, 2> bus{0, 1};
+  BusSettings lsb;
+  lsb.lsb_first = true;
+  // 0x1C sent LSB first is 0x38 on the wire: GetParam(CONFIG). The answer comes back reversed too.
+  std::array<std::uint8_t, 1> mosi{0x1C}, miso{};
+  v.board.drive_chip_select(0, true);
+  v.board.clock_bytes(bus, mosi, miso, lsb);
+  v.board.drive_chip_select(0, false);
+  std::array<std::uint8_t, 2> answer{};
+  for (std::uint8_t& b : answer) {
+    v.board.drive_chip_select(0, true);
+    const std::uint8_t nop = 0;
+    v.board.advance_to(v.board.clock_bytes(bus, std::span(&nop, 1), std::span(&b, 1), lsb));
+    v.board.drive_chip_select(0, false);
+  }
+  EXPECT_EQ(answer, (std::array<std::uint8_t, 2>{0x74, 0x11}));  // 0x2E, 0x88 bit-reversed
+  // Both chip selects low: both chains take the byte; MISO is what both drive together.
+  v.board.drive_chip_select(0, true);
+  v.board.drive_chip_select(1, true);
+  std::array<std::uint8_t, 1> status{0xD0};
+  v.board.advance_to(v.board.clock_bytes(bus, status, miso, BusSettings{}));
+  v.board.drive_chip_select(0, false);
+  v.board.drive_chip_select(1, false);
+  EXPECT_EQ(v.board.chain(0).chip(0).peek(Reg::STATUS) & 0x0200, 0x0200) << "GetStatus cleared UVLO on chain 0";
+  EXPECT_EQ(v.board.chain(1).chip(0).peek(Reg::STATUS) & 0x0200, 0x0200) << "and on chain 1";
+}
+
+TEST(BoardEdges, APredictedEdgeStaysExactWhileTimeMovesInSmallStepsAndANewCommandIsSeen) {
+  VirtualBoard v("bus=0 cs=0 chips=L6470; time=virtual");
+  std::vector<PinEdge> edges;
+  v.board.set_edge_sink([&](const PinEdge& e) { edges.push_back(e); });
+  v.board.watch_pin(0, 0, Pin::BUSY, true);
+  auto frame = [&](std::uint8_t b) {
+    v.board.drive_chip_select(0, true);
+    std::uint8_t in = 0;
+    v.board.advance_to(v.board.clock_bytes(std::array<std::size_t, 1>{0}, std::span(&b, 1), std::span(&in, 1), {}));
+    v.board.drive_chip_select(0, false);
+  };
+  for (std::uint8_t b : {0x41, 0x00, 0x0C, 0x80}) frame(b);  // Move(FWD, 3200)
+  const Tick decoded = v.board.time().now();
+  ASSERT_EQ(edges.size(), 1u);
+  const Tick rise = decoded + move_profile_ticks(true, 3200);
+  EXPECT_EQ(v.board.next_edge_tick(), rise);
+  while (v.board.time().now() < rise + 100) v.board.advance(997);  // steps that straddle the edge
+  ASSERT_EQ(edges.size(), 2u);
+  EXPECT_EQ(edges[1].tick, rise);
+  // A new move invalidates the prediction: its own end is found.
+  for (std::uint8_t b : {0x41, 0x00, 0x0C, 0x80}) frame(b);
+  const Tick second = v.board.time().now() + move_profile_ticks(true, 3200);
+  EXPECT_EQ(v.board.next_edge_tick(), second);
+  v.board.advance_to(second + 1);
+  ASSERT_EQ(edges.size(), 4u);
+  EXPECT_EQ(edges[3].tick, second);
+}
+
 }  // namespace
 }  // namespace l6470emu::test

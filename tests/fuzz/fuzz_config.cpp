@@ -1,6 +1,7 @@
 // libFuzzer harness of the board description parser (board/board_config.hpp parse_board_config):
 // any text gives a config or one error line, never a crash; an accepted config's own
-// description (describe_board_config, what `serve` prints) reads back to the same chains.
+// description (describe_board_config, what `serve` prints) reads back to the same chains,
+// their microcontroller pins and a firmware run's timing.
 #include <string_view>
 
 #include "board/board_config.hpp"
@@ -31,10 +32,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const ChainConfig &x = a.chains[i], &y = b.chains[i];
     FUZZ_CHECK(x.bus == y.bus && x.cs == y.cs && x.path == y.path && x.chips == y.chips && x.gpiochip == y.gpiochip &&
                    x.max_speed_hz == y.max_speed_hz && x.mode == y.mode && x.bufsiz == y.bufsiz &&
-                   x.axes == y.axes,
+                   x.axes == y.axes && x.pins == y.pins,
                "chain %zu reads back differently from its description:\n%.300s", i, description.c_str());
   }
-  FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace,
+  FUZZ_CHECK(a.time.virtual_time == b.time.virtual_time && a.trace == b.trace && a.firmware == b.firmware,
              "time or trace reads back differently from the description:\n%.300s", description.c_str());
   return 0;
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Install and package test (ctest `install_and_package`): `cmake --install` into a temporary
 # prefix; the README's CMake consumer (examples/cmake-consumer) built against it with
-# find_package and with pkg-config, and run; every installed header compiles; the installed
+# find_package and with pkg-config, and run; the README's Arduino sketch (examples/arduino-sketch)
+# built with the installed l6470emu_add_sketch and run; every installed header compiles; the installed
 # Python module finds the installed preload library and its pytest plugin loads through the
 # entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
 # into a throwaway root with dpkg -x, and the consumer is built and run against that too.
@@ -34,6 +35,13 @@ consumers() {
   c++ -std=c++20 -O1 -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
   out=$("$work/$name-pc") || fail "$name: pkg-config consumer exited $?"
   [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: pkg-config consumer printed '$out'"
+
+  step "$name: an Arduino sketch (l6470emu_add_sketch from the installed package)"
+  cmake -S "$source/examples/arduino-sketch" -B "$work/$name-sketch" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-sketch.log" 2>&1 || { cat "$work/$name-sketch.log"; fail "$name: sketch configure"; }
+  cmake --build "$work/$name-sketch" >>"$work/$name-sketch.log" 2>&1 || { cat "$work/$name-sketch.log"; fail "$name: sketch build"; }
+  out=$("$work/$name-sketch/arduino_sketch") || fail "$name: arduino_sketch exited $?"
+  [[ "$out" =~ ^at\ 12800\ after\ [0-9]+\ ms$ ]] || fail "$name: arduino_sketch printed '$out'"
 }
 
 # The installed Python package under SITE finds the preload library at PRELOAD.
@@ -63,7 +71,9 @@ step "cmake --install into a temporary prefix"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 for f in bin/l6470emu include/l6470emu/core/chip.hpp include/l6470emu/daisychain/host.hpp \
-         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md; do
+         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md \
+         include/l6470emu/firmware/firmware.h include/l6470emu/firmware/arduino/Arduino.h include/l6470emu/firmware/arduino/SPI.h \
+         include/l6470emu/firmware/stm32/stm32f4xx_hal.h libexec/l6470emu/l6470emu-ino; do
   [ -f "$prefix/$f" ] || fail "not installed: $f"
 done
 [ -z "$(find "$prefix/include" -path '*preload*' -o -name '*_internal.hpp')" ] || fail "internal headers were installed"
@@ -81,9 +91,14 @@ cat >"$work/targets/CMakeLists.txt" <<'CMAKE'
 cmake_minimum_required(VERSION 3.25)
 project(targets LANGUAGES CXX)
 find_package(l6470emu CONFIG REQUIRED)
-foreach(t core spi daisychain board linux l6470emu)
+foreach(t core spi daisychain board linux l6470emu firmware arduino stm32hal ino)
   if(NOT TARGET l6470emu::${t})
     message(FATAL_ERROR "no target l6470emu::${t}")
+  endif()
+endforeach()
+foreach(f l6470emu_add_sketch l6470emu_add_hal_program l6470emu_add_firmware_program)
+  if(NOT COMMAND ${f})
+    message(FATAL_ERROR "no function ${f}")
   endif()
 endforeach()
 if(NOT EXISTS "${l6470emu_PRELOAD_LIBRARY}" OR NOT EXISTS "${l6470emu_PROGRAM}")
@@ -122,6 +137,8 @@ dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./||' >"$work/deb.files"
 for pattern in usr/bin/l6470emu 'usr/lib/.*l6470emu/libl6470emu-preload\.so' 'usr/lib/.*libl6470emu_core\.a' \
                'usr/lib/.*cmake/l6470emu/l6470emuConfig\.cmake' 'usr/lib/.*pkgconfig/l6470emu\.pc' \
                usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1 \
+               usr/include/l6470emu/firmware/arduino/Arduino.h usr/include/l6470emu/firmware/stm32/stm32_hal.h \
+               usr/libexec/l6470emu/l6470emu-ino 'usr/lib/.*cmake/l6470emu/l6470emuFirmware\.cmake' \
                usr/share/doc/l6470emu/README.md usr/share/doc/l6470emu/examples/cmake-consumer/main.cpp \
                'usr/lib/python3/dist-packages/l6470emu/_l6470emu\.cpython-.*\.so' \
                usr/lib/python3/dist-packages/l6470emu/__init__.py usr/lib/python3/dist-packages/l6470emu/_l6470emu.pyi \

@@ -252,8 +252,10 @@ TEST(BoardConfig, ACommentRunsToTheEndOfTheLineEvenPastASemicolon) {
   EXPECT_TRUE(r.config->time.virtual_time);
   EXPECT_EQ(r.config->chains.size(), 1u);
   EXPECT_EQ(error_of("bus=0 chips=L6470 # ok\n; colour=red", 3), "unknown key 'colour' (chain keys: chips, bus, cs, "
-                                                                 "path, gpiochip, speed, mode, bufsiz; board-wide keys: "
-                                                                 "time, scale, idle, log, socket, trace, numbering)");
+                                                                 "path, gpiochip, speed, mode, bufsiz, cs_pin, "
+                                                                 "busy/flag/sw/stck/stby_rst_pin, spi; board-wide: "
+                                                                 "time, scale, idle, log, socket, trace, numbering, "
+                                                                 "call_time, loop_time, limit, apb_clock)");
 }
 
 TEST(BoardConfig, DefaultGpiochipsAvoidTheNumbersOtherChainsAskFor) {

@@ -1,6 +1,7 @@
 """The README's examples are tests: its Python session runs as a doctest, and every code block
-marked `<!-- file: PATH -->` is that file verbatim (the files themselves are built and run by
-tests/install/install_test.sh and by this pytest session: examples/pytest-driver)."""
+marked `<!-- file: PATH -->` in it and in docs/firmware.md is that file verbatim (the files
+themselves are built and run by tests/install/install_test.sh, by ctest's examples and by this
+pytest session: examples/pytest-driver)."""
 import doctest
 import re
 from pathlib import Path
@@ -26,3 +27,11 @@ def test_every_file_shown_in_the_readme_is_the_file_itself():
     assert len(blocks) >= 3, "the README shows the CMake consumer and the pytest example"
     for path, text in blocks:
         assert (SOURCE_DIR / path).read_text() == text, f"README.md's copy of {path} differs from the file"
+
+
+def test_every_file_shown_in_the_firmware_page_is_the_file_itself():
+    page = (SOURCE_DIR / "docs" / "firmware.md").read_text()
+    blocks = re.findall(r"<!-- file: (\S+) -->\n```[a-z]*\n(.*?)```", page, re.S)
+    assert blocks, "docs/firmware.md shows the C-API shim"
+    for path, text in blocks:
+        assert (SOURCE_DIR / path).read_text() == text, f"docs/firmware.md's copy of {path} differs from the file"

@@ -1,0 +1,680 @@
+// FirmwareRuntime: time and its costs, the pins as the board wires them, edges turned into
+// pending interrupts, delivery, SPI controllers, the end of a run.
+#include "firmware/runtime.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "daisychain/chip_numbering.hpp"
+
+namespace l6470emu {
+
+/// One microcontroller pin: how the program set it, what the board wires to it, who watches it.
+struct FirmwareRuntime::Line {
+  int key = 0;
+  McuPinMode mode = McuPinMode::input;
+  bool latch = false;             // the output latch (an AVR's PORT bit)
+  int cs_chain = -1;              // the chain whose chip select it is
+  std::vector<ChipRef> outputs;   // chip BUSY/FLAG on it (open drain: wired together)
+  std::vector<ChipRef> inputs;    // chip SW/STCK/STBY_RST it drives
+  int applied = -1;               // what it last drove onto the board: -1 unknown, 0 low, 1 high, 2 released
+  unsigned edges = 0;
+  std::function<void(bool)> on_edge;
+  bool level_watch = false;
+  bool watched_level = false;
+  std::function<void(bool)> on_level;
+  bool seen = true;               // the level the watch last saw
+  bool board_watched = false;
+};
+
+namespace {
+
+/// Virtual time reads no clock: the board's time starts at kVirtualMonotonicOrigin and moves
+/// only when the runtime moves it, so every run is the same.
+class FixedHostClock final : public HostClock {
+ public:
+  std::int64_t monotonic_ns() override { return kVirtualMonotonicOrigin; }
+  std::int64_t realtime_ns() override { return kVirtualMonotonicOrigin; }
+  void sleep_until(std::int64_t) override {}
+};
+
+/// A time as "12.5 s" (whole microseconds at most).
+std::string seconds_text(Tick ticks) {
+  const std::uint64_t us = ticks / kTicksPerMicrosecond;
+  std::string frac = std::to_string(us % 1'000'000);
+  frac.insert(0, 6 - frac.size(), '0');
+  while (!frac.empty() && frac.back() == '0') frac.pop_back();
+  return std::to_string(us / 1'000'000) + (frac.empty() ? "" : "." + frac) + " s";
+}
+
+std::string limit_text(Tick ticks) {
+  const std::uint64_t ns = ticks * 250;
+  if (ns % 1'000'000'000 == 0) return std::to_string(ns / 1'000'000'000) + "s";
+  if (ns % 1'000'000 == 0) return std::to_string(ns / 1'000'000) + "ms";
+  return std::to_string(ns / 1000) + "us";
+}
+
+/// The default wiring of chain 0 when a description names no pin (docs/firmware.md): an Uno's
+/// D10 (SS) for CS, D2 and D3 (its two interrupt pins) for FLAG and BUSY, D6 for STBY_RST; for
+/// the STM32 HAL the pins a Nucleo-64 brings to those Arduino header positions.
+void apply_default_pins(BoardConfig& config, FirmwareFront front) {
+  if (config.chains.empty()) return;
+  for (const ChainConfig& c : config.chains)
+    if (c.pins.any()) return;
+  ChainPins& p = config.chains[0].pins;
+  auto pin = [](const char* name) { return *parse_mcu_pin(name); };
+  const bool stm32 = front == FirmwareFront::stm32_hal;
+  p.cs = pin(stm32 ? "PB6" : "D10");
+  p.chip[static_cast<unsigned>(Pin::FLAG)] = {pin(stm32 ? "PA10" : "D2")};
+  p.chip[static_cast<unsigned>(Pin::BUSY)] = {pin(stm32 ? "PB3" : "D3")};
+  p.chip[static_cast<unsigned>(Pin::STBY_RST)] = {pin(stm32 ? "PB10" : "D6")};
+}
+
+}  // namespace
+
+FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log)
+    : front_(front), config_(config), timing_(config.firmware), log_(std::move(log)) {
+  if (!config_.socket.empty())
+    throw std::invalid_argument("socket= forwards to an l6470emu serve daemon; a firmware run has its board in itself");
+  if (!config_.time.virtual_time && config_.time.scale != 1.0)
+    throw std::invalid_argument("scale= is for wall time; a firmware run is always in virtual time");
+  if (config_.chains.empty()) throw std::invalid_argument("the board description has no chain");
+  config_.time.virtual_time = true;
+  config_.time.idle_ns = 0;
+  apply_default_pins(config_, front_);
+  clock_ = std::make_unique<FixedHostClock>();
+  board_ = std::make_unique<Board>(config_, log_, *clock_);
+  board_->set_edge_sink([this](const PinEdge& e) { edges_.push_back(e); });
+  wire(config_);
+}
+
+FirmwareRuntime::~FirmwareRuntime() { finish(); }
+
+// ---------------------------------------------------------------- wiring
+
+FirmwareRuntime::Line* FirmwareRuntime::line(int key) {
+  if (key < 0 || key >= kPinKeys || line_of_[static_cast<std::size_t>(key)] == 0) return nullptr;
+  return lines_[static_cast<std::size_t>(line_of_[static_cast<std::size_t>(key)] - 1)].get();
+}
+
+const FirmwareRuntime::Line* FirmwareRuntime::line(int key) const {
+  return const_cast<FirmwareRuntime*>(this)->line(key);
+}
+
+FirmwareRuntime::Line& FirmwareRuntime::make_line(int key) {
+  if (Line* l = line(key)) return *l;
+  auto l = std::make_unique<Line>();
+  l->key = key;
+  lines_.push_back(std::move(l));
+  line_of_[static_cast<std::size_t>(key)] = static_cast<int>(lines_.size());
+  return *lines_.back();
+}
+
+void FirmwareRuntime::wire(const BoardConfig& config) {
+  chip_line_.resize(config.chains.size());
+  tracked_.resize(config.chains.size());
+  for (std::size_t i = 0; i < config.chains.size(); ++i) {
+    const ChainConfig& c = config.chains[i];
+    const std::size_t n = c.chips.size();
+    std::array<int, kPinsPerChip> none;
+    none.fill(-1);
+    chip_line_[i].assign(n, none);
+    tracked_[i].assign(n, std::array<bool, kPinsPerChip>{true, true, true, true, true});
+    const std::string name = board_->chain_name(i);
+    if (c.pins.cs) {
+      make_line(key_of(*c.pins.cs)).cs_chain = static_cast<int>(i);
+    } else {
+      log(name + ": no cs_pin= in the board description: nothing selects this chain");
+    }
+    const ChipNumbering numbers(config.numbering, n);
+    for (unsigned p = 0; p < kPinsPerChip; ++p) {
+      const Pin pin = static_cast<Pin>(p);
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto mcu = chip_mcu_pin(c.pins, pin, numbers.number_of(k));
+        if (!mcu) continue;
+        const int key = key_of(*mcu);
+        chip_line_[i][k][p] = key;
+        Line& l = make_line(key);
+        (pin_is_chip_output(pin) ? l.outputs : l.inputs).push_back(ChipRef{i, k, pin});
+      }
+    }
+  }
+  // Pins the front has no name for.
+  for (const int key : wired_pins()) {
+    if (front_ == FirmwareFront::stm32_hal && key < 128)
+      log("pin " + std::to_string(key) + " of the board description is an Arduino pin number: an STM32 HAL program "
+          "names its pins PA0 to PK15 and cannot reach it");
+    if (front_ == FirmwareFront::arduino && key >= 256)
+      log("pin " + to_string(pin_of(key)) + " of the board description has no Arduino pin number (PA0 to PH15 have)");
+  }
+  // Controllers: a bus is named by the spi= of a chain on it, else after its number.
+  std::vector<unsigned> buses;
+  for (const ChainConfig& c : config.chains)
+    if (std::find(buses.begin(), buses.end(), c.bus) == buses.end()) buses.push_back(c.bus);
+  std::sort(buses.begin(), buses.end());
+  for (const unsigned bus : buses) {
+    Controller ctl;
+    bool named = false;
+    for (std::size_t i = 0; i < config.chains.size(); ++i) {
+      if (config.chains[i].bus != bus) continue;
+      ctl.chains.push_back(i);
+      if (!config.chains[i].pins.spi.empty()) {
+        ctl.name = config.chains[i].pins.spi;
+        named = true;
+      }
+    }
+    if (!named)
+      ctl.name = front_ == FirmwareFront::stm32_hal ? "SPI" + std::to_string(bus + 1)
+                 : bus == 0                         ? std::string("SPI")
+                                                    : "SPI" + std::to_string(bus);
+    for (const Controller& other : controllers_)
+      if (other.name == ctl.name)
+        throw std::invalid_argument("two buses are both controller " + ctl.name +
+                                    " (one by spi=, one after its bus= number): name them apart with spi=");
+    controllers_.push_back(std::move(ctl));
+  }
+}
+
+std::vector<int> FirmwareRuntime::wired_pins() const {
+  std::vector<int> keys;
+  for (const auto& l : lines_)
+    if (l->cs_chain >= 0 || !l->outputs.empty() || !l->inputs.empty()) keys.push_back(l->key);
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+bool FirmwareRuntime::pin_wired(int key) const {
+  const Line* l = line(key);
+  return l && (l->cs_chain >= 0 || !l->outputs.empty() || !l->inputs.empty());
+}
+
+// ---------------------------------------------------------------- time
+
+void FirmwareRuntime::set_now(Tick tick) {
+  now_ = tick;
+  board_->time().set_now(tick);
+}
+
+void FirmwareRuntime::call() { spend(timing_.call_ticks); }
+
+void FirmwareRuntime::spend(Tick ticks) {
+  if (now_ + ticks >= timing_.limit_ticks) {
+    set_now(std::max(now_, timing_.limit_ticks));  // the run ends at the limit itself
+    stop_at_limit();
+  }
+  set_now(now_ + ticks);
+  catch_up();
+  if (!polled_.empty()) poll_levels();
+  if (any_pending_) deliver();
+}
+
+void FirmwareRuntime::catch_up() {
+  if (board_watches_ == 0 || now_ < next_edge_) return;
+  board_->advance_to(now_);
+  process_edges();
+  next_edge_ = board_->next_edge_tick();
+  process_edges();
+}
+
+void FirmwareRuntime::sleep_until(Tick tick) {
+  const Tick target = std::min(tick, timing_.limit_ticks);
+  constexpr Tick kPollTicks = ticks_from_ms(1);
+  while (now_ < target) {
+    Tick step = target;
+    if (board_watches_) {
+      catch_up();
+      step = std::min(step, next_edge_);
+    }
+    if (!polled_.empty()) step = std::min(step, now_ + kPollTicks);
+    set_now(std::max(step, now_));
+    catch_up();
+    if (!polled_.empty()) poll_levels();
+    if (any_pending_) deliver();
+  }
+  if (now_ >= timing_.limit_ticks) stop_at_limit();
+}
+
+// ---------------------------------------------------------------- pins
+
+void FirmwareRuntime::set_pin_mode(int key, McuPinMode mode) {
+  Line& l = make_line(key);
+  l.mode = mode;
+  // On an Arduino the pull-up is the output latch (an AVR's PORT bit): INPUT clears it, INPUT_PULLUP sets it.
+  if (front_ == FirmwareFront::arduino && mode == McuPinMode::input_pullup) l.latch = true;
+  if (front_ == FirmwareFront::arduino && mode == McuPinMode::input) l.latch = false;
+  apply_drive(l);
+  line_changed(l);
+  process_edges();
+  if (any_pending_) deliver();
+}
+
+McuPinMode FirmwareRuntime::pin_mode(int key) const {
+  const Line* l = line(key);
+  return l ? l->mode : McuPinMode::input;
+}
+
+void FirmwareRuntime::write_pin(int key, bool level) {
+  Line& l = make_line(key);
+  l.latch = level;
+  apply_drive(l);
+  line_changed(l);
+  process_edges();
+  if (any_pending_) deliver();
+}
+
+bool FirmwareRuntime::pin_latch(int key) const {
+  const Line* l = line(key);
+  return l && l->latch;
+}
+
+bool FirmwareRuntime::read_pin(int key) {
+  Line* l = line(key);
+  if (!l) return false;
+  const bool level = line_level(*l, false);
+  process_edges();
+  return level;
+}
+
+bool FirmwareRuntime::line_level(const Line& l, bool tracked) {
+  const bool driving = l.mode == McuPinMode::output || (l.mode == McuPinMode::output_open_drain && !l.latch);
+  if (l.cs_chain >= 0) return driving ? l.latch : true;  // pulled up while released
+  if (!l.outputs.empty()) {
+    bool level = true;  // open drain with a pull-up: low when anything pulls it low
+    for (const ChipRef& r : l.outputs)
+      level = level && (tracked ? tracked_[r.chain][r.chip][static_cast<unsigned>(r.pin)]
+                                : board_->pin_level(r.chain, r.chip, r.pin));
+    return driving ? level && l.latch : level;
+  }
+  if (driving) return l.latch;
+  if (!l.inputs.empty()) {
+    const ChipRef& r = l.inputs.front();
+    if (r.pin == Pin::SW) {
+      board_->catch_up(r.chain);
+      return board_->chain(r.chain).chip(r.chip).sw_pin();  // the switch (or the axis) as the chip sees it
+    }
+    return board_->pin_level(r.chain, r.chip, r.pin);
+  }
+  if (l.mode == McuPinMode::input_pulldown) return false;
+  return l.mode == McuPinMode::input_pullup || l.latch;  // an unconnected input: its pull-up, else low
+}
+
+void FirmwareRuntime::apply_drive(Line& l) {
+  const bool driving = l.mode == McuPinMode::output || (l.mode == McuPinMode::output_open_drain && !l.latch);
+  const int drive = driving ? (l.latch ? 1 : 0) : 2;
+  if (drive == l.applied) return;
+  l.applied = drive;
+  if (l.cs_chain >= 0) {
+    const bool selected = drive == 0;
+    const auto chain = static_cast<std::size_t>(l.cs_chain);
+    if (selected != board_->chip_selected(chain)) {
+      board_->drive_chip_select(chain, selected);
+      dirty();
+    }
+    return;
+  }
+  for (const ChipRef& r : l.inputs) {
+    if (drive == 2 && r.pin == Pin::SW) continue;  // released: the switch decides
+    // Released, STBY_RST is pulled up (running) and STCK down, as boards wire them.
+    const bool level = drive == 2 ? r.pin == Pin::STBY_RST : drive == 1;
+    board_->drive_pin(r.chain, r.chip, r.pin, level);
+    dirty();
+  }
+}
+
+void FirmwareRuntime::line_changed(Line& l) {
+  if (!l.edges || !l.on_edge) return;
+  const bool level = line_level(l, true);
+  if (level == l.seen) return;
+  l.seen = level;
+  if (l.edges & (level ? kEdgeRising : kEdgeFalling)) l.on_edge(level);
+}
+
+void FirmwareRuntime::process_edges() {
+  while (!edges_.empty()) {
+    std::vector<PinEdge> edges;
+    edges.swap(edges_);
+    std::stable_sort(edges.begin(), edges.end(), [](const PinEdge& a, const PinEdge& b) { return a.tick < b.tick; });
+    // Edges of one tick together: chips wired to one pin that change at the same tick make no glitch.
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i;
+      std::vector<int> touched;
+      for (; j < edges.size() && edges[j].tick == edges[i].tick; ++j) {
+        const PinEdge& e = edges[j];
+        if (e.chain >= tracked_.size() || e.chip >= tracked_[e.chain].size()) continue;
+        tracked_[e.chain][e.chip][static_cast<unsigned>(e.pin)] = e.level;
+        const int key = chip_line_[e.chain][e.chip][static_cast<unsigned>(e.pin)];
+        if (key >= 0 && std::find(touched.begin(), touched.end(), key) == touched.end()) touched.push_back(key);
+      }
+      for (const int key : touched)
+        if (Line* l = line(key)) line_changed(*l);
+      i = j;
+    }
+  }
+}
+
+void FirmwareRuntime::watch_pin(int key, unsigned edges, std::function<void(bool)> on_edge) {
+  Line& l = make_line(key);
+  l.edges = edges & kEdgeBoth;
+  l.on_edge = l.edges ? std::move(on_edge) : nullptr;
+  set_board_watch(l, l.edges != 0 && !l.outputs.empty());
+  const bool poll = (l.edges != 0 && l.outputs.empty() && !l.inputs.empty()) || l.level_watch;
+  const auto it = std::find(polled_.begin(), polled_.end(), key);
+  if (poll && it == polled_.end()) polled_.push_back(key);
+  if (!poll && it != polled_.end()) polled_.erase(it);
+  process_edges();
+  l.seen = line_level(l, true);
+}
+
+void FirmwareRuntime::set_board_watch(Line& l, bool watched) {
+  if (watched == l.board_watched) return;
+  for (const ChipRef& r : l.outputs) {
+    board_->catch_up(r.chain);
+    board_->watch_pin(r.chain, r.chip, r.pin, watched);
+    if (watched) tracked_[r.chain][r.chip][static_cast<unsigned>(r.pin)] = board_->level(r.chain, r.chip, r.pin);
+  }
+  l.board_watched = watched;
+  watched ? ++board_watches_ : --board_watches_;
+  next_edge_ = board_watches_ ? 0 : kNever;
+}
+
+bool FirmwareRuntime::wait_for_level(int key, bool level, Tick until) {
+  Line& l = make_line(key);
+  // A chip output is waited for to its exact edge: the board is asked to watch it meanwhile.
+  const bool temporary = !l.outputs.empty() && !l.board_watched;
+  if (temporary) set_board_watch(l, true);
+  bool reached = true;
+  while (read_pin(key) != level) {
+    if (now_ >= until) {
+      reached = false;
+      break;
+    }
+    Tick step = until;
+    if (board_watches_) {
+      catch_up();
+      step = std::min(step, next_edge_);
+    }
+    if (l.outputs.empty()) step = std::min(step, now_ + kTicksPerMicrosecond);  // nothing to predict: look each microsecond
+    sleep_until(std::max(step, now_ + 1));
+  }
+  if (temporary) {
+    set_board_watch(l, false);
+    process_edges();
+  }
+  return reached;
+}
+
+void FirmwareRuntime::watch_level(int key, bool level, std::function<void(bool)> on_level) {
+  Line& l = make_line(key);
+  l.level_watch = static_cast<bool>(on_level);
+  l.watched_level = level;
+  l.on_level = std::move(on_level);
+  const auto it = std::find(polled_.begin(), polled_.end(), key);
+  const bool poll = l.level_watch || (l.edges != 0 && l.outputs.empty() && !l.inputs.empty());
+  if (poll && it == polled_.end()) polled_.push_back(key);
+  if (!poll && it != polled_.end()) polled_.erase(it);
+}
+
+void FirmwareRuntime::poll_levels() {
+  for (std::size_t i = 0; i < polled_.size(); ++i) {
+    Line* l = line(polled_[i]);
+    if (!l) continue;
+    if (l->level_watch) {
+      if (line_level(*l, l->board_watched) == l->watched_level && l->on_level) l->on_level(l->watched_level);
+    } else {
+      // A switch the axis drives: the board cannot say ahead when it changes, so look now.
+      const bool level = line_level(*l, false);
+      if (level != l->seen) {
+        l->seen = level;
+        if (l->edges & (level ? kEdgeRising : kEdgeFalling)) l->on_edge(level);
+      }
+    }
+  }
+  process_edges();
+}
+
+// ---------------------------------------------------------------- interrupts
+
+int FirmwareRuntime::add_irq(std::function<void()> handler) {
+  irqs_.push_back(Irq{std::move(handler), true, false, 0});
+  return static_cast<int>(irqs_.size() - 1);
+}
+
+void FirmwareRuntime::set_irq_enabled(int irq, bool enabled) {
+  Irq& q = irqs_.at(static_cast<std::size_t>(irq));
+  q.enabled = enabled;
+  if (enabled && q.pending) any_pending_ = true;
+}
+
+bool FirmwareRuntime::irq_enabled(int irq) const { return irqs_.at(static_cast<std::size_t>(irq)).enabled; }
+
+void FirmwareRuntime::pend_irq(int irq) {
+  Irq& q = irqs_.at(static_cast<std::size_t>(irq));
+  if (!q.pending) q.since = now_;
+  q.pending = true;
+  if (q.enabled) any_pending_ = true;
+}
+
+void FirmwareRuntime::clear_irq(int irq) { irqs_.at(static_cast<std::size_t>(irq)).pending = false; }
+
+bool FirmwareRuntime::irq_pending(int irq) const { return irqs_.at(static_cast<std::size_t>(irq)).pending; }
+
+void FirmwareRuntime::enable_interrupts() {
+  irqs_on_ = true;
+  if (any_pending_) deliver();
+}
+
+void FirmwareRuntime::deliver() {
+  if (!irqs_on_ || in_irq_) return;
+  any_pending_ = false;
+  // One pass over what is pending now, oldest first (ties: the lower number first). What a
+  // handler leaves or makes pending runs at the next call, so a handler that never clears its
+  // source cannot hold time still.
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < irqs_.size(); ++i)
+    if (irqs_[i].pending && irqs_[i].enabled) order.push_back(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return irqs_[a].since < irqs_[b].since; });
+  for (const std::size_t i : order) {
+    Irq& q = irqs_[i];
+    if (!q.pending || !q.enabled) continue;
+    if (!irqs_on_) break;
+    q.pending = false;
+    in_irq_ = true;
+    q.handler();
+    in_irq_ = false;
+  }
+  for (const Irq& q : irqs_)
+    if (q.pending && q.enabled) any_pending_ = true;
+}
+
+// ---------------------------------------------------------------- SPI
+
+int FirmwareRuntime::controller(std::string_view name) const {
+  const auto canonical = parse_spi_controller(name);
+  for (std::size_t i = 0; i < controllers_.size(); ++i)
+    if (canonical && controllers_[i].name == *canonical) return static_cast<int>(i);
+  return controllers_.size() == 1 ? 0 : -1;
+}
+
+std::vector<std::string> FirmwareRuntime::controller_names() const {
+  std::vector<std::string> names;
+  for (const Controller& c : controllers_) names.push_back(c.name);
+  return names;
+}
+
+void FirmwareRuntime::report_once(const std::string& key, const std::string& text) {
+  if (std::find(reported_.begin(), reported_.end(), key) != reported_.end()) return;
+  reported_.push_back(key);
+  log(text);
+}
+
+void FirmwareRuntime::transfer(int controller, const BusSettings& settings, std::span<const std::uint8_t> tx,
+                               std::span<std::uint8_t> rx) {
+  const Controller& ctl = controllers_.at(static_cast<std::size_t>(controller));
+  if (settings.mode != 3)
+    report_once(ctl.name + " mode",
+                ctl.name + ": SPI mode " + std::to_string(settings.mode) +
+                    ": the chips need mode 3 (CPOL 1, CPHA 1); the bytes are served as if in mode 3");
+  if (settings.lsb_first)
+    report_once(ctl.name + " lsb", ctl.name + ": LSB first: the chips shift MSB first, so each byte reaches them bit-reversed");
+  if (settings.speed_hz > 5'000'000)
+    report_once(ctl.name + " speed", ctl.name + ": SCK " + std::to_string(settings.speed_hz) +
+                                         " Hz is above the chips' 5 MHz (served as if it worked)");
+  std::size_t selected = 0;
+  for (const std::size_t c : ctl.chains) selected += board_->chip_selected(c) ? 1 : 0;
+  if (selected == 0)
+    report_once(ctl.name + " none", ctl.name + ": bytes clocked while no chip select of the bus is low (is cs_pin= "
+                                               "the pin the program drives?)");
+  if (selected > 1)
+    report_once(ctl.name + " two", ctl.name + ": bytes clocked with " + std::to_string(selected) +
+                                        " chip selects low: every selected chain takes them and they drive MISO together");
+  const Tick end = board_->clock_bytes(ctl.chains, tx, rx, settings);
+  set_now(std::max(now_, end));
+  if (board_watches_) dirty();
+  process_edges();
+  if (now_ >= timing_.limit_ticks) stop_at_limit();
+  if (any_pending_) deliver();
+}
+
+// ---------------------------------------------------------------- the run
+
+void FirmwareRuntime::log(std::string_view text) const {
+  if (log_) log_(text);
+}
+
+void FirmwareRuntime::finish() {
+  if (finished_) return;
+  finished_ = true;
+  for (std::size_t i = 0; i < board_->chain_count(); ++i) board_->stop_recording(i);
+}
+
+void FirmwareRuntime::stop(int status, const std::string& why) {
+  if (!why.empty()) log(why);
+  finish();
+  std::fflush(nullptr);
+  std::exit(status);
+}
+
+void FirmwareRuntime::stop_at_limit() {
+  std::string why = "firmware run stopped at its time limit: " + seconds_text(now_) + " of virtual time (limit=" +
+                    limit_text(timing_.limit_ticks) + ")";
+  if (front_ == FirmwareFront::arduino) why += "; loop() had run " + std::to_string(loops) + " times";
+  stop(0, why);
+}
+
+// ---------------------------------------------------------------- the program's runtime
+
+extern "C" {
+/// Set by l6470emu_add_sketch / l6470emu_add_hal_program BOARD (a description) or BOARD_FILE.
+const char* l6470emu_fw_default_board(void) __attribute__((weak));
+const char* l6470emu_fw_default_board_file(void) __attribute__((weak));
+}
+
+namespace {
+
+FirmwareRuntime* g_runtime = nullptr;
+
+[[noreturn]] void fail_to_start(const std::string& line) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "%s\n", line.c_str());
+  std::exit(2);
+}
+
+// Reads a description file with stdio: at most kMaxConfigBytes + 1 bytes.
+ParseResult read_description_file(const std::string& path) {
+  const std::string where = "l6470emu: config file " + shown_text(path, 200) + ": ";
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return {std::nullopt, {where + "cannot be read"}};
+  std::string text(kMaxConfigBytes + 1, '\0');
+  const std::size_t got = std::fread(text.data(), 1, text.size(), f);
+  const bool error = std::ferror(f) != 0;
+  std::fclose(f);
+  if (error) return {std::nullopt, {where + "cannot be read (a directory?)"}};
+  if (got > kMaxConfigBytes) return {std::nullopt, {where + "longer than 1 MiB (a board description is a few lines)"}};
+  text.resize(got);
+  return parse_board_config(text, path);
+}
+
+LineSink make_log(const std::string& where) {
+  if (where == "off") return {};
+  std::FILE* out = stderr;
+  if (where != "stderr") {
+    out = std::fopen(where.c_str(), "a");
+    if (!out) {
+      std::fprintf(stderr, "l6470emu: log file %s cannot be opened: diagnostics go to stderr\n", quoted_text(where).c_str());
+      out = stderr;
+    }
+  }
+  return [out](std::string_view line) {
+    std::fflush(stdout);  // what the program printed before comes first
+    std::fprintf(out, "l6470emu: %.*s\n", static_cast<int>(line.size()), line.data());
+    std::fflush(out);
+  };
+}
+
+void finish_at_exit() {
+  if (g_runtime) g_runtime->finish();
+}
+
+}  // namespace
+
+FirmwareRuntime* existing_firmware_runtime() { return g_runtime; }
+
+FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront front, std::string& error) {
+  if (g_runtime) {
+    error = "l6470emu: firmware: the board is already open (one board per program)";
+    return nullptr;
+  }
+  ParseResult parsed;
+  const char* chain = std::getenv("L6470EMU_CHAIN");
+  const char* file = std::getenv("L6470EMU_CONFIG");
+  if (description) {
+    parsed = parse_board_config(description, "the program's description");
+  } else if (chain && *chain) {
+    parsed = parse_board_config(chain, "L6470EMU_CHAIN");
+  } else if (file && *file) {
+    parsed = read_description_file(file);
+  } else if (const char* built = l6470emu_fw_default_board ? l6470emu_fw_default_board() : nullptr; built && *built) {
+    parsed = parse_board_config(built, "BOARD");
+  } else if (const char* path = l6470emu_fw_default_board_file ? l6470emu_fw_default_board_file() : nullptr;
+             path && *path) {
+    parsed = read_description_file(path);
+  } else {
+    parsed = parse_board_config("chips=L6470", "the default board");
+  }
+  if (!parsed.config) {
+    error = parsed.error.message;
+    return nullptr;
+  }
+  BoardConfig config = std::move(*parsed.config);
+  if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) config.log = log;
+  if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) config.trace = trace;
+  std::unique_ptr<FirmwareRuntime> runtime;
+  try {
+    runtime = std::make_unique<FirmwareRuntime>(config, front, make_log(config.log));
+  } catch (const std::exception& e) {
+    error = std::string("l6470emu: firmware: ") + e.what();
+    return nullptr;
+  }
+  if (!config.trace.empty()) {
+    if (const std::string e = runtime->board().start_recording_all(config.trace); !e.empty()) {
+      error = "l6470emu: trace " + quoted_text(config.trace) + ": " + e;
+      return nullptr;
+    }
+  }
+  g_runtime = runtime.release();  // lives until the program ends
+  std::atexit(finish_at_exit);
+  return g_runtime;
+}
+
+FirmwareRuntime& firmware_runtime(FirmwareFront front) {
+  if (g_runtime) return *g_runtime;
+  std::string error;
+  FirmwareRuntime* r = open_firmware_runtime(nullptr, front, error);
+  if (!r) fail_to_start(error);
+  return *r;
+}
+
+}  // namespace l6470emu

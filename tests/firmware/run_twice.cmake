@@ -1,0 +1,43 @@
+# A firmware run is deterministic: PROGRAM runs twice, each recording its board (L6470EMU_TRACE);
+# standard output, standard error and the recordings must be the same byte for byte. The
+# recording is then read by the tools as any other: `l6470emu replay` matches it and `l6470emu
+# decode` explains it (it must name COMMAND).
+# Usage: cmake -DPROGRAM=... -DTOOL=.../l6470emu -DWORK=dir -DCOMMAND=text -P run_twice.cmake
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+foreach(run 1 2)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env L6470EMU_TRACE=${WORK}/run.trace "${PROGRAM}"
+                  OUTPUT_FILE "${WORK}/out${run}" ERROR_FILE "${WORK}/err${run}" RESULT_VARIABLE rc${run}
+                  WORKING_DIRECTORY "${WORK}")
+  file(RENAME "${WORK}/run.trace" "${WORK}/run${run}.trace")
+  if(NOT rc${run} EQUAL 0)
+    file(READ "${WORK}/err${run}" err)
+    message(FATAL_ERROR "run ${run} exited ${rc${run}}: ${err}")
+  endif()
+endforeach()
+foreach(f out err)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files "${WORK}/${f}1" "${WORK}/${f}2" RESULT_VARIABLE differ)
+  if(differ)
+    message(FATAL_ERROR "the two runs' ${f} differ: ${WORK}/${f}1 ${WORK}/${f}2")
+  endif()
+endforeach()
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files "${WORK}/run1.trace" "${WORK}/run2.trace" RESULT_VARIABLE differ)
+if(differ)
+  message(FATAL_ERROR "the two runs' recordings differ: ${WORK}/run1.trace ${WORK}/run2.trace")
+endif()
+file(SIZE "${WORK}/run1.trace" size)
+if(size LESS 200)
+  message(FATAL_ERROR "the recording is nearly empty (${size} bytes)")
+endif()
+file(SIZE "${WORK}/out1" size)
+message(STATUS "two runs: identical output (${size} bytes) and recordings")
+execute_process(COMMAND "${TOOL}" replay "${WORK}/run1.trace" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "l6470emu replay of the recording: exit ${rc}\n${out}")
+endif()
+execute_process(COMMAND "${TOOL}" decode "${WORK}/run1.trace" RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(FIND "${out}" "${COMMAND}" at)
+if(NOT rc EQUAL 0 OR at LESS 0)
+  message(FATAL_ERROR "l6470emu decode of the recording (exit ${rc}) does not show '${COMMAND}':\n${out}${err}")
+endif()
+message(STATUS "l6470emu replay matches the recording; decode shows ${COMMAND}")
