@@ -4,20 +4,16 @@
 #include <climits>
 #include <sstream>
 
+#include "board/board_chain.hpp"
 #include "board/board_internal.hpp"
 
 namespace l6470emu {
 
 Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
-    : log_(std::move(log)), sanitizer_(config.check, log_), time_(config.time, host), numbering_(config.numbering) {
+    : log_(std::move(log)), sanitizer_(config.check, log_), time_(config.time, host), numbering_(config.numbering),
+      config_(config) {
   for (const ChainConfig& cc : config.chains) {
-    std::vector<Chip> chips;
-    chips.reserve(cc.chips.size());
-    for (const Variant* v : cc.chips) chips.emplace_back(*v);
-    // axis.K counts chips as the board's numbering= does.
-    const ChipNumbering axis_numbers(numbering_, chips.size());
-    for (const auto& [k, spec] : cc.axes) chips.at(axis_numbers.index_of(k)).attach_axis(spec);
-    auto cs = std::make_unique<ChainState>(cc, std::move(chips));
+    auto cs = std::make_unique<ChainState>(cc, build_chips(cc, numbering_));
     cs->name = cc.path.substr(cc.path.rfind('/') + 1);
     cs->index = chains_.size();
     cs->wired = cc.gpiochip.has_value();
@@ -76,6 +72,7 @@ void Board::with_chain(std::size_t chain, const std::function<void(Chain&)>& f) 
   catch_up(c);
   c.prediction_valid = false;
   f(c.chain);
+  if (c.recorder) c.recorder->outputs_may_have_changed();
   emit_changes(c, c.chain.now());
 }
 
@@ -88,6 +85,7 @@ SpiDevice& Board::begin_transfer(std::size_t chain, const WireSettings& wire) {
   const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
   if (start > c.chain.now()) advance_chain(c, start);
   record_outputs(c);
+  c.touched = true;
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
   for (auto& other : chains_)
     if (other.get() != &c && other->config.bus == c.config.bus && other->bus->selected()) {
@@ -115,6 +113,7 @@ void Board::drive_chip_select(std::size_t chain, bool selected) {
   ChainState& c = state(chain);
   catch_up(c);
   c.prediction_valid = false;
+  c.touched = true;
   // Through the chain's bus, as a host's CS edge: t_disCS (a CS low too soon after a rise
   // misses the chips' answer load) and the sanitizer's frame checks apply.
   c.bus->set_device(spi_of(c));
@@ -147,6 +146,7 @@ Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std
     ChainState& c = state(i);
     if (!c.chain.selected()) continue;
     c.prediction_valid = false;
+    c.touched = true;
     if (start > c.chain.now()) advance_chain(c, start);
     record_outputs(c);
     ChainBus& bus = *c.bus;
@@ -268,8 +268,10 @@ Tick Board::first_change(ChainState& c, std::size_t chip, Pin pin, bool level, T
 }
 
 void Board::advance_chain(ChainState& c, Tick target) {
+  // Through the recording when there is one: it records every BUSY and FLAG edge at its tick.
+  SpiDevice& dev = spi_of(c);
   if (c.watched.empty() || (c.prediction_valid && target < c.predicted_edge)) {
-    c.chain.advance_to(target);  // nothing watched changes before `target`
+    dev.advance_to(target);  // nothing watched changes before `target`
     return;
   }
   // Step from edge to edge so that every edge carries the tick it happened at.
@@ -282,13 +284,13 @@ void Board::advance_chain(ChainState& c, Tick target) {
                                            c.chain.now(), target));
     }
     if (first == kNever) {
-      c.chain.advance_to(target);
+      dev.advance_to(target);
       break;
     }
-    c.chain.advance_to(first);
+    dev.advance_to(first);
     emit_changes(c, first);
   }
-  if (c.chain.now() < target) c.chain.advance_to(target);
+  if (c.chain.now() < target) dev.advance_to(target);
 }
 
 Tick Board::predict_next_edge(ChainState& c) {
@@ -315,7 +317,15 @@ Tick Board::predict_next_edge(ChainState& c) {
   return best;
 }
 
-bool Board::advance(Tick ticks) { return time_.is_virtual() && advance_to(time_.now() + ticks); }
+bool Board::advance(Tick ticks) {
+  if (!time_.is_virtual() || !advance_to(time_.now() + ticks)) return false;
+  for (auto& c : chains_)
+    if (c->recorder) {
+      c->recorder->mark_advance();
+      record_outputs(*c);
+    }
+  return true;
+}
 
 bool Board::advance_to(Tick tick) {
   if (!time_.is_virtual()) return false;

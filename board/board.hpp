@@ -23,6 +23,7 @@
 #include "daisychain/chip_numbering.hpp"
 #include "spi/message.hpp"
 #include "spi/trace.hpp"
+#include "spi/trace_output.hpp"
 
 namespace l6470emu {
 
@@ -88,7 +89,9 @@ class Board {
   int find_chain(const std::string& name) const;
   /// The chain as it stands at its own tick (for reading; nothing is brought up to the clock).
   const Chain& chain(std::size_t chain) const;
-  /// Runs `f` on chain `chain` brought up to the clock, then reports the edges it caused.
+  /// Runs `f` on chain `chain` brought up to the clock, then reports the edges it caused. For
+  /// looking at the chips: what `f` changes is not recorded (the stimuli have calls of their own
+  /// below, which record).
   void with_chain(std::size_t chain, const std::function<void(Chain&)>& f);
 
   // ---- SPI: a front clocks bytes on a chain between begin_transfer and end_transfer --------
@@ -178,10 +181,13 @@ class Board {
   const BoardTime& time() const { return time_; }
   /// Brings chain `chain` up to the board's time, reporting the edges on the way.
   void catch_up(std::size_t chain);
-  /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
+  /// Virtual time: moves every chain on by `ticks` (edges reported on the way), as `ctl advance`
+  /// or a scenario does: chains being recorded get an `advance` event at the new time, so a
+  /// replay runs as far. Wall time: false.
   bool advance(Tick ticks);
   /// Virtual time: moves the board's time to `tick` if it is later and brings every chain
-  /// there, reporting the edges of watched pins at their own ticks. Wall time: false.
+  /// there, reporting the edges of watched pins at their own ticks (a host's sleep: nothing is
+  /// recorded but the edges). Wall time: false.
   bool advance_to(Tick tick);
   /// Brings every chain up to the clock, then says the earliest tick at which a watched BUSY
   /// or FLAG will change by itself (kNever: none). A host waiting for edges wakes then.
@@ -196,10 +202,24 @@ class Board {
   /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain
   /// `chain` now, recorded when the chain is being recorded; edges reported. False for a bad index.
   bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// Changes the load on the axis of chip `chip` now (`ctl axis load`, a scenario), recorded when
+  /// the chain is being recorded; edges reported. A recording started later carries the new load
+  /// in its board description. False for a bad index or a chip without an axis.
+  bool set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& load);
+  /// Opens the output of a recording at `path` (throws std::runtime_error with one line when it
+  /// cannot). A front brings its own (linux/: a memory-mapped file); the default writes through
+  /// stdio and zlib (spi/trace_output.hpp).
+  using TraceOutputOpener = std::function<std::unique_ptr<TraceOutput>(const std::string& path)>;
+  /// Sets how recordings open their files (an empty function: the default). For recordings
+  /// started after the call.
+  void set_trace_output_opener(TraceOutputOpener opener) { open_output_ = std::move(opener); }
   /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
-  /// progress on the chain is stopped first): every CS frame, every input pin change, every
-  /// backdoor event and the BUSY/FLAG changes, each line flushed as it is written.
-  /// Returns "" or one line saying why not.
+  /// progress on the chain is stopped first). The header holds the chain's board description
+  /// (describe_recorded_chain: variants, numbering, axes with their current loads, every other
+  /// key of the description); then come every CS frame, every input pin change, every backdoor
+  /// event and axis load change, every `advance`, and the BUSY/FLAG changes at their own ticks.
+  /// A recording started on chips that have already run says so in the log and in the file
+  /// (its replay starts them at power-up). Returns "" or one line saying why not.
   std::string start_recording(std::size_t chain, const std::string& path);
   /// Starts recording every chain: into `path` for one chain, else trace_path_for_chain files.
   std::string start_recording_all(const std::string& path);
@@ -211,6 +231,9 @@ class Board {
   /// Drops every recording without writing to it again (a forked child's copies of its
   /// parent's recordings, which the parent keeps writing).
   void abandon_recordings();
+  /// Hands what recordings hold to the OS when their flush policy's time has come (a gzip
+  /// recording gone quiet); a front calls it now and then. Cheap when nothing is due.
+  void flush_recordings();
 
  private:
   struct ChainState;
@@ -231,6 +254,8 @@ class Board {
   EdgeSink edge_sink_;
   BoardTime time_;
   NumberFrom numbering_ = NumberFrom::miso;
+  BoardConfig config_;  // the description (board-wide keys) a recording's header carries
+  TraceOutputOpener open_output_;
   std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last use ends
   std::vector<std::unique_ptr<ChainState>> chains_;
 };

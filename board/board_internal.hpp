@@ -21,6 +21,7 @@ struct Board::ChainState {
     auto operator<=>(const WatchedPin&) const = default;
   };
 
+  /// How one chip's diagnostics are logged: its name in the log and how many of each kind came.
   ChainConfig config;
   Chain chain;
   std::string name;                   // "spidev0.0"
@@ -32,6 +33,7 @@ struct Board::ChainState {
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
   std::unique_ptr<ChainChecker> checker;         // the sanitizer's checks of this chain
   std::unique_ptr<ChainBus> bus;                 // what begin_transfer hands out
+  bool touched = false;               // a transfer or a stimulus has reached the chips since power-up
   // The next change of a watched BUSY/FLAG as predict_next_edge found it (kNever: none), valid
   // until something other than time reaches the chain (a byte, a CS edge, an input, a fault,
   // a new watch): until then the chain advances to any earlier tick without probing.

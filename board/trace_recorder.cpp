@@ -12,13 +12,17 @@ namespace l6470emu {
 /// may reach a host program's C call through the preload library).
 class ChainTraceRecorder::Sink final : public TraceSink {
  public:
-  explicit Sink(const std::string& path) : writer_(path) {}
+  explicit Sink(std::unique_ptr<TraceOutput> output) : writer_(std::move(output)) {}
   void write_header(const TraceHeader& h) override {
     guard([&] { writer_.write_header(h); });
   }
   void write(const TraceEvent& e) override {
     guard([&] { writer_.write(e); });
   }
+  void flush_if_due() {
+    guard([&] { writer_.flush_if_due(); });
+  }
+  void abandon() { writer_.abandon(); }
   std::string error;
 
  private:
@@ -36,11 +40,12 @@ class ChainTraceRecorder::Sink final : public TraceSink {
   NativeTraceWriter writer_;
 };
 
-std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(Chain& chain, const std::string& path,
-                                                             std::string& error) noexcept {
+std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(
+    Chain& chain, const std::string& path, const std::string& board,
+    const std::function<std::unique_ptr<TraceOutput>(const std::string&)>& open_output, std::string& error) noexcept {
   try {
-    auto sink = std::make_unique<Sink>(path);
-    std::unique_ptr<ChainTraceRecorder> r(new ChainTraceRecorder(chain, std::move(sink), path));
+    auto sink = std::make_unique<Sink>(open_output ? open_output(path) : open_trace_file_output(path));
+    std::unique_ptr<ChainTraceRecorder> r(new ChainTraceRecorder(chain, std::move(sink), path, board));
     if (!r->error().empty()) {
       error = r->error();
       return nullptr;
@@ -54,8 +59,9 @@ std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(Chain& chain, const
   return nullptr;
 }
 
-ChainTraceRecorder::ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path)
-    : sink_(std::move(sink)), recording_(chain, *sink_), path_(std::move(path)) {}
+ChainTraceRecorder::ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path,
+                                       const std::string& board)
+    : sink_(std::move(sink)), recording_(chain, *sink_, RecordOptions{.board = board}), path_(std::move(path)) {}
 
 ChainTraceRecorder::~ChainTraceRecorder() = default;
 
@@ -78,6 +84,14 @@ void ChainTraceRecorder::fault(std::size_t chip, TraceFault fault, std::uint8_t 
     case TraceFault::ADCIN: recording_.set_adc_input(chip, value); break;
   }
 }
+
+void ChainTraceRecorder::set_axis_load(std::size_t chip, const LoadSpec& load) { recording_.set_axis_load(chip, load); }
+
+void ChainTraceRecorder::mark_advance() { recording_.mark_advance(); }
+
+void ChainTraceRecorder::flush_if_due() { sink_->flush_if_due(); }
+
+void ChainTraceRecorder::abandon() { sink_->abandon(); }
 
 void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value) {
   switch (fault) {

@@ -1,25 +1,31 @@
-// Recording one chain of the board into a native trace file (docs/trace-format.md): a
-// RecordingChain over the chain and a NativeTraceWriter flushed event by event, so a killed
-// process leaves a complete file. Never throws after it is open: a write error stops the
-// recording and is reported once. Knows nothing of spidev or gpio; the Board drives it.
+// Recording one chain of the board into a native trace (docs/trace-format.md): a
+// RecordingChain over the chain and a NativeTraceWriter on an output the front chose (a
+// memory-mapped file, stdio), event by event, so a killed process leaves a complete file.
+// Never throws after it is open: a write error stops the recording and is reported once.
+// Knows nothing of spidev, gpio or file descriptors; the Board drives it.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "board/pins.hpp"
 #include "daisychain/recording_chain.hpp"
 #include "spi/trace.hpp"
+#include "spi/trace_output.hpp"
 
 namespace l6470emu {
 
 /// A native trace being recorded from one chain. Single-threaded: its owner (the Board) serialises every call.
 class ChainTraceRecorder {
  public:
-  /// Creates or truncates `path` and writes the header (the chain and its BUSY/FLAG levels).
-  /// Returns nullptr and sets `error` (one line) when the file cannot be created.
-  static std::unique_ptr<ChainTraceRecorder> open(Chain& chain, const std::string& path, std::string& error) noexcept;
+  /// Opens the output of `path` with `open_output` (the default stdio/zlib one when empty) and
+  /// writes the header: the chain, its board description `board` (`board` lines), and the
+  /// BUSY/FLAG levels. Returns nullptr and sets `error` (one line) when that fails.
+  static std::unique_ptr<ChainTraceRecorder> open(
+      Chain& chain, const std::string& path, const std::string& board,
+      const std::function<std::unique_ptr<TraceOutput>(const std::string&)>& open_output, std::string& error) noexcept;
   ~ChainTraceRecorder();
   ChainTraceRecorder(const ChainTraceRecorder&) = delete;
   ChainTraceRecorder& operator=(const ChainTraceRecorder&) = delete;
@@ -30,8 +36,18 @@ class ChainTraceRecorder {
   void set_input(std::size_t chip, Pin pin, bool level);
   /// A backdoor event (fault on/off, thermal class, ADCIN code): applied to the chip and recorded.
   void fault(std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// The load on chip `chip`'s axis changes: applied to the chip and recorded.
+  void set_axis_load(std::size_t chip, const LoadSpec& load);
+  /// Records that time was moved on to the chain's tick (`ctl advance`).
+  void mark_advance();
   /// Records BUSY/FLAG levels that changed since they were last seen.
   void observe_outputs() { recording_.observe_outputs(); }
+  /// The chain was changed behind the recorder's back: the next look sees it.
+  void outputs_may_have_changed() { recording_.outputs_may_have_changed(); }
+  /// Hands what the output holds to the OS if its flush policy's time has come.
+  void flush_if_due();
+  /// Stops without writing anything more (a forked child's copy).
+  void abandon();
 
   const std::string& path() const { return path_; }
   std::uint64_t frames() const { return recording_.frames_recorded(); }
@@ -40,7 +56,7 @@ class ChainTraceRecorder {
 
  private:
   class Sink;
-  ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path);
+  ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path, const std::string& board);
 
   std::unique_ptr<Sink> sink_;
   RecordingChain recording_;

@@ -82,6 +82,13 @@ class Decoder {
     put(t, std::move(line_), e.chip);
   }
 
+  /// The banner at the first divergence: the log goes on with the emulator's model.
+  void divergence(const FirstDivergence& d) {
+    put(d.seconds, stamp(d.seconds) + "!!!!!!!! DIVERGED: " + d.summary + "\n" +
+                       std::string(stamp(d.seconds).size(), ' ') +
+                       "!!!!!!!! from here on this log is the emulator's model of the run, not what the trace holds");
+  }
+
   bool shown(std::size_t chip) const {
     return options_.only_chip < 0 || chip == ProtocolEvent::kNoChip ||
            numbering_.number_of(chip) == static_cast<std::size_t>(options_.only_chip);
@@ -113,6 +120,11 @@ class Decoder {
           what += std::string(", seen at (the edge was not watched: it came after t=") + buf + " s)";
         }
       }
+    } else if (e.kind == TraceEventKind::load) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "axis load: %.2f g·cm² load inertia, %.6f N·m friction, %.6f N·m force",
+                    e.load.inertia_g_mm2 / 100.0, e.load.friction_uNm / 1e6, e.load.force_uNm / 1e6);
+      what = buf;
     } else {
       what = "fault " + std::string(to_string(e.fault)) + " ";
       if (e.fault == TraceFault::THERMAL) what += thermal_name(e.value);
@@ -200,10 +212,15 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
                                 std::to_string(chain.size()) + " chips (0.." + std::to_string(chain.size() - 1) + ")");
   Decoder decoder(out, options, name, ChipNumbering(options.number_from, chain.size()));
   ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); }, options.number_from);
+  DivergenceWatch watch(name, ChipNumbering(options.number_from, chain.size()));
+  auto check = [&](bool was) {
+    if (!was && watch.diverged()) decoder.divergence(watch.first());
+  };
   TraceEvent e;
   std::vector<std::uint8_t> rx;
   double previous = 0;  // display time of the end of the event before (a frame's CS rising edge)
   while (in.next(e)) {
+    const bool diverged = watch.diverged();
     if (e.kind == TraceEventKind::frame) {
       previous = display_seconds(e.end(), e.source_time == e.source_time
                                               ? e.source_time + static_cast<double>(e.duration) / kTicksPerSecond
@@ -211,6 +228,8 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       ++decoder.summary.frames;
       rx.resize(e.mosi.size());
       tracker.begin_frame(e, rx);
+      watch.frame(e, rx);
+      check(diverged);
       tracker.end_frame();
       // Lines of this time stay queued: a later event of the same time may add lines of
       // chips numbered lower, which come first.
@@ -221,6 +240,12 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       throw TraceError(name, e.line, trace_chip_outside_chain(e.chip, chain.size()));
     tracker.apply(e);
     const double t = display_seconds(e.tick, e.source_time);
+    if (e.kind == TraceEventKind::advance) continue;  // time only
+    if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+      const Chip& chip = chain.chip(e.chip);
+      watch.observation(e, e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin());
+      check(diverged);
+    }
     decoder.pin(e, t, previous);
     // Outputs looked at together share one bound; an input or fault is an event of its own.
     if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) previous = t;
@@ -228,6 +253,9 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
   }
   tracker.finish();
   decoder.flush(std::numeric_limits<double>::infinity());
+  decoder.summary.divergence = watch.first();
+  decoder.summary.frames_diverged = watch.frames_diverged();
+  decoder.summary.pins_diverged = watch.pins_diverged();
   return decoder.summary;
 }
 

@@ -291,6 +291,7 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
 
   if (chain.now() == from) sampler.sample_all(from);  // a window from the start: the power-up state
   PassReporter reporter(in, options.progress);
+  DivergenceWatch watch(in.header().name, ChipNumbering(options.number_from, chain.size()));
   std::vector<std::uint8_t> rx;
   TraceEvent e;
   bool ended = true;
@@ -310,6 +311,7 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
       frame_end = at;
       rx.resize(e.mosi.size());
       tracker.begin_frame(e, rx);
+      watch.frame(e, rx);
       tracker.end_frame();
       for (std::size_t k = 0; k < chain.size(); ++k)
         if (decoded[k]) {
@@ -318,9 +320,13 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
         }
     } else {
       tracker.apply(e);
-      // Pin observations (BUSY, FLAG) change nothing; inputs and faults may.
-      if (e.kind == TraceEventKind::fault || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG))
+      // Pin observations (BUSY, FLAG) change nothing, but are checked; inputs, faults and loads may.
+      if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+        const Chip& chip = chain.chip(e.chip);
+        watch.observation(e, e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin());
+      } else if (e.kind != TraceEventKind::advance) {
         sampler.sample(e.chip, at);
+      }
     }
   }
   if (ended) tracker.finish();
@@ -344,6 +350,9 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
   // The last samples close the window (the sampler only looks at moving chips).
   sampler.sample_all(std::min(chain.now(), to));
   out.chips = sampler.finish(to);
+  out.divergence = watch.first();
+  out.frames_diverged = watch.frames_diverged();
+  out.pins_diverged = watch.pins_diverged();
   reporter.end();
   return out;
 }

@@ -13,6 +13,7 @@
 #include "core/variant.hpp"
 #include "daisychain/chain.hpp"
 #include "daisychain/chip_numbering.hpp"
+#include "daisychain/divergence.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -82,6 +83,11 @@ struct MotionSeries {
   Tick from = 0, to = 0;          ///< the window actually sampled
   Tick trace_end = 0;             ///< the last event's tick (frame: its CS rising edge)
   std::vector<ChipMotion> chips;  ///< in the order asked for
+  /// Where the emulator first gave MISO bytes or a BUSY/FLAG level other than the trace's, up
+  /// to the window's end: from there on the series are the emulator's model, not the capture.
+  FirstDivergence divergence;
+  std::uint64_t frames_diverged = 0;  ///< frames read with a captured MISO byte the emulator gives differently
+  std::uint64_t pins_diverged = 0;    ///< BUSY/FLAG observations read that the emulator does not reproduce
 };
 
 /// The last tick of a trace: the latest event's tick (a frame's CS rising edge). `progress`

@@ -278,10 +278,15 @@ void ProtocolTracker::end_frame() {
 
 void ProtocolTracker::apply(const TraceEvent& e) {
   if (e.kind == TraceEventKind::frame) return;
-  if (e.chip >= chain_.size()) return;  // the caller reports chips outside the chain
   chain_.advance_to(e.tick);
+  if (e.chip >= chain_.size()) return;  // the caller reports chips outside the chain
   Chip& chip = chain_.chip(e.chip);
   ChipTrack& c = chips_[e.chip];
+  if (e.kind == TraceEventKind::advance) return;  // time only: the chain is there now
+  if (e.kind == TraceEventKind::load) {
+    chip.set_axis_load(e.load);
+    return;
+  }
   if (e.kind == TraceEventKind::pin) {
     switch (e.pin) {
       case TracePin::SW: chip.set_sw_pin(e.value != 0); break;

@@ -90,7 +90,8 @@ class ProtocolTracker {
   void begin_frame(const TraceEvent& frame, std::span<std::uint8_t> rx);
   /// CS rises at frame.end(): the chips decode; events are reported.
   void end_frame();
-  /// Applies a pin (inputs only; outputs are observations) or fault event to the chain.
+  /// Applies a pin (inputs only; outputs are observations), fault, axis load or advance event to
+  /// the chain, at its tick.
   void apply(const TraceEvent& e);
   /// The trace ended: reports answers still being shifted out as cut short.
   void finish();

@@ -1,6 +1,8 @@
 // RecordingChain: forwards to the Chain and writes trace events at the CS rising edge.
 #include "daisychain/recording_chain.hpp"
 
+#include <algorithm>
+
 #include "daisychain/chain_spec.hpp"
 
 namespace l6470emu {
@@ -10,6 +12,7 @@ RecordingChain::RecordingChain(Chain& chain, TraceSink& sink, RecordOptions opti
   TraceHeader h;
   h.format = "native";
   h.chain = chain_spec_of(chain_);
+  h.board = options_.board;
   sink_.write_header(h);
   if (options_.observe_outputs) {
     busy_.assign(chain_.size(), 2);  // 2 = not seen yet: the first look records the level
@@ -20,7 +23,80 @@ RecordingChain::RecordingChain(Chain& chain, TraceSink& sink, RecordOptions opti
 
 void RecordingChain::emit(const TraceEvent& e) { sink_.write(e); }
 
+namespace {
+
+constexpr std::uint32_t kStepModeSyncEn = 1u << 7;  // STEP_MODE.SYNC_EN: BUSY\SYNC is a clock
+/// How far ahead a recording looks for BUSY/FLAG changes when time passes (64 ms): nothing to
+/// look at again until then, unless something is done to the chain.
+constexpr Tick kLookAheadTicks = ticks_from_ms(64);
+
+}  // namespace
+
+/// The first tick in (now, to] at which `chip`'s BUSY or FLAG differs from its level now
+/// (kNever: neither changes by then), found on copies of the chip moved on (cheap: a copy
+/// keeps the chip's knowledge of the motion's uniform runs). `unsure` is set when a BUSY that
+/// is the SYNC clock was left out.
+Tick RecordingChain::first_output_change(std::size_t k, Tick to, bool& unsure) const {
+  const Chip& chip = chain_.chip(k);
+  const Tick from = chain_.now();
+  if (!chip.spi_enabled()) return kNever;  // held in standby: BUSY high, nothing moves
+  const bool sync = (chip.peek(Reg::STEP_MODE) & kStepModeSyncEn) != 0;
+  unsure = unsure || sync;
+  const bool busy0 = chip.busy_sync_pin(), flag0 = chip.flag_pin();
+  auto differs_at = [&](Tick t) {
+    Chip probe = chip;
+    probe.set_diagnostic_sink({});
+    probe.advance_to(t);
+    return (!sync && probe.busy_sync_pin() != busy0) || probe.flag_pin() != flag0;
+  };
+  if (!differs_at(to)) return kNever;
+  Tick lo = from, hi = to;  // the same at lo, different at hi
+  while (hi - lo > 1) {
+    const Tick mid = lo + (hi - lo) / 2;
+    (differs_at(mid) ? hi : lo) = mid;
+  }
+  return hi;
+}
+
+void RecordingChain::advance_to(Tick tick) {
+  if (!options_.observe_outputs || chain_.selected() || tick <= chain_.now()) {
+    chain_.advance_to(tick);
+    return;
+  }
+  observe_outputs();  // what is recorded is the levels now
+  // Step from change to change so that each is recorded at the tick it happens. A look ahead
+  // that finds nothing up to quiet_until_ holds until something is done to the chain.
+  for (int guard = 0; guard < 10000 && chain_.now() < tick; ++guard) {
+    if (tick <= quiet_until_) {
+      chain_.advance_to(tick);
+      observed_at_ = tick;  // nothing changed on the way
+      return;
+    }
+    const Tick ahead = std::max(tick, chain_.now() + kLookAheadTicks);
+    Tick first = kNever;
+    bool unsure = false;
+    for (std::size_t k = 0; k < chain_.size(); ++k) {
+      if (chain_.chip(k).next_event_tick() == kNever) continue;  // nothing moves on its own
+      first = std::min(first, first_output_change(k, ahead, unsure));
+    }
+    if (first == kNever || first > tick) {
+      if (unsure) {  // a SYNC clock: looked at when the time comes, not stepped
+        chain_.advance_to(tick);
+        observe_outputs();
+        return;
+      }
+      quiet_until_ = first == kNever ? ahead : first - 1;
+      continue;
+    }
+    chain_.advance_to(first);
+    observe_outputs();
+  }
+  chain_.advance_to(tick);
+  observe_outputs();
+}
+
 void RecordingChain::select() {
+  observed_at_ = kNever;
   if (chain_.selected()) return;
   start_frame();
   chain_.select();
@@ -39,6 +115,7 @@ void RecordingChain::start_frame() {
 }
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
+  observed_at_ = kNever;
   const std::uint8_t miso = chain_.exchange(mosi);
   if (chain_.selected()) {
     tx_.push_back(mosi);
@@ -48,6 +125,7 @@ std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
 }
 
 void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  observed_at_ = kNever;
   chain_.exchange(tx, rx);
   if (chain_.selected()) {
     tx_.insert(tx_.end(), tx.begin(), tx.end());
@@ -65,6 +143,8 @@ void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<s
 }
 
 void RecordingChain::deselect() {
+  observed_at_ = kNever;
+  quiet_until_ = 0;
   if (!chain_.selected()) return;
   chain_.deselect();
   finish_frame();
@@ -106,12 +186,35 @@ void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_
     emit(e);  // an observation, made between frames
     return;
   }
+  stimulus(e);
+}
+
+void RecordingChain::stimulus(const TraceEvent& e) {
+  observed_at_ = kNever;
+  quiet_until_ = 0;
   if (chain_.selected()) {
     deferred_.push_back(e);
     return;
   }
   emit(e);
   observe_outputs();
+}
+
+void RecordingChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
+  chain_.chip(chip).set_axis_load(load);
+  TraceEvent e;
+  e.kind = TraceEventKind::load;
+  e.tick = chain_.now();
+  e.chip = static_cast<std::uint16_t>(chip);
+  e.load = load;
+  stimulus(e);
+}
+
+void RecordingChain::mark_advance() {
+  TraceEvent e;
+  e.kind = TraceEventKind::advance;
+  e.tick = chain_.now();
+  stimulus(e);
 }
 
 void RecordingChain::set_sw_pin(std::size_t chip, bool level) {
@@ -153,7 +256,8 @@ void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
 }
 
 void RecordingChain::observe_outputs() {
-  if (!options_.observe_outputs || chain_.selected()) return;
+  if (!options_.observe_outputs || chain_.selected() || chain_.now() == observed_at_) return;
+  observed_at_ = chain_.now();
   for (std::size_t k = 0; k < chain_.size(); ++k) {
     const Chip& c = chain_.chip(k);
     const std::uint8_t busy = c.busy_sync_pin(), flag = c.flag_pin();

@@ -17,9 +17,13 @@ namespace l6470emu {
 
 /// Choices for a recording.
 struct RecordOptions {
-  /// Look at every chip's BUSY and FLAG after each frame and event, and record changes
-  /// (replay then checks them). Costs a motion update per chip per frame.
+  /// Record every chip's BUSY and FLAG changes: after each frame and event, and at their own
+  /// ticks as time passes (replay then checks them). Costs a motion update per chip per frame.
   bool observe_outputs = true;
+  /// The board description of the chain (board/board_config.hpp's text: variants, axes,
+  /// numbering, quirks, checks), written as the header's `board` lines so that a replay builds
+  /// the same world. Empty: only the `chain` line (the variants).
+  std::string board;
 };
 
 /// Records what happens to a Chain through it.
@@ -40,7 +44,10 @@ class RecordingChain final : public SpiDevice {
   void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override;
   void deselect_wire() override;
   Tick now() const override { return chain_.now(); }
-  void advance_to(Tick tick) override { chain_.advance_to(tick); }
+  /// Lets time pass. With CS high, every change of a chip's BUSY or FLAG on the way is
+  /// recorded at its own tick (a BUSY that is the SYNC clock only when looked at); with CS low,
+  /// changes are recorded when CS rises.
+  void advance_to(Tick tick) override;
 
   // The physical world, recorded (chip k of the chain). Changes made while CS is low are
   // written after the frame's line (a trace line's time never goes back).
@@ -53,10 +60,22 @@ class RecordingChain final : public SpiDevice {
   void set_thermal(std::size_t chip, Thermal t);
   void set_overcurrent(std::size_t chip, bool active);
   void set_stall(std::size_t chip, Bridge bridge, bool active);
+  /// The load on chip `chip`'s axis changes (no effect on the chip without an axis, but recorded).
+  void set_axis_load(std::size_t chip, const LoadSpec& load);
+  /// Records that time was moved on to now() with nothing else happening (`ctl advance`), so
+  /// that a replay lets the chips run as far.
+  void mark_advance();
 
   /// Records BUSY/FLAG levels that changed since they were last seen (done after every
-  /// frame and event; call it to catch a change between frames, e.g. a move ending).
+  /// frame and event; call it to catch a change between frames, e.g. a move ending). Looking
+  /// again at the same tick with nothing done to the chain through the recorder in between is free.
   void observe_outputs();
+  /// The chain was changed behind the recorder's back (through chain()): the next
+  /// observe_outputs() looks even at the same tick.
+  void outputs_may_have_changed() {
+    observed_at_ = kNever;
+    quiet_until_ = 0;
+  }
 
   Chain& chain() { return chain_; }
   std::uint64_t frames_recorded() const { return frames_; }
@@ -65,6 +84,8 @@ class RecordingChain final : public SpiDevice {
   void start_frame();
   void finish_frame();
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
+  Tick first_output_change(std::size_t chip, Tick to, bool& unsure) const;
+  void stimulus(const TraceEvent& e);
   void emit(const TraceEvent& e);
 
   Chain& chain_;
@@ -74,6 +95,8 @@ class RecordingChain final : public SpiDevice {
   std::vector<std::uint8_t> tx_, rx_;
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   std::vector<std::uint8_t> busy_, flag_;
+  Tick observed_at_ = kNever;  // tick of the last look at the outputs; kNever after any change
+  Tick quiet_until_ = 0;       // no output changes by itself up to here (until the chain is touched)
   std::uint64_t frames_ = 0;
 };
 

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "board/trace_recorder.hpp"
+#include "linux/recording_output.hpp"
 #include "linux/device_board_internal.hpp"
 
 namespace l6470emu {
@@ -18,6 +19,11 @@ namespace l6470emu {
 DeviceBoard::DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostClock& host)
     : log_(log), board_(config, [&log](std::string_view line) { log.line(line); }, host) {
   board_.set_edge_sink([this](const PinEdge& e) { report_edge(e); });
+  // Recordings: plain files through a shared mapping (no system call per event), gzip flushed
+  // by size and host time.
+  board_.set_trace_output_opener([&host](const std::string& path) {
+    return open_recording_output(path, [&host] { return host.monotonic_ns(); });
+  });
   unsigned spi_minor = 0;
   for (const ChainConfig& cc : config.chains) {
     auto cd = std::make_unique<ChainDev>();
@@ -446,7 +452,11 @@ bool DeviceBoard::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
   return board_.level(chain, chip, pin);
 }
 
-bool DeviceBoard::advance(Tick ticks) { return time().is_virtual() && advance_to(time().now() + ticks); }
+bool DeviceBoard::advance(Tick ticks) {
+  if (!time().is_virtual()) return false;
+  std::lock_guard lock(m_);
+  return board_.advance(ticks);
+}
 
 bool DeviceBoard::advance_to(Tick tick) {
   if (!time().is_virtual()) return false;
@@ -467,6 +477,13 @@ Tick DeviceBoard::now(std::size_t chain) {
 bool DeviceBoard::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value) {
   std::lock_guard lock(m_);
   if (!board_.inject_fault(chain, chip, fault, value)) return false;
+  wake_pump();
+  return true;
+}
+
+bool DeviceBoard::set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& load) {
+  std::lock_guard lock(m_);
+  if (!board_.set_axis_load(chain, chip, load)) return false;
   wake_pump();
   return true;
 }

@@ -157,7 +157,8 @@ class DeviceBoard {
   bool drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level);
   /// Level of a pin of a chip (what a host reading the line would see before active-low).
   bool pin_level(std::size_t chain, std::size_t chip, Pin pin);
-  /// Virtual time: moves every chain on by `ticks` (edges reported on the way). Wall time: false.
+  /// Virtual time: moves every chain on by `ticks` (edges reported on the way; recorded as an
+  /// `advance` event). Wall time: false.
   bool advance(Tick ticks);
   /// Virtual time: moves the board's time to `tick` if it is later and brings every chain
   /// there, delivering the BUSY/FLAG edges of watched lines at their own ticks. Wall time: false.
@@ -175,12 +176,17 @@ class DeviceBoard {
   /// A backdoor event (fault on/off, thermal class, ADCIN code) on chip `chip` of chain `chain`,
   /// recorded when the chain is being recorded. Returns false for a bad index.
   bool inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// Changes the load on the axis of chip `chip` (`ctl axis load`), recorded when the chain is
+  /// being recorded. False for a bad index or a chip without an axis.
+  bool set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& load);
 
   // ---- trace recording (the Board's, under the lock) ---------------------------------
 
   /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
-  /// progress on the chain is stopped first): every CS frame, every input pin change (host gpio
-  /// or ctl), every backdoor event and the BUSY/FLAG changes, each line flushed as it is written.
+  /// progress on the chain is stopped first): the chain's board description, every CS frame,
+  /// every input pin change (host gpio or ctl), every backdoor event, axis load change and
+  /// `advance`, and the BUSY/FLAG changes at their ticks (Board::start_recording). A plain file
+  /// is written through a shared mapping, a gzip file flushed by size and host time.
   /// Returns "" or one line saying why not.
   std::string start_recording(std::size_t chain, const std::string& path);
   /// Starts recording every chain: into `path` for one chain, else trace_path_for_chain files.

@@ -9,6 +9,7 @@
 #include <new>
 
 #include "linux/device_board_internal.hpp"
+#include "linux/recording_output.hpp"
 
 namespace l6470emu {
 
@@ -54,7 +55,11 @@ void DeviceBoard::pump_loop() {
     {
       std::lock_guard lock(m_);
       if (pump_stop_) return;
+      // A gzip recording gone quiet still hands its data to the OS on time.
+      board_.flush_recordings();
       for (std::size_t i = 0; i < chains_.size(); ++i) {
+        if (!board_.recording_path(i).empty())
+          deadline = std::min(deadline, time().host().monotonic_ns() + kRecordingGzipFlushNs);
         if (chains_[i]->gpio < 0 || !board_.has_watched_pins(i)) continue;
         board_.catch_up(i);
         if (time().is_virtual()) continue;

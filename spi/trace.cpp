@@ -54,6 +54,13 @@ void Trace::write(const TraceEvent& e) {
   s.kind = e.kind;
   s.value = e.value;
   s.what = e.kind == TraceEventKind::pin ? static_cast<std::uint8_t>(e.pin) : static_cast<std::uint8_t>(e.fault);
+  if (e.kind == TraceEventKind::load) {
+    // The load's three numbers go to the byte pool (rare events: Stored stays small).
+    s.offset = bytes_.size();
+    const std::uint32_t words[3] = {e.load.inertia_g_mm2, e.load.friction_uNm, static_cast<std::uint32_t>(e.load.force_uNm)};
+    for (std::uint32_t w : words)
+      for (int b = 0; b < 4; ++b) bytes_.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+  }
   if (e.kind == TraceEventKind::frame) {
     if ((!e.miso.empty() && e.miso.size() != e.mosi.size()) ||
         (!e.miso_known.empty() && e.miso_known.size() != e.mosi.size()))
@@ -87,6 +94,14 @@ TraceEvent Trace::operator[](std::size_t i) const {
   e.value = s.value;
   if (s.kind == TraceEventKind::pin) e.pin = static_cast<TracePin>(s.what);
   if (s.kind == TraceEventKind::fault) e.fault = static_cast<TraceFault>(s.what);
+  if (s.kind == TraceEventKind::load) {
+    std::uint32_t words[3] = {};
+    for (int w = 0; w < 3; ++w)
+      for (int b = 0; b < 4; ++b) words[w] |= std::uint32_t{bytes_[s.offset + 4 * w + b]} << (8 * b);
+    e.load.inertia_g_mm2 = words[0];
+    e.load.friction_uNm = words[1];
+    e.load.force_uNm = static_cast<std::int32_t>(words[2]);
+  }
   if (s.kind == TraceEventKind::frame) {
     const std::uint8_t* p = bytes_.data() + s.offset;
     e.mosi = {p, s.length};
@@ -234,33 +249,63 @@ std::string line_too_long() {
          std::to_string(kMaxTraceFrameBytes) + " bytes: not a trace, or a damaged one)";
 }
 
+namespace {
+
+/// Appends `v` in decimal, at least `width` digits (zeros in front).
+void append_decimal(std::string& out, std::uint64_t v, int width = 1) {
+  char buf[24];
+  char* p = buf + sizeof buf;
+  do {
+    *--p = static_cast<char>('0' + v % 10);
+    v /= 10;
+  } while (v != 0);
+  while (buf + sizeof buf - p < width) *--p = '0';
+  out.append(p, static_cast<std::size_t>(buf + sizeof buf - p));
+}
+
+}  // namespace
+
+void append_seconds(std::string& out, Tick t) {
+  append_decimal(out, t / kTicksPerSecond);
+  out += '.';
+  append_decimal(out, (t % kTicksPerSecond) * 25, 8);
+}
+
+void append_microseconds(std::string& out, Tick t) {
+  append_decimal(out, t / kTicksPerMicrosecond);
+  out += '.';
+  append_decimal(out, (t % kTicksPerMicrosecond) * 25, 2);
+}
+
+void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) out += ' ';
+    if (!known.empty() && !known[i]) {
+      out += "??";
+      continue;
+    }
+    out += kHex[bytes[i] >> 4];
+    out += kHex[bytes[i] & 15];
+  }
+}
+
 std::string format_seconds(Tick t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%llu.%08llu", static_cast<unsigned long long>(t / kTicksPerSecond),
-                static_cast<unsigned long long>((t % kTicksPerSecond) * 25));
-  return buf;
+  std::string s;
+  append_seconds(s, t);
+  return s;
 }
 
 std::string format_microseconds(Tick t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%llu.%02llu", static_cast<unsigned long long>(t / kTicksPerMicrosecond),
-                static_cast<unsigned long long>((t % kTicksPerMicrosecond) * 25));
-  return buf;
+  std::string s;
+  append_microseconds(s, t);
+  return s;
 }
 
 std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
-  static constexpr char kHex[] = "0123456789ABCDEF";
   std::string s;
   s.reserve(bytes.size() * 3);
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    if (i) s += ' ';
-    if (!known.empty() && !known[i]) {
-      s += "??";
-      continue;
-    }
-    s += kHex[bytes[i] >> 4];
-    s += kHex[bytes[i] & 15];
-  }
+  append_hex_bytes(s, bytes, known);
   return s;
 }
 

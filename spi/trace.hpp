@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/axis_spec.hpp"
 #include "core/tick.hpp"
 
 namespace l6470emu {
@@ -42,6 +43,8 @@ enum class TraceEventKind : std::uint8_t {
   frame,  ///< one CS frame: CS falls, bytes are exchanged, CS rises
   pin,    ///< a pin changed level (inputs SW, STCK, STBY) or was observed (outputs BUSY, FLAG)
   fault,  ///< a backdoor event: a fault condition starts or ends, or the ADCIN level changes
+  load,   ///< the load on a chip's mechanical axis changes (inertia, friction, force: TraceEvent::load)
+  advance,  ///< time was moved on with nothing else happening (`ctl advance`): the chips run up to here
 };
 
 /// The chip pins a trace can carry, by datasheet name.
@@ -82,6 +85,7 @@ struct TraceEvent {
   TracePin pin = TracePin::SW;               ///< pin events
   TraceFault fault = TraceFault::UVLO;       ///< fault events
   std::uint8_t value = 0;                    ///< pin: level 0/1; fault: see TraceFault
+  LoadSpec load;                             ///< load events: the axis's new load
   std::uint64_t line = 0;                    ///< line in the source file (0 = none)
   std::uint64_t repetition = 0;              ///< native `repeat` lines: which repetition (1..), else 0
   double source_time = std::numeric_limits<double>::quiet_NaN();  ///< seconds as in the source file
@@ -102,6 +106,12 @@ struct TraceHeader {
   std::string format;         ///< "native", "saleae", "umockdev", "ftrace", "sigrok"
   std::string chain;          ///< the chain the trace was taken from ("3*L6470"); empty = not known
   std::uint64_t chain_line = 0;      ///< where `chain` was written (for error messages)
+  /// The board description of the chain the trace was recorded on (native version 2 `board`
+  /// lines, one clause per line, as board/board_config.hpp parses it): variants, axes, quirks,
+  /// numbering, checks. Empty = not known (captures, version 1 files).
+  std::string board;
+  std::uint64_t board_line = 0;      ///< where the first `board` line was written
+  int version = 0;                   ///< native format version read (0: not a native trace)
   std::vector<std::string> notes;    ///< importer remarks: guessed framing, missing channels...
 };
 
@@ -223,6 +233,9 @@ bool ticks_between(const SourceTime& origin, const SourceTime& t, Tick& out);
 std::string format_seconds(Tick t);
 /// Ticks as microseconds with 2 decimals, exact ("1.75").
 std::string format_microseconds(Tick t);
+/// format_seconds / format_microseconds appended to `out` (no allocation when it has room).
+void append_seconds(std::string& out, Tick t);
+void append_microseconds(std::string& out, Tick t);
 
 // ---- bytes -------------------------------------------------------------------
 
@@ -236,5 +249,7 @@ constexpr int hex_digit_value(char c) {
 
 /// Bytes as upper-case hex separated by spaces ("D0 00 7E"); unknown MISO bytes as "??".
 std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
+/// hex_bytes appended to `out`.
+void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
 
 }  // namespace l6470emu

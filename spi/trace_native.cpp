@@ -1,4 +1,4 @@
-// Native trace format, version 1: parsing line by line with exact times and expanding
+// Native trace format, versions 1 and 2: parsing line by line with exact times and expanding
 // `repeat` lines, and writing with one flush per event and runs of repeated frames
 // collapsed. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
@@ -116,6 +116,13 @@ void NativeTraceReader::fail(const std::string& message) const {
 
 bool NativeTraceReader::next_line(std::string_view& line) {
   for (;;) {
+    // A line that starts with a NUL byte ends the trace: what follows is the unwritten rest of
+    // a recording file that was not closed (a killed recorder's mapped file) or bytes it hid.
+    if (!text_.empty() && text_[0] == '\0') {
+      text_ = {};
+      eof_ = true;
+      return false;
+    }
     const std::size_t nl = text_.find('\n');
     if (nl != std::string_view::npos) {
       line = text_.substr(0, nl);
@@ -155,7 +162,9 @@ bool NativeTraceReader::next_line(std::string_view& line) {
 
 void NativeTraceReader::read_header() {
   std::string_view line;
-  if (!next_line(line)) throw TraceError(header_.name, 0, "empty file (expected a native trace: 'l6470emu-trace 1')");
+  if (!next_line(line))
+    throw TraceError(header_.name, 0,
+                     "empty file (expected a native trace: 'l6470emu-trace " + std::to_string(kNativeTraceVersion) + "')");
   std::string_view rest = line;
   const std::string_view magic = next_token(rest);
   const std::string_view version = next_token(rest);
@@ -163,20 +172,34 @@ void NativeTraceReader::read_header() {
     fail("not an l6470emu trace: the first line must be 'l6470emu-trace " + std::to_string(kNativeTraceVersion) + "'");
   unsigned long v = 0;
   if (!parse_uint(version, 1000000, v) || !next_token(rest).empty()) fail("malformed header line " + quoted(line));
-  if (v != static_cast<unsigned long>(kNativeTraceVersion))
-    fail("format version " + std::to_string(v) + " (this l6470emu reads version " +
+  if (v < 1 || v > static_cast<unsigned long>(kNativeTraceVersion))
+    fail("format version " + std::to_string(v) + " (this l6470emu reads versions 1 to " +
          std::to_string(kNativeTraceVersion) + ")");
+  header_.version = static_cast<int>(v);
   // Directives up to the first event.
   while (next_line(line)) {
     rest = line;
     const std::string_view word = next_token(rest);
     if (word.empty() || word[0] == '#') continue;
-    if (word == "chain") {
+    if (word == "chain" || word == "board") {
       std::size_t i = 0;
       while (i < rest.size() && is_space(rest[i])) ++i;
-      header_.chain = std::string(rest.substr(i));
-      header_.chain_line = line_no_;
-      if (header_.chain.empty()) fail("'chain' needs the chips, e.g. 'chain 3*L6470'");
+      std::string_view value = rest.substr(i);
+      while (!value.empty() && is_space(value.back())) value.remove_suffix(1);
+      if (word == "chain") {
+        if (!header_.chain.empty()) fail("a second 'chain' line (the first is line " + std::to_string(header_.chain_line) + ")");
+        header_.chain = std::string(value);
+        header_.chain_line = line_no_;
+        if (header_.chain.empty()) fail("'chain' needs the chips, e.g. 'chain 3*L6470'");
+        continue;
+      }
+      if (header_.version < 2) fail("'board' lines need format version 2 (the first line says 1)");
+      if (value.empty()) fail("'board' needs a clause of the board description, e.g. 'board chips=L6470 axis.0=default'");
+      if (header_.board.size() + value.size() > kMaxBoardBytes)
+        fail("the 'board' lines hold more than " + std::to_string(kMaxBoardBytes) + " bytes (a board description is a few lines)");
+      if (header_.board.empty()) header_.board_line = line_no_;
+      header_.board += value;
+      header_.board += '\n';
       continue;
     }
     have_pending_ = parse_line(line, pending_);
@@ -238,9 +261,26 @@ void NativeTraceReader::next_repetition(TraceEvent& e) {
 /// `TIME repeat K frames N times every PERIODus`: checks it and sets up the repetitions.
 void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view time_tok, Tick tick) {
   const std::string_view group_tok = next_token(rest), frames_tok = next_token(rest);
-  const std::string_view count_tok = next_token(rest), times_tok = next_token(rest);
-  const std::string_view every_tok = next_token(rest), period_tok = next_token(rest);
-  const std::string form = " (expected 'TIME repeat K frames N times every PERIODus')";
+  std::string_view count_tok, times_tok, every_tok, period_tok;
+  // Closed: `TIME repeat K frames N times every PERIODus`, TIME = the last repetition's last frame.
+  // Open (version 2): `TIME repeat K frames every PERIODus times N`, TIME = the group's last
+  // frame before the repetitions, N from 0 (a recording updates it in place).
+  std::string_view rest_after = rest;
+  const bool open = next_token(rest_after) == "every";
+  if (open) {
+    every_tok = next_token(rest);
+    period_tok = next_token(rest);
+    times_tok = next_token(rest);
+    count_tok = next_token(rest);
+  } else {
+    count_tok = next_token(rest);
+    times_tok = next_token(rest);
+    every_tok = next_token(rest);
+    period_tok = next_token(rest);
+  }
+  const std::string form = open ? " (expected 'TIME repeat K frames every PERIODus times N')"
+                                : " (expected 'TIME repeat K frames N times every PERIODus')";
+  if (open && header_.version < 2) fail("repeat: the form 'repeat K frames every PERIODus times N' needs format version 2");
   unsigned long group = 0;
   if (!parse_uint(group_tok, 1000000000, group) || group == 0 || group > kMaxRepeatGroup)
     fail("repeat: group size " + quoted(group_tok) + " is not a number of frames from 1 to " +
@@ -252,8 +292,9 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
     if (c < '0' || c > '9') count_ok = false;
     if (count_ok) count = count * 10 + static_cast<std::uint64_t>(c - '0');
   }
-  if (!count_ok || count == 0 || count > kMaxRepeatCount)
-    fail("repeat: count " + quoted(count_tok) + " is not a number of repetitions from 1 to 10^12" + form);
+  if (!count_ok || count < (open ? 0u : 1u) || count > kMaxRepeatCount)
+    fail("repeat: count " + quoted(count_tok) + " is not a number of repetitions from " + (open ? "0" : "1") +
+         " to 10^12" + form);
   if (times_tok != "times" && times_tok != "time") fail("repeat: " + quoted(times_tok) + " where 'times' belongs" + form);
   if (every_tok != "every") fail("repeat: " + quoted(every_tok) + " where 'every' belongs" + form);
   Tick period = 0;
@@ -273,9 +314,17 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
     fail("repeat: period " + quoted(period_tok) + " is shorter than the " + std::to_string(group) +
          " frames it repeats (" + format_microseconds(last.tick + last.duration - first.tick) + " us from the first CS "
          "falling edge to the last CS rising edge): repetitions would overlap");
-  // The time written is the last repeated frame's: the group's last frame, count periods on.
   const Tick limit = kMaxNativeTraceTick - last.duration;  // the last repetition's CS rising edge fits too
-  if (period > limit / count || last.tick > limit - period * count || last.tick + period * count != tick)
+  if (open) {
+    // The time written is the group's last frame, before any repetition.
+    if (tick != last.tick)
+      fail("repeat: the line's time " + as_written(time_tok, tick) + " s is not when the group's last frame starts (" +
+           format_seconds(last.tick) + " s)");
+    if (count != 0 && (period > limit / count || last.tick > limit - period * count))
+      fail("repeat: the last repetition would end after " + max_time_words());
+  }
+  // Closed: the time written is the last repeated frame's: the group's last frame, count periods on.
+  else if (period > limit / count || last.tick > limit - period * count || last.tick + period * count != tick)
     fail("repeat: the line's time " + as_written(time_tok, tick) + " s is not when the last repetition's last frame starts (" +
          (period <= limit / count && last.tick <= limit - period * count ? format_seconds(last.tick + period * count) + " s"
                                                                          : "beyond " + max_time_words()) +
@@ -292,7 +341,7 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
   repeat_done_ = 0;
   repeat_period_ = period;
   repeat_line_ = line_no_;
-  last_frame_end_ = tick + last.duration;
+  last_frame_end_ = last.tick + period * count + last.duration;
 }
 
 /// Parses one line into `e`; false for comments and blank lines.
@@ -301,7 +350,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   const std::string_view time_tok = next_token(rest);
   if (time_tok.empty() || time_tok[0] == '#') return false;
   if (time_tok[0] < '0' || time_tok[0] > '9') {
-    if (time_tok == "chain") fail("'chain' must come before the first event");
+    if (time_tok == "chain" || time_tok == "board") fail("'" + std::string(time_tok) + "' must come before the first event");
     if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
     fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault ...')");
   }
@@ -349,7 +398,8 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   const std::string_view kind = next_token(rest);
   if (kind == "repeat") {
     parse_repeat(rest, time_tok, tick);
-    last_tick_ = tick;
+    // Later events come after the last repetition (an open line's time is its group's).
+    last_tick_ = std::max(tick, last_frame_end_ - kept_[(kept_next_ + kMaxRepeatGroup - 1) % kMaxRepeatGroup].duration);
     return false;  // next() hands out the repetitions
   }
   e = TraceEvent{};
@@ -467,10 +517,39 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
         e.value = value == "on";
       }
     }
+  } else if (kind == "load" || kind == "advance") {
+    if (header_.version < 2) fail("'" + std::string(kind) + "' events need format version 2 (the first line says 1)");
+    kept_count_ = 0;
+    if (kind == "advance") {
+      e.kind = TraceEventKind::advance;
+      if (!next_token(rest).empty()) fail("too many fields in " + quoted(line) + " (expected 'TIME advance')");
+    } else {
+      e.kind = TraceEventKind::load;
+      const std::string form = " (expected 'TIME load CHIP inertia=G_MM2 friction=UNM force=UNM')";
+      const std::string_view chip_tok = next_token(rest);
+      unsigned long chip = 0;
+      if (!parse_uint(chip_tok, 255, chip)) fail("chip " + quoted(chip_tok) + " is not a chip number (0..255)" + form);
+      e.chip = static_cast<std::uint16_t>(chip);
+      static constexpr std::string_view kNames[] = {"inertia=", "friction=", "force="};
+      for (int i = 0; i < 3; ++i) {
+        const std::string_view tok = next_token(rest);
+        if (tok.substr(0, kNames[i].size()) != kNames[i]) fail("load: " + quoted(tok) + " where " + std::string(kNames[i]) + "... belongs" + form);
+        std::string_view num = tok.substr(kNames[i].size());
+        const bool negative = i == 2 && !num.empty() && num[0] == '-';
+        if (negative) num.remove_prefix(1);
+        unsigned long v = 0;
+        if (!parse_uint(num, 1'000'000'000, v))
+          fail("load: " + quoted(tok) + " is not a whole number from " + (i == 2 ? "-" : "") + "0 to 1000000000" + form);
+        if (i == 0) e.load.inertia_g_mm2 = static_cast<std::uint32_t>(v);
+        if (i == 1) e.load.friction_uNm = static_cast<std::uint32_t>(v);
+        if (i == 2) e.load.force_uNm = negative ? -static_cast<std::int32_t>(v) : static_cast<std::int32_t>(v);
+      }
+      if (!next_token(rest).empty()) fail("too many fields in " + quoted(line) + form);
+    }
   } else if (kind.empty()) {
     fail("time without an event");
   } else {
-    fail("unknown event " + quoted(kind) + " (frame, repeat, pin or fault)");
+    fail("unknown event " + quoted(kind) + " (frame, repeat, pin, fault, load or advance)");
   }
   any_event_ = true;
   last_tick_ = tick;
@@ -504,6 +583,18 @@ bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
   return true;
 }
 
+bool NativeTraceWriter::Held::same_bytes(const TraceEvent& e) const {
+  // As same_bytes(Held) with `e` held (without copying it).
+  const bool e_has_miso = !e.miso.empty();
+  if (duration != e.duration || has_miso != e_has_miso || !std::equal(mosi.begin(), mosi.end(), e.mosi.begin(), e.mosi.end()) ||
+      !std::equal(known.begin(), known.end(), e.miso_known.begin(), e.miso_known.end()))
+    return false;
+  if (miso.size() != e.miso.size()) return false;
+  for (std::size_t i = 0; i < miso.size(); ++i)
+    if ((known.empty() || known[i]) && miso[i] != e.miso[i]) return false;
+  return true;
+}
+
 TraceEvent NativeTraceWriter::Held::event() const {
   TraceEvent e;
   e.kind = TraceEventKind::frame;
@@ -518,20 +609,29 @@ TraceEvent NativeTraceWriter::Held::event() const {
 NativeTraceWriter::NativeTraceWriter(const std::string& path, bool flush_each_event)
     : NativeTraceWriter(path, NativeWriteOptions{flush_each_event, true}) {}
 
+namespace {
+
+TraceFlushPolicy policy_for(const NativeWriteOptions& o) {
+  TraceFlushPolicy p;
+  p.plain_every_event = o.flush_each_event;
+  if (!o.flush_each_event) p.gzip_bytes = SIZE_MAX;  // only at the end
+  return p;
+}
+
+}  // namespace
+
 NativeTraceWriter::NativeTraceWriter(const std::string& path, NativeWriteOptions options)
-    : file_(std::make_unique<TraceFileWriter>(path)), options_(options) {}
+    : NativeTraceWriter(open_trace_file_output(path, policy_for(options)), options) {}
 
 NativeTraceWriter::NativeTraceWriter(std::ostream& out, bool flush_each_event)
     : NativeTraceWriter(out, NativeWriteOptions{flush_each_event, true}) {}
 
 NativeTraceWriter::NativeTraceWriter(std::ostream& out, NativeWriteOptions options, std::string name)
-    : out_(&out), out_name_(std::move(name)), options_(options) {}
+    : NativeTraceWriter(stream_trace_output(out, std::move(name), options.flush_each_event), options) {}
 
-/// Throws when the stream has failed; errno was cleared before the write, so a value now is its reason.
-void NativeTraceWriter::check_stream() const {
-  if (*out_) return;
-  const int e = errno;
-  throw std::runtime_error(out_name_ + ": write failed" + (e != 0 ? std::string(": ") + std::strerror(e) : std::string()));
+NativeTraceWriter::NativeTraceWriter(std::unique_ptr<TraceOutput> output, NativeWriteOptions options)
+    : out_(std::move(output)), options_(options) {
+  if (!out_) throw std::invalid_argument("NativeTraceWriter: no output");
 }
 
 NativeTraceWriter::~NativeTraceWriter() {
@@ -541,71 +641,74 @@ NativeTraceWriter::~NativeTraceWriter() {
   }
 }
 
+const std::string& NativeTraceWriter::name() const { return out_->name(); }
+
 void NativeTraceWriter::finish() {
   if (finished_) return;
   finished_ = true;
+  if (abandoned_) return;
   if (in_run_) end_run();
-  if (file_) {
-    file_->close();
-  } else if (out_ != nullptr) {
-    errno = 0;
-    out_->flush();
-    check_stream();
-  }
+  out_->close();
 }
 
-bool NativeTraceWriter::rewritable() const { return file_ && !file_->gzip() && options_.flush_each_event; }
-
-void NativeTraceWriter::put(const std::string& text) {
-  if (file_) {
-    file_->write(text);
-  } else {
-    errno = 0;
-    out_->write(text.data(), static_cast<std::streamsize>(text.size()));
-    check_stream();
-  }
+void NativeTraceWriter::flush_if_due() {
+  if (!finished_ && !abandoned_) out_->flush_if_due();
 }
 
-/// The end of one event: handed to the OS when asked to.
-void NativeTraceWriter::end_event() {
-  if (!options_.flush_each_event) return;
-  if (file_) {
-    file_->flush();
-  } else {
-    errno = 0;
-    out_->flush();
-    check_stream();
-  }
+void NativeTraceWriter::abandon() {
+  if (abandoned_) return;
+  abandoned_ = true;
+  out_->abandon();
 }
+
+/// Open `repeat` lines (a count replaced in place) where the output can be rewritten and every
+/// event must survive a kill; elsewhere closed lines, written when a run ends or at checkpoints.
+bool NativeTraceWriter::open_runs() const { return out_->rewritable() && options_.flush_each_event; }
+
+void NativeTraceWriter::put(const std::string& text) { out_->append(text); }
 
 void NativeTraceWriter::write_header(const TraceHeader& header) {
   if (header_written_) return;
   header_written_ = true;
   std::string text = std::string(kNativeTraceMagic) + " " + std::to_string(kNativeTraceVersion) + "\n";
   if (!header.chain.empty()) text += "chain " + header.chain + "\n";
+  // The board description, a clause per line (the reader joins them again).
+  std::string_view board = header.board;
+  while (!board.empty()) {
+    const std::size_t nl = board.find('\n');
+    std::string_view clause = board.substr(0, nl);
+    board = nl == std::string_view::npos ? std::string_view{} : board.substr(nl + 1);
+    while (!clause.empty() && (clause.back() == ' ' || clause.back() == '\r')) clause.remove_suffix(1);
+    if (clause.empty()) continue;
+    text += "board ";
+    text += clause;
+    text += '\n';
+  }
   text += "# " + std::string(kNativeTraceNumbering) + "\n";
   if (!header.name.empty() && header.format != "native")
     text += "# converted from " + header.name + (header.format.empty() ? "" : " (" + header.format + ")") + "\n";
   for (const std::string& note : header.notes) text += "# note: " + note + "\n";
   put(text);
-  end_event();
+  out_->event_end();
 }
 
 void NativeTraceWriter::write_line(const TraceEvent& e) {
-  line_ = format_event(e);
+  line_.clear();
+  append_event(line_, e);
   line_ += '\n';
   put(line_);
 }
 
 void NativeTraceWriter::write(const TraceEvent& e) {
   if (finished_) throw std::logic_error("NativeTraceWriter::write after finish()");
+  if (abandoned_) return;
   // What the reader would refuse is not written (a virtual host that slept past 10^12 s, a
   // frame longer than a reader takes).
   if (e.kind == TraceEventKind::frame && e.mosi.size() > kMaxTraceFrameBytes)
-    throw std::runtime_error((file_ ? file_->path() : out_name_) + ": the frame at " + format_seconds(e.tick) +
+    throw std::runtime_error(name() + ": the frame at " + format_seconds(e.tick) +
                              " s cannot be written: " + frame_too_long(e.mosi.size()));
   if (e.tick > kMaxNativeTraceTick || e.duration > kMaxNativeTraceTick - e.tick)
-    throw std::runtime_error((file_ ? file_->path() : out_name_) + ": an event at " + format_seconds(e.tick) + " s" +
+    throw std::runtime_error(name() + ": an event at " + format_seconds(e.tick) + " s" +
                              (e.kind == TraceEventKind::frame ? " lasting " + format_microseconds(e.duration) + " us" : "") +
                              " is beyond " + max_time_words() + ", the latest time a native trace holds");
   if (!header_written_) write_header({});
@@ -616,7 +719,7 @@ void NativeTraceWriter::write(const TraceEvent& e) {
     recent_.clear();
     write_line(e);
   }
-  end_event();
+  out_->event_end();
 }
 
 std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period) {
@@ -625,37 +728,50 @@ std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group,
          " every " + format_microseconds(period) + "us";
 }
 
+namespace {
+
+/// The count of an open repeat line (at most kMaxOpenRepeatCount): 6 characters, right-aligned,
+/// and the newline.
+std::string_view open_count_field(std::uint64_t count, char (&buf)[7]) {
+  for (int i = 5; i >= 0; --i) {
+    buf[i] = count != 0 || i == 5 ? static_cast<char>('0' + count % 10) : ' ';
+    count /= 10;
+  }
+  buf[6] = '\n';
+  return {buf, 7};
+}
+
+}  // namespace
+
 /// A frame with compaction: either the next one of the run under way, or a line of its own
 /// (after which it may start a run).
 void NativeTraceWriter::frame(const TraceEvent& e) {
   if (in_run_) {
-    const Held& model = run_[partial_.size()];
-    Held h;
-    h.assign(e);
-    // A repeat line stands for at most kMaxRepeatCount repetitions: a longer run starts anew.
-    if (e.tick == model.tick + run_period_ && h.same_bytes(model) && line_count_ < kMaxRepeatCount) {
-      if (rewritable()) write_line(e);  // a killed process leaves it; rewritten into the count below
-      partial_.push_back(std::move(h));
-      if (partial_.size() < run_group_) return;
-      // A whole repetition more.
-      run_.swap(partial_);
-      partial_.clear();
-      ++line_count_;
-      if (rewritable()) {
-        // The repeat line, rewritten in one write(2) over itself and the frame lines after it;
-        // what is left of them becomes a comment, so a kill before the cut leaves a valid file.
-        const std::string line = format_repeat(line_base_, run_group_, line_count_, run_period_);
-        const std::uint64_t old_tail = file_->end_offset() - run_offset_;
-        std::string text = line;
-        if (old_tail == line.size() + 2) text += ' ';  // one byte to cover: trailing space (allowed)
-        text += '\n';
-        const std::size_t keep = text.size();
-        if (old_tail >= text.size() + 2) {
-          text += '#';
-          text.append(static_cast<std::size_t>(old_tail - text.size() - 1), ' ');
-          text += '\n';
+    const Held& model = run_[partial_];
+    // A repeat line stands for at most kMaxRepeatCount repetitions (an open one for
+    // kMaxOpenRepeatCount): a longer run starts anew.
+    const std::uint64_t max_count = open_runs() ? kMaxOpenRepeatCount : kMaxRepeatCount;
+    if (e.tick == model.tick + run_period_ && model.same_bytes(e) && line_count_ < max_count) {
+      if (++partial_ < run_group_) {
+        if (open_runs()) {
+          // A killed process leaves it; taken into the count below. Only its time is new.
+          line_.clear();
+          append_seconds(line_, e.tick);
+          line_ += run_bodies_[partial_ - 1];
+          put(line_);
         }
-        file_->overwrite_tail(run_offset_, text, keep);
+        return;
+      }
+      // A whole repetition more: the group moves on by one period.
+      for (Held& h : run_) h.tick += run_period_;
+      partial_ = 0;
+      ++line_count_;
+      if (open_runs()) {
+        // The count and the end of its line, in the 8-byte word that also holds the first byte
+        // of the frame lines after it: one store makes them the repetition's count instead.
+        char field[7];
+        out_->replace_tail(count_offset_, open_count_field(line_count_, field));
+        if (line_count_ == kMaxOpenRepeatCount) end_run();
       } else if (options_.flush_each_event &&
                  (line_count_ >= kCheckpointRepetitions || run_.back().tick - checkpoint_tick_ >= kCheckpointTicks)) {
         write_repeat_line();
@@ -665,36 +781,65 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     end_run();
   }
   write_line(e);
-  Held h;
-  h.assign(e);
-  recent_.push_back(std::move(h));
-  if (recent_.size() > 2 * kMaxRepeatGroup) recent_.erase(recent_.begin());
+  if (recent_.size() == 3 * kMaxRepeatGroup) {
+    std::rotate(recent_.begin(), recent_.begin() + 1, recent_.end());  // reuses the oldest one's buffers
+    recent_.back().assign(e);
+  } else {
+    recent_.emplace_back().assign(e);
+  }
   look_for_run();
 }
 
-/// Whether the last frames are a group that came twice with a constant period: then the
+/// Whether the last frames are a group that came twice (closed lines) or three times (open
+/// lines, which cost a line even when no repetition follows) with a constant period: then the
 /// next ones may be its repetitions.
 void NativeTraceWriter::look_for_run() {
   const std::size_t n = recent_.size();
-  for (std::size_t k = 1; k <= kMaxRepeatGroup && 2 * k <= n; ++k) {
-    const Held* a = &recent_[n - 2 * k];
-    const Held* b = &recent_[n - k];
-    const Tick period = b[0].tick - a[0].tick;
+  const std::size_t copies = open_runs() ? 3 : 2;
+  for (std::size_t k = 1; k <= kMaxRepeatGroup && copies * k <= n; ++k) {
+    const Held* c = &recent_[n - k];
+    const Tick period = c[0].tick - recent_[n - 2 * k].tick;
     if (period == 0) continue;
     bool same = true;
-    for (std::size_t j = 0; j < k && same; ++j) same = b[j].tick - a[j].tick == period && b[j].same_bytes(a[j]);
+    for (std::size_t copy = 1; copy < copies && same; ++copy) {
+      const Held* a = &recent_[n - (copy + 1) * k];
+      const Held* b = &recent_[n - copy * k];
+      for (std::size_t j = 0; j < k && same; ++j) same = b[j].tick - a[j].tick == period && b[j].same_bytes(a[j]);
+    }
     if (!same) continue;
     in_run_ = true;
     run_group_ = k;
     run_period_ = period;
     run_.assign(recent_.end() - static_cast<std::ptrdiff_t>(k), recent_.end());
-    partial_.clear();
+    partial_ = 0;
+    run_bodies_.resize(k);
+    for (std::size_t j = 0; j < k; ++j) {
+      run_bodies_[j].clear();
+      append_event_body(run_bodies_[j], run_[j].event());
+      run_bodies_[j] += '\n';
+    }
     line_count_ = 0;
     line_base_ = run_.back().tick;
     checkpoint_tick_ = run_.back().tick;
-    if (file_) run_offset_ = file_->end_offset();
+    if (open_runs()) write_open_repeat_line();
     return;
   }
+}
+
+/// `TIME repeat K frames every PERIODus times N` with N 0 for now, laid out so that the count
+/// field (6 characters) starts at a multiple of 8 bytes: the count, the newline and the first
+/// byte of the next line then share one aligned 8-byte word of the output.
+void NativeTraceWriter::write_open_repeat_line() {
+  line_ = format_seconds(line_base_) + " repeat " + std::to_string(run_group_) + (run_group_ == 1 ? " frame" : " frames") +
+          " every " + format_microseconds(run_period_) + "us times";
+  const std::uint64_t start = out_->size();
+  std::uint64_t field = start + line_.size() + 1;  // at least one blank before the count
+  field = (field + 7) / 8 * 8;
+  line_.append(static_cast<std::size_t>(field - start - line_.size()), ' ');
+  count_offset_ = field;
+  char count[7];
+  line_ += open_count_field(0, count);
+  put(line_);
 }
 
 void NativeTraceWriter::write_repeat_line() {
@@ -708,37 +853,50 @@ void NativeTraceWriter::write_repeat_line() {
 }
 
 /// The run is over: its repeat line and the frames of an unfinished repetition go to the file
-/// (a rewritten plain file has them already), and they are the recent frames from now on.
+/// (an open line has them already), and they are the recent frames from now on.
 void NativeTraceWriter::end_run() {
   in_run_ = false;
-  if (!rewritable()) {
+  // The frames of the unfinished repetition: the group's first ones, one period on.
+  std::vector<Held> partial(run_.begin(), run_.begin() + static_cast<std::ptrdiff_t>(partial_));
+  for (Held& h : partial) h.tick += run_period_;
+  if (!open_runs()) {
     write_repeat_line();
-    for (const Held& h : partial_) write_line(h.event());
+    for (const Held& h : partial) write_line(h.event());
   }
   recent_ = std::move(run_);
-  for (Held& h : partial_) recent_.push_back(std::move(h));
+  for (Held& h : partial) recent_.push_back(std::move(h));
   run_.clear();
-  partial_.clear();
+  partial_ = 0;
   // A new run may start right away among these frames (but not one that includes the old run's
   // group twice: that would have continued the run).
 }
 
 std::string NativeTraceWriter::format_event(const TraceEvent& e) {
-  std::string s = format_seconds(e.tick);
+  std::string s;
+  append_event(s, e);
+  return s;
+}
+
+void NativeTraceWriter::append_event(std::string& s, const TraceEvent& e) {
+  append_seconds(s, e.tick);
+  append_event_body(s, e);
+}
+
+void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
   switch (e.kind) {
     case TraceEventKind::frame:
       s += " frame ";
-      s += format_microseconds(e.duration);
+      append_microseconds(s, e.duration);
       s += "us";
       if (!e.mosi.empty()) {
         s += ' ';
-        s += hex_bytes(e.mosi);
+        append_hex_bytes(s, e.mosi);
       }
       if (!e.miso.empty()) {
         s += " |";
         if (!e.mosi.empty()) {
           s += ' ';
-          s += hex_bytes(e.miso, e.miso_known);
+          append_hex_bytes(s, e.miso, e.miso_known);
         }
       }
       break;
@@ -754,8 +912,14 @@ std::string NativeTraceWriter::format_event(const TraceEvent& e) {
       else
         s += e.value ? "on" : "off";
       break;
+    case TraceEventKind::load:
+      s += " load " + std::to_string(e.chip) + " inertia=" + std::to_string(e.load.inertia_g_mm2) +
+           " friction=" + std::to_string(e.load.friction_uNm) + " force=" + std::to_string(e.load.force_uNm);
+      break;
+    case TraceEventKind::advance:
+      s += " advance";
+      break;
   }
-  return s;
 }
 
 std::string to_native_text(const Trace& trace, bool compact) {

@@ -1,5 +1,5 @@
 // The native trace format (docs/trace-format.md): line-based text, one CS frame per
-// line, version 1, plain or gzip. Reader (streaming, for traces of any length, expanding
+// line, version 2 (version 1 read too), plain or gzip. Reader (streaming, for traces of any length, expanding
 // `repeat` lines as it goes) and writer (flushed event by event, so a killed process leaves
 // a complete file; collapsing runs of repeated frames into `repeat` lines). No other formats here.
 #pragma once
@@ -12,17 +12,22 @@
 #include <vector>
 
 #include "spi/trace.hpp"
+#include "spi/trace_output.hpp"
 
 namespace l6470emu {
 
 /// The first line of every native trace.
 inline constexpr std::string_view kNativeTraceMagic = "l6470emu-trace";
-/// The format version this code writes and reads.
-inline constexpr int kNativeTraceVersion = 1;
+/// The format version this code writes (it reads versions 1 and 2). Version 2 added the
+/// `board` header lines, the `load` and `advance` events and open `repeat` lines.
+inline constexpr int kNativeTraceVersion = 2;
 /// The comment the writer puts under the header (after `chain`), so a reader of the file
 /// knows which end chip 0 is: the chain's own order, whatever a tool shows.
 inline constexpr std::string_view kNativeTraceNumbering =
     "chip numbers count from the MISO end: chip 0 drives MISO, byte k of a frame goes to chip k";
+
+/// The most bytes of `board` lines a reader takes (a board description is a few lines).
+inline constexpr std::size_t kMaxBoardBytes = std::size_t{1} << 20;
 
 /// The most frames a `repeat` line can repeat as one group.
 inline constexpr std::size_t kMaxRepeatGroup = 16;
@@ -36,7 +41,6 @@ inline constexpr std::uint64_t kMaxNativeTraceSeconds = 1'000'000'000'000ull;
 inline constexpr Tick kMaxNativeTraceTick = kMaxNativeTraceSeconds * kTicksPerSecond;
 
 class TraceFileReader;
-class TraceFileWriter;
 
 /// Reads a native trace event by event; memory use does not grow with its length (a line is
 /// at most kMaxTraceLineBytes, a frame at most kMaxTraceFrameBytes).
@@ -47,7 +51,7 @@ class TraceFileWriter;
 class NativeTraceReader final : public TraceReader {
  public:
   /// Opens `path` (gzip-compressed or not: recognised by its first bytes). Throws TraceError
-  /// when it cannot be read or is not a version-1 native trace.
+  /// when it cannot be read or is not a native trace of version 1 or 2.
   explicit NativeTraceReader(const std::string& path, std::uint64_t max_frames = kDefaultMaxTraceFrames);
   /// Reads `text` (kept by reference: it must outlive the reader), called `name` in messages.
   NativeTraceReader(std::string_view text, std::string name, std::uint64_t max_frames = kDefaultMaxTraceFrames);
@@ -102,22 +106,28 @@ class NativeTraceReader final : public TraceReader {
 
 /// Choices for a NativeTraceWriter.
 struct NativeWriteOptions {
-  /// Hand every event to the OS (for gzip: a sync flush) before write() returns, so a process
-  /// that is killed leaves a trace that ends with the last event written.
+  /// Hand every event to the OS before write() returns (a plain file: each line; a gzip file:
+  /// a sync-flush point by size and time, TraceFlushPolicy), so a process that is killed leaves
+  /// a trace that ends with the last event written (gzip: the last flush point).
   bool flush_each_event = true;
   /// Collapse a group of up to kMaxRepeatGroup frames that repeats with a constant period
   /// (same bytes, same durations) into one `repeat` line. Lossless: reading gives every frame.
   bool compact = true;
 };
 
-/// Writes a native trace: one line per event, or per run of repeated frames (see
+/// The most repetitions an open `repeat` line (the count a recording updates in place) holds:
+/// its count field is 6 characters wide. A longer run goes on with frame lines and a new run.
+inline constexpr std::uint64_t kMaxOpenRepeatCount = 999'999;
+
+/// Writes a native trace (version 2): one line per event, or per run of repeated frames (see
 /// NativeWriteOptions). A file whose name ends in ".gz" is gzip-compressed.
 ///
-/// What a killed process leaves (flush_each_event): in a plain file, every event written,
-/// including the repetitions of a run in progress (the run's `repeat` line is rewritten in
-/// place as it grows, the frames of an unfinished repetition follow it as frame lines); in a
-/// gzip file, every event up to the last flush point, where a run in progress is written at
-/// most every 1024 repetitions or every second of trace time (the repetitions since are lost).
+/// What a killed process leaves (flush_each_event): in an output that can be rewritten (a plain
+/// file), every event written, including the repetitions of a run in progress: a run is an
+/// open `repeat` line whose count is replaced in place as repetitions complete, the frames of
+/// an unfinished repetition following it as frame lines; in a gzip file, every event up to the
+/// last flush point (TraceFlushPolicy), where a run in progress is written as a closed `repeat`
+/// line at most every 1024 repetitions or every second of trace time.
 class NativeTraceWriter final : public TraceSink {
  public:
   /// Creates or truncates `path`. Throws std::runtime_error when it cannot.
@@ -128,6 +138,8 @@ class NativeTraceWriter final : public TraceSink {
   /// output", a file's path), and the reason when the system gave one.
   explicit NativeTraceWriter(std::ostream& out, bool flush_each_event = true);
   NativeTraceWriter(std::ostream& out, NativeWriteOptions options, std::string name = "the output stream");
+  /// Writes to `output` (a front's own: a memory-mapped file, a file with its flush policy).
+  explicit NativeTraceWriter(std::unique_ptr<TraceOutput> output, NativeWriteOptions options = {});
   /// Writes what is pending (a run in progress) and closes; errors here are lost: call finish().
   ~NativeTraceWriter() override;
   NativeTraceWriter(const NativeTraceWriter&) = delete;
@@ -137,9 +149,19 @@ class NativeTraceWriter final : public TraceSink {
   void write(const TraceEvent& e) override;
   /// Writes what is pending and closes the file (the gzip trailer). Throws on a write error.
   void finish();
+  /// Hands what the output holds to the OS if its flush policy's time has come (call it while
+  /// a recording is quiet). Throws on a write error.
+  void flush_if_due();
+  /// Stops without writing anything more, now or when destroyed (a forked child's copy of a
+  /// recording its parent goes on writing).
+  void abandon();
 
   /// One event as its native line, without the newline.
   static std::string format_event(const TraceEvent& e);
+  /// The same, appended to `out`.
+  static void append_event(std::string& out, const TraceEvent& e);
+  /// The line without its time (" frame 1.75us D0 | 00"), appended to `out`.
+  static void append_event_body(std::string& out, const TraceEvent& e);
   /// The `repeat` line, without the newline, saying that the last `group` frames (the last
   /// of them at `last_frame`) repeat `count` times, each repetition `period` after the one before.
   static std::string format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period);
@@ -151,37 +173,39 @@ class NativeTraceWriter final : public TraceSink {
     std::vector<std::uint8_t> mosi, miso, known;
     void assign(const TraceEvent& e);
     bool same_bytes(const Held& o) const;
+    bool same_bytes(const TraceEvent& e) const;
     TraceEvent event() const;
   };
   void put(const std::string& text);
-  void check_stream() const;
-  void end_event();
   void write_line(const TraceEvent& e);
   void frame(const TraceEvent& e);
   void look_for_run();
   void end_run();
   void write_repeat_line();
-  bool rewritable() const;
+  void write_open_repeat_line();
+  bool open_runs() const;
+  const std::string& name() const;
 
-  std::unique_ptr<TraceFileWriter> file_;
-  std::ostream* out_ = nullptr;
-  std::string out_name_;  // what out_ is, for messages
+  std::unique_ptr<TraceOutput> out_;
   NativeWriteOptions options_;
   bool header_written_ = false;
   bool finished_ = false;
+  bool abandoned_ = false;
   std::string line_;
-  // Compaction: the frames written since the last pin/fault event (at most 2 groups' worth)...
+  // Compaction: the frames written since the last pin/fault event (at most 3 groups' worth)...
   std::vector<Held> recent_;
   // ...and the run being collapsed: the group (its last complete repetition), the period,
-  // the repetitions not yet in the file and the frames of the repetition under way.
+  // the repetitions not yet in the file (closed lines) or in its count (open lines) and the
+  // frames of the repetition under way.
   bool in_run_ = false;
   std::size_t run_group_ = 0;
   Tick run_period_ = 0;
   std::vector<Held> run_;
-  std::vector<Held> partial_;
+  std::size_t partial_ = 0;  // frames of the repetition under way (the group's first ones, a period on)
+  std::vector<std::string> run_bodies_;  // open runs: each group frame's line after its time, with the newline
   std::uint64_t line_count_ = 0;  // repetitions the run's repeat line stands for
   Tick line_base_ = 0;            // tick of the group's last frame as the file has it before that line
-  std::uint64_t run_offset_ = 0;  // plain file being rewritten: where the repeat line starts
+  std::uint64_t count_offset_ = 0;  // open line: where its count field starts in the output
   Tick checkpoint_tick_ = 0;
 };
 

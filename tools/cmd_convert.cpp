@@ -147,7 +147,13 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
                                                       : std::make_unique<NativeTraceWriter>(args.output, wo);
       NativeTraceWriter& w = *writer;
       TraceHeader h = reader->header();
-      if (!args.trace.chain.empty()) h.chain = chain_spec_of(parse_chain_spec(args.trace.chain));
+      if (!args.trace.chain.empty() || !args.trace.board.empty()) {
+        // The world given goes into the header: a capture keeps the board it was given.
+        const TraceWorld world = world_of(args.trace, file);
+        h.chain = chain_spec_of(world.chain().chips);
+        h.board = args.trace.board.empty() && args.trace.chain.find('=') == std::string::npos ? "" : world.board_text();
+        if (world.overrides) err << "note: " << world.override_note(file.path()) << "\n";
+      }
       w.write_header(h);
       ProgressBar bar = ProgressBar::on_stderr("converting " + file.path());
       ProgressTraceReader watched(*reader, bar);
@@ -176,13 +182,14 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
       if (args.no_emulation) {
         export_vcd(trace, *dst, {args.timescale_ns});
       } else {
-        std::string how;
-        Chain chain = make_chain(chain_for_trace(args.trace.chain, file, how));
+        const TraceWorld world = world_of(args.trace, file);
+        Chain chain = world.make_chain();
         EmulatedVcdOptions o;
         o.timescale_ns = args.timescale_ns;
         o.sample_ticks = static_cast<Tick>(std::llround(args.sample_us * kTicksPerMicrosecond));
         export_emulated_vcd(trace, chain, *dst, o);
-        err << "l6470emu: BUSY, FLAG and ABS_POS from an emulated chain " << chain_spec_of(chain) << " (" << how << ")\n";
+        err << "l6470emu: BUSY, FLAG and ABS_POS from an emulated chain " << world.summary() << " (" << world.how << ")\n";
+        if (world.overrides) err << "note: " << world.override_note(file.path()) << "\n";
       }
     }
     errno = 0;

@@ -16,12 +16,12 @@ int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
   try {
     const NumberFrom number_from = number_from_option(args.number_from);
     const TraceFile file(args.trace.path, input_options(args.trace));
-    std::string how;
-    const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
-    Chain chain = make_chain(variants);
+    const TraceWorld world = world_of(args.trace, file);
+    Chain chain = world.make_chain();
     print_notes(file.header(), err);
-    out << "# " << file.path() << " (" << file.header().format << "), chain " << chain_spec_of(variants) << " (" << how
+    out << "# " << file.path() << " (" << file.header().format << "), chain " << world.summary() << " (" << world.how
         << "); " << describe_numbering(number_from) << "\n";
+    if (world.overrides) out << "# " << world.override_note(file.path()) << "\n";
     DecodeOptions options;
     options.show_nops = args.nops;
     options.max_repeats = args.max_repeats;
@@ -41,6 +41,16 @@ int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
     if (s.suppressed) out << " (" << s.suppressed << " not shown: --max-repeats 0 shows all)";
     if (s.answer_mismatches) out << ", " << s.answer_mismatches << " answers the emulator would give differently (see replay)";
     out << "\n";
+    if (s.divergence.found) {
+      // Said at the end too, and by the exit status: the log after that point is a model.
+      out << "# DIVERGED in " << s.frames_diverged << (s.frames_diverged == 1 ? " frame" : " frames");
+      if (s.pins_diverged) out << " and " << s.pins_diverged << (s.pins_diverged == 1 ? " pin level" : " pin levels");
+      out << ", first at " << s.divergence.summary << ": from there on the log is the emulator's model, not the trace\n";
+      err << "l6470emu decode: the emulator does not reproduce " << file.path() << ": " << s.divergence.summary
+          << (args.accept_divergence ? " (accepted: --accept-divergence)" : " (exit status 1; --accept-divergence accepts it)")
+          << "\n";
+      if (!args.accept_divergence) return kTraceDiverged;
+    }
     return kTraceOk;
   } catch (const std::exception& e) {
     err << "l6470emu decode: " << e.what() << "\n";

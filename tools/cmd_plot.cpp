@@ -62,7 +62,9 @@ std::vector<std::string> plot_command(const std::vector<std::string>& args) {
 namespace {
 
 struct PlotArgs {
-  std::string trace, output, chips, from, to, chain, format, select, max_points, max_frames, title, size, dpi, number_from;
+  std::string trace, output, chips, from, to, chain, board, format, select, max_points, max_frames, title, size, dpi,
+      number_from;
+  bool accept_divergence = false;
 };
 
 [[noreturn]] void run_plot(const PlotArgs& a, const CLI::App& sub) {
@@ -72,9 +74,10 @@ struct PlotArgs {
       {"--output", &a.output}, {"--chips", &a.chips},   {"--from", &a.from},   {"--to", &a.to},
       {"--chain", &a.chain},   {"--format", &a.format}, {"--select", &a.select}, {"--max-points", &a.max_points},
       {"--title", &a.title},   {"--size", &a.size},     {"--dpi", &a.dpi},     {"--number-from", &a.number_from},
-      {"--max-frames", &a.max_frames}};
+      {"--max-frames", &a.max_frames}, {"--board", &a.board}};
   for (const auto& [name, value] : options)
     if (sub.count(name) > 0) args.push_back(std::string(name) + "=" + *value);
+  if (a.accept_divergence) args.push_back("--accept-divergence");
 
   char exe[4096];
   const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
@@ -102,7 +105,8 @@ void add_plot_command(CLI::App& app) {
   auto a = std::make_shared<PlotArgs>();
   CLI::App* p = app.add_subcommand(
       "plot", "draw each chip's position, speed, BUSY/FLAG/SW and commands against time (PNG or SVG), "
-              "from a trace replayed through the emulator (needs python3-matplotlib; exit 2 = bad input)");
+              "from a trace replayed through the emulator (needs python3-matplotlib; exit 1 = the emulator does not "
+              "reproduce the trace, which the picture marks; 2 = bad input)");
   p->add_option("TRACE", a->trace, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr");
   p->add_option("-o,--output", a->output, "picture to write: .png or .svg");
   p->add_option("--chips", a->chips, "chips to draw: 0,2 or 1-3 (default all; numbered as --number-from says)");
@@ -110,7 +114,14 @@ void add_plot_command(CLI::App& app) {
                 "chip 0 is the chip driving MISO (miso, the default) or the one reading the host's MOSI (mosi)");
   p->add_option("--from", a->from, "window start, seconds from the trace's start (a capture's own clock counts from 0 here)");
   p->add_option("--to", a->to, "window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)");
-  p->add_option("--chain", a->chain, "the emulated chain (3, 2*L6470,L6480); default: the trace's own");
+  p->add_option("--chain", a->chain,
+                "the emulated chain (3, 2*L6470,L6480), or the board description of one chain (\"chips=L6470 "
+                "axis.0=stops=0..256000,switch=home@0\"); default: the trace's own");
+  p->add_option("--board", a->board,
+                "a file with the board description of one chain to run a capture through (replaces the trace's own; "
+                "the picture says so)");
+  p->add_flag("--accept-divergence", a->accept_divergence,
+              "exit 0 even when the emulator does not reproduce the trace (the picture still marks where)");
   p->add_option("--format", a->format, "input format: native, saleae, umockdev, ftrace, sigrok, vcd (default: recognised)");
   p->add_option("--select", a->select, "the stream to take when the file has several");
   p->add_option("--max-points", a->max_points,

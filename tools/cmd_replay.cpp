@@ -14,11 +14,14 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
   try {
     const NumberFrom number_from = number_from_option(args.number_from);
     const TraceFile file(args.trace.path, input_options(args.trace));
-    std::string how;
-    const std::vector<const Variant*> variants = chain_for_trace(args.trace.chain, file, how);
-    Chain chain = make_chain(variants);
+    const TraceWorld world = world_of(args.trace, file);
+    Chain chain = world.make_chain();
     print_notes(file.header(), err);
-    err << "l6470emu: replaying " << file.path() << " through " << chain_spec_of(variants) << " (" << how << ")\n";
+    err << "l6470emu: replaying " << file.path() << " through " << world.summary() << " (" << world.how << ")\n";
+    if (world.overrides) {
+      err << "note: " << world.override_note(file.path()) << "\n";
+      out << "# " << world.override_note(file.path()) << "\n";
+    }
 
     ReplayOptions options;
     options.keep_going = args.keep_going;

@@ -29,6 +29,10 @@ TraceInputOptions input_options(const TraceArgs& args) {
   return o;
 }
 
+TraceWorld world_of(const TraceArgs& args, const TraceFile& file) {
+  return world_for_trace(WorldOptions{args.chain, args.board}, file);
+}
+
 NumberFrom number_from_option(const std::string& text) {
   try {
     return parse_number_from(text);
@@ -56,8 +60,12 @@ void add_trace_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("--format", a.format, "input format (default: recognised from the content)")
       ->check(CLI::IsMember({"auto", "native", "saleae", "umockdev", "ftrace", "sigrok", "vcd"}));
   sub->add_option("--chain", a.chain,
-                  "the emulated chain, chip 0 (MISO end) first: N, N*VARIANT or a list (3, 2*L6470,L6480); "
+                  "the emulated chain, chip 0 (MISO end) first: N, N*VARIANT or a list (3, 2*L6470,L6480), or the "
+                  "board description of one chain (\"chips=L6470 axis.0=stops=0..256000,switch=home@0\"); "
                   "default: the trace's own, else guessed from the frame lengths");
+  sub->add_option("--board", a.board,
+                  "a file with the board description of one chain (axes, switches, loads, numbering: "
+                  "docs/linux.md) to run a capture through; replaces the trace's own, which the output says");
   sub->add_option("--select", a.select,
                   "the stream to take when the file has several: Saleae analyzer name, ftrace device (spi0.0), "
                   "sigrok decoder (spi-1)");
@@ -97,9 +105,12 @@ void add_trace_commands(CLI::App& app) {
   r->callback([replay] { finish(run_replay(*replay, std::cout, std::cerr)); });
 
   auto decode = std::make_shared<DecodeArgs>();
-  CLI::App* d = app.add_subcommand("decode", "explain a trace: every command and answer per chip, with protocol diagnostics");
+  CLI::App* d = app.add_subcommand("decode", "explain a trace: every command and answer per chip, with protocol diagnostics "
+                                             "(exit 0; 1 = the emulator does not reproduce the trace; 2 = bad input)");
   add_trace_options(d, decode->trace);
   d->add_flag("--nops", decode->nops, "also list NOPs and STCK edges");
+  d->add_flag("--accept-divergence", decode->accept_divergence,
+              "exit 0 even when the emulator does not reproduce the trace (the log still marks where it parts)");
   d->add_option("--max-repeats", decode->max_repeats, "show each kind of diagnostic at most this often per chip (0 = all)");
   d->add_option("--chip", decode->chip, "show only this chip's lines (numbered as --number-from says)")
       ->check(CLI::Range(0, 255));

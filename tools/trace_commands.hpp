@@ -10,6 +10,7 @@
 
 #include "daisychain/chip_numbering.hpp"
 #include "tools/trace_input.hpp"
+#include "tools/trace_world.hpp"
 
 namespace CLI {
 class App;
@@ -21,7 +22,8 @@ namespace l6470emu {
 struct TraceArgs {
   std::string path;            ///< the trace file
   std::string format = "auto";  ///< auto, native, saleae, umockdev, ftrace, sigrok, vcd
-  std::string chain;           ///< chain description ("3", "2*L6470,L6480"); empty = the trace's own
+  std::string chain;           ///< chain ("3", "2*L6470,L6480") or board description of one chain; empty = the trace's own
+  std::string board;           ///< --board: a file with the board description of one chain; empty = the trace's own
   std::string select;          ///< analyzer / device / decoder to take when the file has several
   std::string framing = "auto";  ///< ftrace: auto, cs, transfer, message
   std::string sigrok_decoder;  ///< sigrok-cli decoder spec for VCD/.sr captures (empty = the default)
@@ -31,6 +33,9 @@ struct TraceArgs {
 /// The reading options `args` stand for. Throws std::invalid_argument for an unknown
 /// format or framing name.
 TraceInputOptions input_options(const TraceArgs& args);
+
+/// The world `args` ask for (--chain, --board) for `file`, or the trace's own.
+TraceWorld world_of(const TraceArgs& args, const TraceFile& file);
 
 /// The value of a --number-from option ("miso" or "mosi"). Throws std::invalid_argument
 /// with one line starting "--number-from: " for anything else.
@@ -55,12 +60,14 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err);
 
 struct DecodeArgs {
   TraceArgs trace;
+  bool accept_divergence = false;  ///< exit 0 even when the emulator does not reproduce the trace
   bool nops = false;
   std::size_t max_repeats = 10;
   int chip = -1;  ///< only this chip's lines (numbered as number_from says)
   std::string number_from = "miso";  ///< how the log numbers the chips: miso or mosi
 };
-/// `l6470emu decode`: 0, or 2 on bad input.
+/// `l6470emu decode`: 0; 1 when the emulator does not reproduce the trace (the log then marks
+/// where, and what follows is the emulator's model) unless accept_divergence; 2 on bad input.
 int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err);
 
 struct ConvertArgs {

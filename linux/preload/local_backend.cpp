@@ -1,5 +1,6 @@
 // Backend with the DeviceBoard inside the host process (L6470EMU_CHAIN / L6470EMU_CONFIG); with
 // time=virtual the board's time becomes the program's own (virtual_time.hpp).
+#include <cstdlib>
 #include <mutex>
 
 #include "linux/preload/backend.hpp"
@@ -71,8 +72,25 @@ class LocalBackend final : public Backend {
 
   void start_trace() {
     if (trace_.empty()) return;
-    if (const std::string error = board_.start_recording_all(trace_); !error.empty())
+    if (const std::string error = board_.start_recording_all(trace_); !error.empty()) {
       log_.line("trace not recorded: " + error);
+      return;
+    }
+    // The program's exit finishes the trace (a plain file cut to its length, a gzip file's end).
+    // The backend lives until then: it is never destroyed.
+    static LocalBackend* recording = nullptr;
+    if (recording == nullptr) {
+      recording = this;
+      std::atexit([] { recording->finish_recordings(); });
+    }
+  }
+
+  void finish_recordings() {
+    // A thread that still holds the board at exit keeps it: the trace is whole as it is (its
+    // unwritten end reads as the end), only not cut to its length.
+    if (!board_.mutex().try_lock()) return;
+    board_.mutex().unlock();
+    for (std::size_t c = 0; c < board_.chain_count(); ++c) board_.stop_recording(c);
   }
 
   DiagnosticLog log_;

@@ -329,16 +329,17 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       }
       std::string error;
       bool has_axis = true;
+      LoadSpec load;
       board.with_chain(ci, [&](Chain& c) {
-        Chip& chip = c.chip(k);
+        const Chip& chip = c.chip(k);
         if (!chip.axis()) {
           has_axis = false;
           return;
         }
-        LoadSpec load = chip.axis()->spec().load;
+        load = chip.axis()->spec().load;
         error = parse_axis_load(a.words[1], load);
-        if (error.empty()) chip.set_axis_load(load);
       });
+      if (has_axis && error.empty()) board.set_axis_load(ci, k, load);  // recorded when recording
       if (!has_axis) {
         out = "ctl: " + label(k) + " has no axis (axis.K= in the board description)\n";
         return 1;

@@ -28,6 +28,8 @@ DEFAULT_MAX_FRAMES = _l6470emu.DEFAULT_MAX_FRAMES
 FORMATS = (".png", ".svg")
 
 EXIT_BAD_INPUT = 2
+#: The emulator does not reproduce the trace (the picture marks where); --accept-divergence makes it 0.
+EXIT_DIVERGED = 1
 #: What to say when matplotlib is missing.
 MATPLOTLIB_MISSING = "matplotlib is not installed (Debian: apt install python3-matplotlib)"
 
@@ -93,7 +95,7 @@ class TerminalProgress:
 
 
 def _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress=None,
-               max_frames=DEFAULT_MAX_FRAMES):
+               max_frames=DEFAULT_MAX_FRAMES, board=None):
     """l6470emu.motion() of a Motion (as is), a Chain recording into memory, a Trace or a path."""
     if isinstance(source, _l6470emu.Motion):
         return source
@@ -105,7 +107,7 @@ def _motion_of(source, chain, chips, start, end, format, select, max_points, num
         source = source.trace if source.trace is not None else source.record_path
     return _l6470emu.motion(source, chain, format=format, select=select, chips=chips, start=start, end=end,
                             max_points=max_points, number_from=number_from, progress=progress,
-                            max_frames=max_frames)
+                            max_frames=max_frames, board=board)
 
 
 def _time_scale(motion) -> tuple:
@@ -120,21 +122,27 @@ def _time_scale(motion) -> tuple:
 def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
            title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None,
-           number_from: str = "miso", progress=None, max_frames: int = DEFAULT_MAX_FRAMES):
+           number_from: str = "miso", progress=None, max_frames: int = DEFAULT_MAX_FRAMES, board=None):
     """The picture as a matplotlib Figure (not shown, not saved; pyplot is not used).
 
     source: a trace file (any format the l6470emu program reads), a Trace, a Chain made with
     record=True, or a Motion from l6470emu.motion() (which brings its own numbering). The other
-    arguments are motion()'s (number_from: chip 0 at the "miso" or the "mosi" end), and
-    position_unit = (name, microsteps per unit), e.g. ("rev", 25600), to draw positions in
-    another unit than ABS_POS's microsteps. progress: motion()'s progress(stage, done, total,
-    unit), e.g. a TerminalProgress, told how far reading and replaying the trace have come.
+    arguments are motion()'s (number_from: chip 0 at the "miso" or the "mosi" end; chain and
+    board: the world a capture runs through), and position_unit = (name, microsteps per unit),
+    e.g. ("rev", 25600), to draw positions in another unit than ABS_POS's microsteps. progress:
+    motion()'s progress(stage, done, total, unit), e.g. a TerminalProgress, told how far reading
+    and replaying the trace have come.
+
+    Where the emulator does not reproduce the trace (motion().divergence), the picture says so: a
+    red line at the first divergence with what differed, the time after it shaded, and a banner
+    that what follows is the emulator's model, not the capture. The Motion drawn is the
+    figure's `motion` attribute.
     """
     import numpy as np
     from matplotlib.figure import Figure
 
     motion = _motion_of(source, chain, chips, start, end, format, select, max_points, number_from, progress,
-                        max_frames)
+                        max_frames, board)
     scale, unit = _time_scale(motion)
     pos_unit, per_unit = position_unit if position_unit is not None else ("microsteps", 1.0)
     if not per_unit > 0:
@@ -191,9 +199,41 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
         if total_commands > MAX_LABELLED_COMMANDS:
             title += f" ({total_commands} commands: markers only)"
     fig.suptitle(title, fontsize=11)
-    # Which end chip 0 is at, once, under the picture.
-    fig.text(0.005, 0.002, motion.numbering, fontsize=7, color="0.35", ha="left", va="bottom")
+    # Which end chip 0 is at, once, under the picture (and a description the user gave instead
+    # of the trace's own).
+    small_print = motion.numbering + (f"; {motion.overridden}" if motion.overridden else "")
+    fig.text(0.005, 0.002, small_print, fontsize=7, color="0.35", ha="left", va="bottom")
+    if motion.divergence is not None:
+        _mark_divergence(fig, (pos_ax, speed_ax, pin_ax), motion, scale, unit)
+    fig.motion = motion
     return fig
+
+
+def divergence_text(motion) -> str:
+    """One line about where the emulator first parts from the trace ("" when it does not)."""
+    d = motion.divergence
+    if d is None:
+        return ""
+    more = motion.frames_diverged + motion.pins_diverged - 1
+    return (f"{d.summary}" + (f" (and {more} more differences)" if more > 0 else ""))
+
+
+def _mark_divergence(fig, axes, motion, scale, unit) -> None:
+    """The first divergence: a red line with what differed, the model's part shaded, a banner."""
+    d = motion.divergence
+    x = d.tick * SECONDS_PER_TICK * scale
+    right = motion.end * SECONDS_PER_TICK * scale
+    for ax in axes:
+        ax.axvline(x, color="red", linewidth=1.4, zorder=4)
+        if x < right:
+            ax.axvspan(x, right, color="red", alpha=0.06, linewidth=0, zorder=0)
+    chip = "bytes past the chain" if d.chip is None else f"chip {d.chip}"
+    axes[0].annotate(f"first divergence: {chip}: {d.what}", (x, 1.0), xycoords=("data", "axes fraction"),
+                     xytext=(4, -12), textcoords="offset points", fontsize=7, color="red", va="top")
+    axes[0].text(0.5, 0.03, f"DIVERGED at t={d.seconds:.6f} s ({chip}): from the red line on, this is the "
+                 "emulator's model of the run, not what the trace holds", transform=axes[0].transAxes, fontsize=8.5,
+                 color="white", ha="center", va="bottom", zorder=5,
+                 bbox=dict(facecolor="red", edgecolor="none", boxstyle="round,pad=0.3"))
 
 
 def plot(source, output: Union[str, Path], **options) -> Path:
@@ -208,7 +248,11 @@ def plot(source, output: Union[str, Path], **options) -> Path:
     if hasattr(progress, "stage"):
         progress.stage(f"drawing {output.name}")
     fig.savefig(output, dpi=dpi)
+    plot.last_motion = fig.motion  # what was drawn (main() reads its divergence)
     return output
+
+
+plot.last_motion = None
 
 
 class _Parser(argparse.ArgumentParser):
@@ -229,7 +273,12 @@ def _arguments(argv):
                    help="window start, seconds from the trace's start (a capture's own clock counts from 0 here)")
     p.add_argument("--to", dest="end", type=float,
                    help="window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)")
-    p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480); default: the trace's own")
+    p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480), or the board description of one chain "
+                   "(\"chips=L6470 axis.0=stops=0..256000,switch=home@0\"); default: the trace's own")
+    p.add_argument("--board", help="a file with the board description of one chain to run a capture through "
+                   "(replaces the trace's own; the picture says so)")
+    p.add_argument("--accept-divergence", action="store_true",
+                   help="exit 0 even when the emulator does not reproduce the trace (the picture still marks it)")
     p.add_argument("--format", default=None, help="input format (default: recognised from the content)")
     p.add_argument("--select", default="", help="the stream to take when the file has several")
     p.add_argument("--max-points", type=int, default=4000,
@@ -282,8 +331,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         # The file's name alone: a long path cut to fit would cut the stage's name too.
         bar = TerminalProgress(Path(args.trace).name)
         try:
-            out = plot(args.trace, args.output, chain=args.chain, chips=chips, start=args.start, end=args.end,
-                       format=args.format, select=args.select, max_points=args.max_points,
+            if args.chain is not None and args.board is not None:
+                raise PlotError("--chain and --board both describe the chain: give one of them")
+            out = plot(args.trace, args.output, chain=args.chain, board=args.board, chips=chips, start=args.start,
+                       end=args.end, format=args.format, select=args.select, max_points=args.max_points,
                        max_frames=args.max_frames, title=args.title,
                        size=(width, height), dpi=args.dpi, number_from=args.number_from, progress=bar)
         finally:
@@ -292,6 +343,16 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"l6470emu plot: {e}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(f"l6470emu plot: wrote {out}", file=sys.stderr)
+    motion = plot.last_motion
+    if motion is not None and motion.overridden:
+        print(f"note: {motion.overridden}", file=sys.stderr)
+    if motion is not None and motion.divergence is not None:
+        print(f"l6470emu plot: the emulator does not reproduce {args.trace}: {divergence_text(motion)}; the picture "
+              "marks it, and after it shows the emulator's model, not the capture"
+              + (" (accepted: --accept-divergence)" if args.accept_divergence
+                 else " (exit status 1; --accept-divergence accepts it)"), file=sys.stderr)
+        if not args.accept_divergence:
+            return EXIT_DIVERGED
     return 0
 
 

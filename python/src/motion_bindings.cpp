@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "bindings.hpp"
 #include "convert.hpp"
@@ -36,8 +37,10 @@ struct PyChipMotion {
 
 struct PyMotion {
   Tick start = 0, end = 0, trace_end = 0;
-  std::string chain, how, number_from = "miso", numbering;
+  std::string chain, how, number_from = "miso", numbering, overridden;
   std::vector<PyChipMotion> chips;
+  std::optional<FirstDivergence> divergence;  // none: the emulator reproduced what was read
+  std::uint64_t frames_diverged = 0, pins_diverged = 0;
 };
 
 PyChipMotion chip_of(ChipMotion&& m) {
@@ -144,16 +147,24 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       .def_readonly("chips", &PyMotion::chips, "one ChipMotion per chip asked for")
       .def_readonly("number_from", &PyMotion::number_from, "how chip numbers count: \"miso\" or \"mosi\"")
       .def_readonly("numbering", &PyMotion::numbering, "what the chip numbers mean, in words")
+      .def_readonly("divergence", &PyMotion::divergence,
+                    "None when the emulator gave every captured MISO byte and BUSY/FLAG level read (up to the "
+                    "window's end); else where it first did not (a FirstDivergence): from there on the series "
+                    "are the emulator's model, not the capture, and plot() marks it")
+      .def_readonly("frames_diverged", &PyMotion::frames_diverged, "frames read whose captured MISO the emulator does not give")
+      .def_readonly("pins_diverged", &PyMotion::pins_diverged, "BUSY/FLAG observations read that the emulator does not reproduce")
+      .def_readonly("overridden", &PyMotion::overridden,
+                    "\"\" or a sentence saying that chain=/board= replaced the trace's own description")
       .def("__repr__", [](const PyMotion& p) {
         return "Motion(chain " + p.chain + ", " + std::to_string(p.chips.size()) + " chips, ticks " +
-               std::to_string(p.start) + ".." + std::to_string(p.end) + ")";
+               std::to_string(p.start) + ".." + std::to_string(p.end) + (p.divergence ? ", DIVERGED" : "") + ")";
       });
 
   m.def(
       "motion",
       [](py::handle trace, py::handle chain, py::handle format, std::string select, py::handle chips, py::handle start,
          py::handle end, py::handle max_points, std::size_t max_commands, const std::string& number_from,
-         py::handle progress, py::handle max_frames) {
+         py::handle progress, py::handle max_frames, py::handle board) {
         if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
           throw py::type_error("progress: a function progress(stage, done, total, unit), or None");
         PyProgress told(progress);
@@ -177,12 +188,13 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
         PyMotion result;
         result.number_from = to_string(o.number_from);
         result.numbering = describe_numbering(o.number_from);
-        const Source source = source_of(trace, chain, format, select, max_frames_arg(max_frames));
-        result.how = source.how;
+        const Source source = source_of(trace, chain, format, select, max_frames_arg(max_frames), board);
+        result.how = source.world.how;
+        result.overridden = source.world.override_note(source.trace ? source.trace->header.name : source.file->path());
         {
           py::gil_scoped_release unlocked;
-          Chain c = make_chain(source.variants);
-          result.chain = chain_spec_of(c);
+          Chain c = source.world.make_chain();
+          result.chain = source.world.summary();
           Tick trace_end = 0;
           {
             auto pass = source.reader();
@@ -195,18 +207,25 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
           result.end = s.to;
           result.trace_end = s.trace_end;
           for (ChipMotion& cm : s.chips) result.chips.push_back(chip_of(std::move(cm)));
+          if (s.divergence.found) result.divergence = s.divergence;
+          result.frames_diverged = s.frames_diverged;
+          result.pins_diverged = s.pins_diverged;
         }
         return result;
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("select") = "", py::arg("chips") = py::none(), py::arg("start") = py::none(), py::arg("end") = py::none(),
       py::arg("max_points") = 4000, py::arg("max_commands") = 2000, py::arg("number_from") = "miso",
-      py::arg("progress") = py::none(), py::arg("max_frames") = kDefaultMaxTraceFrames,
+      py::arg("progress") = py::none(), py::arg("max_frames") = kDefaultMaxTraceFrames, py::arg("board") = py::none(),
       R"(Replays a trace through a fresh emulated chain and samples what each chip did.
 
 trace: a Trace (Chain(record=True).trace, Trace.load()) or a file in any format the l6470emu
-program reads. chain: the chain (default: the trace's own; for a file without one, guessed
-from its frame lengths). chips: chip numbers to sample (default all), counted from the MISO
+program reads. chain: the chain (default: the trace's own description; for a file without one,
+guessed from its frame lengths): variants ("3*L6470") or the board description of one chain
+("chips=L6470 axis.0=stops=0..256000,switch=home@0"); board: instead, the path of a file holding
+such a description (a capture from a rig with a switch or a loaded axis runs through the same
+world). The result's divergence says where the emulator first gave MISO bytes or a BUSY/FLAG
+level other than the trace's: from there on the series are its model, not the capture. chips: chip numbers to sample (default all), counted from the MISO
 end (number_from="miso", chip 0 drives MISO) or the MOSI end ("mosi"). start, end: the window
 in seconds from the trace's start (end None: the trace's end, plus up to 1 s while a move is
 still going). Samples are the chips' exact states at their ticks: at the window's edges,

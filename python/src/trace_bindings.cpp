@@ -39,7 +39,7 @@ struct PyTraceEvent {
 };
 
 PyTraceEvent event_of(const TraceEvent& e) {
-  static constexpr const char* kKinds[] = {"frame", "pin", "fault"};
+  static constexpr const char* kKinds[] = {"frame", "pin", "fault", "load", "advance"};
   PyTraceEvent p;
   p.kind = kKinds[static_cast<int>(e.kind)];
   p.tick = e.tick;
@@ -96,7 +96,8 @@ void bind_trace(py::module_& m) {
   });
 
   py::class_<PyTraceEvent>(m, "TraceEvent", "One event of a trace: a CS frame, a pin level or a backdoor fault.")
-      .def_readonly("kind", &PyTraceEvent::kind, "\"frame\", \"pin\" or \"fault\"")
+      .def_readonly("kind", &PyTraceEvent::kind,
+                    "\"frame\", \"pin\", \"fault\", \"load\" (an axis load change: see .text) or \"advance\" (time moved on)")
       .def_readonly("tick", &PyTraceEvent::tick, "frame: CS falling edge; pin/fault: when (250 ns ticks)")
       .def_readonly("duration", &PyTraceEvent::duration, "frame: ticks from CS falling to rising edge")
       .def_property_readonly("end", [](const PyTraceEvent& e) { return e.tick + e.duration; }, "frame: the CS rising edge")
@@ -200,6 +201,24 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def("__str__", [](const Divergence& d) { return d.report; })
       .def("__repr__", [](const Divergence& d) { return "Divergence(" + d.summary + ")"; });
 
+  py::class_<FirstDivergence>(m, "FirstDivergence",
+                              "Where the emulator first gave MISO bytes or a BUSY/FLAG level other than a trace's.")
+      .def_readonly("frame", &FirstDivergence::frame, "1-based frame number (for a pin: the last frame before it)")
+      .def_readonly("line", &FirstDivergence::line, "line of the trace file (0: none)")
+      .def_readonly("repetition", &FirstDivergence::repetition, "repetition of a native repeat line (0: none)")
+      .def_readonly("tick", &FirstDivergence::tick, "when, in 250 ns ticks")
+      .def_readonly("seconds", &FirstDivergence::seconds, "when, as shown (the capture's own time when it has one)")
+      .def_property_readonly(
+          "chip", [](const FirstDivergence& d) -> py::object {
+            if (d.number == FirstDivergence::kNoChip) return py::none();
+            return py::int_(d.number);
+          },
+          "the chip that differed, numbered as the call's number_from says (None: bytes past the chain's length)")
+      .def_readonly("what", &FirstDivergence::what, "what differed: \"MISO byte 1 expected 0x7E, emulated 0x7C\"")
+      .def_readonly("summary", &FirstDivergence::summary, "one line: where, when, which chip, what")
+      .def("__str__", [](const FirstDivergence& d) { return d.summary; })
+      .def("__repr__", [](const FirstDivergence& d) { return "FirstDivergence(" + d.summary + ")"; });
+
   py::class_<PyReplayResult>(m, "ReplayResult", "What a replay did; true when every captured byte and pin matched.")
       .def_property_readonly("matched", &ReplayResult::matched, "every captured MISO byte and pin level matched")
       .def("__bool__", &ReplayResult::matched)
@@ -230,6 +249,17 @@ text; a Chain made with record=True gives one as Chain.trace.)")
                              "diagnostics not shown (max_repeats)")
       .def_property_readonly("answer_mismatches", [](const DecodeResult& d) { return d.summary.answer_mismatches; },
                              "captured answers the emulator would give differently")
+      .def_property_readonly(
+          "divergence", [](const DecodeResult& d) -> py::object {
+            if (!d.summary.divergence.found) return py::none();
+            return py::cast(d.summary.divergence);
+          },
+          "None when the emulator gives every captured MISO byte and BUSY/FLAG level; else where it first does "
+          "not (a FirstDivergence; the log shows a banner there: what follows is the emulator's model)")
+      .def_property_readonly("frames_diverged", [](const DecodeResult& d) { return d.summary.frames_diverged; },
+                             "frames whose captured MISO the emulator does not give")
+      .def_property_readonly("pins_diverged", [](const DecodeResult& d) { return d.summary.pins_diverged; },
+                             "BUSY/FLAG observations the emulator does not reproduce")
       .def_readonly("text", &DecodeResult::text, "the log, one line per command, answer or diagnostic")
       .def_readonly("number_from", &DecodeResult::number_from, "how the log counts the chips: \"miso\" or \"mosi\"")
       .def_readonly("numbering", &DecodeResult::numbering, "what the log's chip numbers mean, in words")
@@ -242,10 +272,10 @@ text; a Chain made with record=True gives one as Chain.trace.)")
   m.def(
       "replay",
       [](py::handle trace, py::handle chain, py::handle format, bool keep_going, std::size_t max_reports,
-         bool compare_pins, const std::string& number_from, py::handle max_frames) {
+         bool compare_pins, const std::string& number_from, py::handle max_frames, py::handle board) {
         ReplayOptions o;
         o.number_from = number_from_arg(number_from);
-        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames));
+        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames), board);
         o.keep_going = keep_going;
         o.max_reports = max_reports;
         o.compare_pins = compare_pins;
@@ -253,18 +283,20 @@ text; a Chain made with record=True gives one as Chain.trace.)")
         result.number_from = to_string(o.number_from);
         result.numbering = describe_numbering(o.number_from);
         py::gil_scoped_release unlocked;
-        Chain c = make_chain(s.variants);
+        Chain c = s.world.make_chain();
         auto reader = s.reader();
         static_cast<ReplayResult&>(result) = replay_trace(*reader, c, o);
         return result;
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("keep_going") = false, py::arg("max_reports") = 100, py::arg("compare_pins") = true,
-      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames,
+      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames, py::arg("board") = py::none(),
       R"(Drives a trace's MOSI into a fresh emulated chain with the captured timing and compares every
 MISO byte (and BUSY/FLAG observation). trace: a Trace or a file path. chain: the chain
-(default: the trace's own; for a file without one, guessed from its frame lengths), chip 0
-at the MISO end as in trace files. number_from: which end the reports call chip 0, "miso"
+(default: the trace's own description; for a file without one, guessed from its frame lengths),
+chip 0 at the MISO end as in trace files: variants ("3*L6470") or the board description of one
+chain with its axes ("chips=L6470 axis.0=stops=0..256000,switch=home@0"); board: instead, the path
+of a file holding such a description. number_from: which end the reports call chip 0, "miso"
 (chip 0 drives MISO, the default) or "mosi" (chip 0 reads the host's MOSI). max_frames: the
 most frames a trace file may hold (native repeat lines counted as the frames they stand for;
 0: no limit); a file asking for more raises TraceError at once.)");
@@ -272,21 +304,21 @@ most frames a trace file may hold (native repeat lines counted as the frames the
   m.def(
       "decode",
       [](py::handle trace, py::handle chain, py::handle format, bool show_nops, std::size_t max_repeats,
-         py::object only_chip, const std::string& number_from, py::handle max_frames) {
+         py::object only_chip, const std::string& number_from, py::handle max_frames, py::handle board) {
         DecodeOptions o;
         o.number_from = number_from_arg(number_from);
-        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames));
+        const Source s = source_of(trace, chain, format, "", max_frames_arg(max_frames), board);
         o.show_nops = show_nops;
         o.max_repeats = max_repeats;
         if (!only_chip.is_none())
-          o.only_chip = static_cast<int>(int_in_range(only_chip, "only_chip", 0, static_cast<long long>(s.variants.size()) - 1));
+          o.only_chip = static_cast<int>(int_in_range(only_chip, "only_chip", 0, static_cast<long long>(s.chips()) - 1));
         DecodeResult result;
         result.number_from = to_string(o.number_from);
         result.numbering = describe_numbering(o.number_from);
         {
           py::gil_scoped_release unlocked;
           std::ostringstream text;
-          Chain c = make_chain(s.variants);
+          Chain c = s.world.make_chain();
           auto reader = s.reader();
           result.summary = decode_trace(*reader, c, text, o);
           result.text = text.str();
@@ -295,8 +327,10 @@ most frames a trace file may hold (native repeat lines counted as the frames the
       },
       py::arg("trace"), py::arg("chain") = py::none(), py::kw_only(), py::arg("format") = py::none(),
       py::arg("show_nops") = false, py::arg("max_repeats") = 10, py::arg("only_chip") = py::none(),
-      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames,
+      py::arg("number_from") = "miso", py::arg("max_frames") = kDefaultMaxTraceFrames, py::arg("board") = py::none(),
       R"(Explains a trace: every command and answer per chip, with protocol diagnostics (as `l6470emu decode`).
+chain, board: the world it runs through, as for replay(). The result's divergence says where the
+emulator first parts from the trace (None: nowhere); the log marks it with a banner.
 number_from: which end the log calls chip 0, "miso" (chip 0 drives MISO, the default) or "mosi"
 (chip 0 reads the host's MOSI); only_chip is a number in the same convention. max_frames: as
 for replay().)");

@@ -22,32 +22,34 @@ std::uint64_t max_frames_arg(py::handle max_frames) {
 }
 
 Source source_of(py::handle trace, py::handle chain, py::handle format, const std::string& select,
-                 std::uint64_t max_frames) {
+                 std::uint64_t max_frames, py::handle board) {
   Source s;
-  std::string spec;
-  if (!chain.is_none()) spec = chain_spec_from(chain);
+  WorldOptions world;
+  if (!chain.is_none()) world.chain = chain_spec_from(chain);
+  if (!board.is_none()) world.board_file = path_from(board, "board");
+  if (!world.chain.empty() && !world.board_file.empty())
+    throw py::value_error("chain= and board= both describe the chain: give one of them");
+  // A bad chain= is the argument's fault (ValueError naming it); a bad board file is TraceError.
+  auto world_for = [&](const TraceHeader& header, const auto& guess) {
+    try {
+      return world_for_header(world, header, guess);
+    } catch (const TraceError& e) {
+      if (e.file() == "--chain") throw py::value_error(std::string("chain: ") + e.reason());
+      throw;
+    } catch (const std::invalid_argument& e) {
+      throw py::value_error(e.what());
+    }
+  };
   if (py::isinstance<Trace>(trace)) {
     s.trace = trace.cast<std::shared_ptr<Trace>>();
-    const std::string& own = s.trace->header.chain;
-    if (spec.empty() && own.empty())
-      throw py::value_error("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
-    s.how = spec.empty() ? "from the trace" : "from chain=";
-    try {
-      s.variants = parse_chain_spec(spec.empty() ? own : spec);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(std::string("chain: ") + e.what());
-    }
+    const std::function<std::vector<const Variant*>(std::string&)> no_guess = [](std::string&) -> std::vector<const Variant*> {
+      throw std::invalid_argument("the trace names no chain: pass chain=... (e.g. chain=\"3*L6470\")");
+    };
+    s.world = world_for(s.trace->header, no_guess);
+    if (!world.chain.empty() && world.chain.find('=') == std::string::npos) s.world.how = "from chain=";
     return s;
   }
   const std::string path = path_from(trace, "trace");
-  if (!spec.empty()) {
-    // Checked here so that the message names the argument (chain_for_trace names "--chain").
-    try {
-      parse_chain_spec(spec);
-    } catch (const std::invalid_argument& e) {
-      throw py::value_error(std::string("chain: ") + e.what());
-    }
-  }
   TraceInputOptions options;
   options.format = format_arg(py::reinterpret_borrow<py::object>(format));
   options.import.select = select;
@@ -55,9 +57,14 @@ Source source_of(py::handle trace, py::handle chain, py::handle format, const st
   {
     py::gil_scoped_release unlocked;  // may read a large file or run sigrok-cli
     s.file = std::make_unique<TraceFile>(path, options);
-    s.variants = chain_for_trace(spec, *s.file, s.how);
   }
-  if (!spec.empty()) s.how = "from chain=";
+  const TraceFile& file = *s.file;
+  const std::function<std::vector<const Variant*>(std::string&)> guess = [&file](std::string& how) {
+    py::gil_scoped_release unlocked;
+    return chain_for_trace("", file, how);
+  };
+  s.world = world_for(file.header(), guess);
+  if (!world.chain.empty() && world.chain.find('=') == std::string::npos) s.world.how = "from chain=";
   return s;
 }
 

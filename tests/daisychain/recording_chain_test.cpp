@@ -28,7 +28,7 @@ TEST(RecordingChain, WritesTheChainAndTheInitialOutputLevelsFirst) {
 }
 
 TEST(RecordingChain, RecordsEachFrameAtItsCsEdgesWithBothDirections) {
-  RecordedSession s(1, RecordOptions{false});
+  RecordedSession s(1, RecordOptions{.observe_outputs = false});
   s.frame({0xD0});
   const Bytes rx = s.frame({0x00});
   const TraceEvent e = s.trace[1];
@@ -58,7 +58,7 @@ TEST(RecordingChain, RecordsPinsFaultsAndTheOutputsTheyChange) {
 }
 
 TEST(RecordingChain, WritesEventsMadeWhileCsIsLowAfterTheFrame) {
-  RecordedSession s(1, RecordOptions{false});
+  RecordedSession s(1, RecordOptions{.observe_outputs = false});
   s.rec.advance_to(100);
   s.rec.select();
   s.rec.exchange(0xD0);
@@ -78,7 +78,7 @@ TEST(RecordingChain, WritesEventsMadeWhileCsIsLowAfterTheFrame) {
 TEST(RecordingChain, RecordsSpidevMessagesFrameByFrame) {
   Chain chain(2);
   Trace trace;
-  RecordingChain rec(chain, trace, RecordOptions{false});
+  RecordingChain rec(chain, trace, RecordOptions{.observe_outputs = false});
   const Bytes tx0{0xD0, 0xD0}, tx1{0x00, 0x00};
   Bytes rx0(2), rx1(2);
   const SpiTransfer t[] = {{tx0, rx0, 2, 4'000'000, 0, true}, {tx1, rx1, 2, 4'000'000, 0, false}};

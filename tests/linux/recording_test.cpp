@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "run_program.hpp"
+#include "board/trace_recorder.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu::test {
@@ -55,7 +56,8 @@ TEST_F(Recording, InProcessCClientWithCsChangeMessagesIsRecordedFrameByFrameAndR
                                    {"L6470EMU_TRACE", trace_}});
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const std::string text = read_file(trace_);
-  EXPECT_EQ(text.rfind("l6470emu-trace 1\nchain L6470\n", 0), 0u) << text;
+  // The header: the chain, and its whole board description (what a replay builds).
+  EXPECT_EQ(text.rfind("l6470emu-trace 2\nchain L6470\nboard bus=0 cs=0 path=/dev/spidev0.0 chips=L6470 ", 0), 0u) << text;
   // GetStatus as three one-byte transfers with cs_change between them: three CS frames.
   EXPECT_NE(text.find(" frame 2.00us D0 | 00\n"), std::string::npos) << text;
   EXPECT_NE(text.find(" frame 2.00us 00 | 7C\n"), std::string::npos) << text;
@@ -106,8 +108,12 @@ TEST_F(Recording, AHostKilledMidRunLeavesATraceCompleteUpToItsLastFrame) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   hammer.stop(SIGKILL);
-  const std::string text = read_file(trace_);
+  // Written through a shared mapping: the file keeps its chunk's length, the unwritten rest
+  // zero bytes where readers stop. The text before them ends with a whole line.
+  const std::string file = read_file(trace_);
+  const std::string text = file.substr(0, file.find('\0'));
   ASSERT_FALSE(text.empty());
+  EXPECT_LT(text.size(), file.size()) << "killed before it was cut to its length";
   EXPECT_EQ(text.back(), '\n') << "the last line is whole";
   std::uint64_t frames = 0;
   try {
@@ -119,6 +125,46 @@ TEST_F(Recording, AHostKilledMidRunLeavesATraceCompleteUpToItsLastFrame) {
   }
   EXPECT_GT(frames, 100u);
   EXPECT_TRUE(replays_clean(trace_));
+}
+
+// The chain of issue 25's headline: a mechanical axis whose home switch closes SW at 0.
+constexpr const char* kHomingChain = "bus=0 cs=0 chips=L6470 axis.0=stops=-6400..300000,start=51200,switch=home@0:below:hyst=64";
+
+/// `l6470emu decode` and `plot` of the file say nothing diverged (exit 0, no banner).
+::testing::AssertionResult decodes_without_divergence(const std::string& path) {
+  const RunResult r = run_program({l6470emu_program(), "decode", path});
+  if (r.status != 0 || r.out.find("DIVERGED") != std::string::npos)
+    return ::testing::AssertionFailure() << "decode exit " << r.status << "\n" << r.out << r.err;
+  return ::testing::AssertionSuccess();
+}
+
+TEST_F(Recording, APreloadedHomingRunAgainstTheAxisSwitchRecordsItsWorldAndReplaysExactly) {
+  const RunResult r = run_program({system_python(), script("spidev_homing.py"), "0", "0"},
+                                  {{"LD_PRELOAD", preload_library()},
+                                   {"L6470EMU_CHAIN", std::string(kHomingChain) + "; time=virtual"},
+                                   {"L6470EMU_TRACE", trace_}});
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  ASSERT_NE(r.out.find("homed\n"), std::string::npos) << r.out;
+  const std::string text = read_file(trace_);
+  // The axis and its switch are in the recording's board description.
+  EXPECT_NE(text.find("\nboard bus=0 cs=0 path=/dev/spidev0.0 chips=L6470 "), std::string::npos) << text;
+  EXPECT_NE(text.find(" axis.0=stops=-6400..300000,start=51200,switch=home@0:below:no:hyst=64"), std::string::npos) << text;
+  EXPECT_NE(text.find("\nboard time=virtual"), std::string::npos) << text;
+  // Replayed through the world it ran in: every MISO byte and BUSY/FLAG level as recorded.
+  EXPECT_TRUE(replays_clean(trace_));
+  const RunResult rep = run_program({l6470emu_program(), "replay", trace_});
+  EXPECT_NE(rep.err.find("with an axis behind chip 0 (from the trace's board description)"), std::string::npos) << rep.err;
+  EXPECT_TRUE(decodes_without_divergence(trace_));
+  // Without the axis (the chain named on the command line) the switch never closes: the
+  // replay, decode and plot all say so, and the latter two exit 1 unless told to accept it.
+  const RunResult bare = run_program({l6470emu_program(), "replay", "--chain", "L6470", trace_});
+  EXPECT_EQ(bare.status, 1) << bare.out << bare.err;
+  EXPECT_NE(bare.out.find("BUSY expected high (released), emulated low (busy)"), std::string::npos) << bare.out;
+  const RunResult dec = run_program({l6470emu_program(), "decode", "--chain", "L6470", trace_});
+  EXPECT_EQ(dec.status, 1) << dec.out << dec.err;
+  EXPECT_NE(dec.out.find("DIVERGED"), std::string::npos) << dec.out;
+  EXPECT_NE(dec.err.find("--accept-divergence accepts it"), std::string::npos) << dec.err;
+  EXPECT_EQ(run_program({l6470emu_program(), "decode", "--accept-divergence", "--chain", "L6470", trace_}).status, 0);
 }
 
 class RecordingDaemon : public Recording {
@@ -186,7 +232,8 @@ TEST_F(RecordingDaemon, ADaemonKilledWhileRecordingLeavesACompleteTrace) {
   daemon_->process().stop(SIGKILL);
   unlink(daemon_->socket().c_str());
   daemon_.reset();
-  const std::string text = read_file(trace_);
+  const std::string file = read_file(trace_);
+  const std::string text = file.substr(0, file.find('\0'));  // the unwritten rest of the mapped file
   // The program's last command (GetStatus, one frame per byte) is the file's last frame.
   EXPECT_EQ(text.substr(text.rfind(" frame ")), " frame 2.00us 00 | 12\n") << text;
   // Every frame the program sent is in the file (how many it sent depends on how often it
@@ -195,6 +242,70 @@ TEST_F(RecordingDaemon, ADaemonKilledWhileRecordingLeavesACompleteTrace) {
   const RunResult r = run_program({l6470emu_program(), "replay", trace_});
   EXPECT_NE(r.out.find(": " + frames + " frames, "), std::string::npos) << "the program sent " << frames << " frames\n"
                                                                         << r.out;
+}
+
+TEST_F(RecordingDaemon, AVirtualTimeDaemonWithAnAxisSeveralClientsLoadsFaultsAndAdvanceReplaysExactly) {
+  // Two chains on one bus: the homing axis behind chip select 0, a plain chip behind 1.
+  daemon_ = std::make_unique<ServeDaemon>(std::string(kHomingChain) + "; bus=0 cs=1 chips=L6470",
+                                          std::vector<std::string>{"--virtual-time", "--record", trace_});
+  ASSERT_TRUE(daemon_->ready()) << daemon_->process().out();
+  const std::string homed_trace = trace_path_for_chain(trace_, "spidev0.0", 2);
+  const std::string other_trace = trace_path_for_chain(trace_, "spidev0.1", 2);
+  // The daemon's virtual time moves with bus traffic and `ctl advance` only (its clients' sleeps
+  // are real): the test steps it, as a harness orchestrating several programs does, while a
+  // homing run on spidev0.0 and a second program on spidev0.1 (a Move, status and position
+  // polled) share the bus.
+  auto home = [&](std::vector<std::string> argv) {
+    Background homing(argv, env());
+    for (int i = 0; i < 2000; ++i) {
+      const std::string out = homing.out();
+      if (out.find("homed\n") != std::string::npos || out.find("FAIL") != std::string::npos) break;
+      ctl({"advance", "100"});
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return homing.wait(30);
+  };
+  Background watcher({system_python(), "-c",
+                      "import spidev, time\ns = spidev.SpiDev(); s.open(0, 1); s.mode = 3\n"
+                      "x = lambda *bs: [s.xfer2([b])[0] for b in bs]\n"
+                      "x(0x51, 0, 0x20, 0)\n"
+                      "for _ in range(100): x(0xD0, 0, 0); x(0x21, 0, 0, 0); time.sleep(0.002)\n"},
+                     env());
+  const RunResult first = home({system_python(), script("spidev_homing.py"), "0", "0"});
+  ASSERT_EQ(first.status, 0) << first.out << first.err;
+  const RunResult watched = watcher.wait(30);
+  ASSERT_EQ(watched.status, 0) << watched.err;
+  // Stimuli that do not come over the bus: a heavier load, time passing, a fault, the host's SW.
+  ASSERT_EQ(ctl({"axis", "load", "friction=0.3", "--chip", "0"}).status, 0);
+  ASSERT_EQ(ctl({"advance", "50"}).status, 0);
+  const RunResult stalled = run_program({system_python(), "-c",
+                                         "import spidev, time\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
+                                         "x = lambda *bs: [s.xfer2([b])[0] for b in bs]\n"
+                                         "x(0x41, 0, 0x32, 0)\n"},
+                                        env());
+  ASSERT_EQ(ctl({"advance", "1500"}).status, 0);  // the Move against 0.3 N·m of friction
+  ASSERT_EQ(stalled.status, 0) << stalled.err;
+  ASSERT_EQ(ctl({"fault", "ocd", "on"}).status, 0);
+  ASSERT_EQ(ctl({"advance", "20"}).status, 0);
+  ASSERT_EQ(ctl({"fault", "ocd", "off"}).status, 0);
+  ASSERT_EQ(ctl({"axis", "load", "friction=0", "--chip", "0"}).status, 0);
+  const RunResult last = home({system_python(), script("spidev_homing.py"), "0", "0", "3000"});
+  ASSERT_EQ(last.status, 0) << last.out << last.err;
+  const RunResult d = daemon_->process().stop(SIGTERM);
+  daemon_.reset();
+  ASSERT_EQ(d.status, 0) << d.out << d.err;
+  const std::string text = read_file(homed_trace);
+  EXPECT_NE(text.find(" axis.0=stops=-6400..300000,start=51200,switch=home@0:below:no:hyst=64"), std::string::npos) << text;
+  EXPECT_EQ(count_of(text, " load 0 "), 2u) << text;
+  EXPECT_GE(count_of(text, " advance\n"), 20u) << text;
+  EXPECT_NE(text.find(" fault 0 OCD on\n"), std::string::npos) << text;
+  EXPECT_TRUE(replays_clean(homed_trace));
+  EXPECT_TRUE(decodes_without_divergence(homed_trace));
+  const std::string other = read_file(other_trace);
+  EXPECT_GE(count_of(other, " frame "), 500u) << other;
+  EXPECT_TRUE(replays_clean(other_trace));
+  std::remove(homed_trace.c_str());
+  std::remove(other_trace.c_str());
 }
 
 }  // namespace

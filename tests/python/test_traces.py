@@ -230,3 +230,44 @@ def test_motion_refuses_more_points_than_a_picture_can_use(points):
     with pytest.raises(ValueError, match=r"max_points .* out of range 0\.\.100000"):
         l6470emu.motion(FIXTURES / "three_chips.trace", max_points=points)
     assert len(l6470emu.motion(FIXTURES / "three_chips.trace", max_points=l6470emu.MAX_MOTION_POINTS).chips) == 3
+
+
+HOMING_RIG = "chips=L6470 axis.0=stops=-6400..300000,start=51200,switch=home@0:below:hyst=64"
+
+
+def test_a_recording_carries_its_world_and_a_foreign_capture_takes_it_as_board(tmp_path):
+    # homing_axis.trace: a preloaded python3-spidev homing run against the axis' home switch.
+    native = FIXTURES / "homing_axis.trace"
+    assert l6470emu.replay(native).matched          # the trace's own board lines: the axis
+    decoded = l6470emu.decode(native)
+    assert decoded.divergence is None and decoded.frames_diverged == 0 and decoded.pins_diverged == 0
+    assert l6470emu.motion(native).divergence is None
+    # The same traffic as a Saleae export carries no board: without one the switch never
+    # closes, and every result says where the emulator departs from the capture.
+    capture = FIXTURES / "homing_axis_saleae.csv"
+    bare = l6470emu.decode(capture)
+    first = bare.divergence
+    assert isinstance(first, l6470emu.FirstDivergence)
+    assert first.chip == 0 and first.frame > 0 and first.seconds > 2.0 and "expected" in first.what
+    assert bare.frames_diverged > 0 and "DIVERGED" in bare.text
+    motion = l6470emu.motion(capture)
+    assert motion.divergence is not None and motion.divergence.frame == first.frame
+    assert not l6470emu.replay(capture).matched
+    # Given the rig's description (a board file, or the description as chain=), it matches.
+    rig = tmp_path / "rig.conf"
+    rig.write_text(HOMING_RIG + "\n")
+    assert l6470emu.replay(capture, board=rig).matched
+    assert l6470emu.replay(capture, chain=HOMING_RIG).matched
+    assert l6470emu.decode(capture, board=rig).divergence is None
+    assert l6470emu.motion(capture, board=str(rig)).divergence is None
+
+
+def test_a_foreign_capture_the_model_does_not_reproduce_says_where_in_every_result():
+    capture = FIXTURES / "ftrace_spi_set_cs.txt"
+    d = l6470emu.decode(capture).divergence
+    assert d is not None and d.frame == 23 and d.chip == 0
+    assert d.what == "MISO byte 0 expected 0xF0, emulated 0xCD"
+    assert d.summary.endswith("frame 23 at t=1523.803136 s: chip 0: MISO byte 0 expected 0xF0, emulated 0xCD")
+    m = l6470emu.motion(capture)
+    assert m.divergence is not None and m.divergence.frame == 23 and m.frames_diverged >= 1
+    assert "DIVERGED" in repr(m)

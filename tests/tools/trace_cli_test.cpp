@@ -85,12 +85,58 @@ TEST(DecodeCommand, PrintsTheExplainedLog) {
   EXPECT_NE(r.out.find("# 54 frames, 4 commands, 12 answers, 0 diagnostics"), std::string::npos) << r.out;
 }
 
+TEST(DecodeCommand, ACaptureTheModelDoesNotReproduceIsMarkedAndExitsOneUnlessAccepted) {
+  const std::string capture = fixture_path("ftrace_spi_set_cs.txt");
+  RunResult r = l6470emu("decode " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("t=1523.803136 s  !!!!!!!! DIVERGED: " + capture +
+                       ":169: frame 23 at t=1523.803136 s: chip 0: MISO byte 0 expected 0xF0, emulated 0xCD\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("from there on the log is the emulator's model, not the trace"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("l6470emu decode: the emulator does not reproduce " + capture), std::string::npos) << r.out;
+  r = l6470emu("decode --accept-divergence " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("DIVERGED"), std::string::npos) << "accepted, still marked: " << r.out;
+  // A trace the emulator reproduces: exit 0, no mark.
+  r = l6470emu("decode " + fixture_path("homing_axis.trace") + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(r.out.find("DIVERGED"), std::string::npos) << r.out;
+}
+
+TEST(ReplayCommand, AForeignCaptureRunsThroughTheBoardItIsGivenAndSaysWhence) {
+  test::TempDir dir;
+  const std::string capture = fixture_path("homing_axis_saleae.csv");  // a homing run; its switch is in no capture
+  const std::string rig = "chips=L6470 axis.0=stops=-6400..300000,start=51200,switch=home@0:below:hyst=64";
+  RunResult r = l6470emu("replay " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find(":1874: frame 625 at t=2.057488000 s: MISO byte 0 expected 0x0E, emulated 0x60"), std::string::npos) << r.out;
+  const std::string board = dir.write("rig.conf", "# the rig: one L6470, a carriage, a home switch\n" + rig + "\n");
+  r = l6470emu("replay --board " + board + " " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("through L6470 with an axis behind chip 0 (from --board " + board + ")"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": 800 frames, 800 MISO bytes compared: matched"), std::string::npos) << r.out;
+  r = l6470emu("replay --chain '" + rig + "' " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  r = l6470emu("decode --board " + board + " " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("# 800 frames, 4 commands, 263 answers, 0 diagnostics"), std::string::npos) << r.out;
+  // A native recording's own board is replaced only when told, and the output says so.
+  r = l6470emu("replay --chain L6470 " + fixture_path("homing_axis.trace") + " 2>&1");
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("the trace's own description (its board lines, from line 3) is not used"), std::string::npos) << r.out;
+  // A bad board file: one line naming it.
+  r = l6470emu("replay --board " + dir.write("bad.conf", "chips=L6470 axis.3=default\n") + " " + capture + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("bad.conf"), std::string::npos) << r.out;
+}
+
 TEST(ConvertCommand, WritesNativeVcdAndUmockdevFiles) {
   test::TempDir dir;
   RunResult r = l6470emu("convert " + fixture_path("saleae_logic2.csv") + " -o " + dir.file("c.trace"));
   ASSERT_EQ(r.status, 0) << r.out;
   const std::string native = test::read_text(dir.file("c.trace"));
-  EXPECT_EQ(native.rfind("l6470emu-trace 1\n# " + std::string(kNativeTraceNumbering) + "\n# converted from ", 0), 0u)
+  EXPECT_EQ(native.rfind("l6470emu-trace 2\n# " + std::string(kNativeTraceNumbering) + "\n# converted from ", 0), 0u)
       << native;
   // The converted trace replays as the original does.
   r = l6470emu("replay --chain 1 " + dir.file("c.trace"));
@@ -216,7 +262,7 @@ TEST(ConvertCommand, KeepsWhatItWroteBeforeABadLine) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.out, "l6470emu convert: " + bad + ":3: MOSI \"ZZ\" is not a byte (two hex digits)\n");
   const std::string written =
-      "l6470emu-trace 1\n# " + std::string(kNativeTraceNumbering) + "\n0.00100000 frame 0.00us 00 | 00\n";
+      "l6470emu-trace 2\n# " + std::string(kNativeTraceNumbering) + "\n0.00100000 frame 0.00us 00 | 00\n";
   EXPECT_EQ(test::read_text(dir.file("out.trace")), written);
   r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert " + bad + " -o - 2>/dev/null; }");
   EXPECT_EQ(r.out, written);

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# What recording costs (issue 25): the same virtual-time run unrecorded, recorded into a plain
+# trace and into a .trace.gz, side by side in alternating runs, for a C client (one-byte NOP
+# messages: bench/preload_roundtrips.c; its trace is a few repeat lines) and a polling Python
+# client (python3-spidev: a Move, then 100 000 polls of GetStatus and GetParam(ABS_POS), one
+# xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames). Prints each run's
+# CPU time (user + system, best of RUNS), the time per frame and the ratio recorded/unrecorded
+# (goal: at most 1.25), then the .gz recording's size against `gzip -6` of the plain one
+# (goal: at most 1.2x). Usage: bench/recording_bench.sh [BUILD_DIR] [RUNS]
+set -euo pipefail
+build=${1:-build}
+runs=${2:-3}
+build=$(cd "$build" && pwd)
+client=$build/bench/l6470emu_preload_roundtrips
+preload=$build/libl6470emu-preload.so
+python=/usr/bin/python3
+for f in "$client" "$preload"; do
+  [ -e "$f" ] || { echo "recording_bench: $f is missing; build the l6470emu_benchmarks target" >&2; exit 1; }
+done
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+chain="bus=0 cs=0 chips=L6470 mode=3; time=virtual"
+c_frames=2000000
+py_polls=100000
+cat >"$work/poll.py" <<'EOF'
+import sys
+import spidev
+s = spidev.SpiDev(); s.open(0, 0); s.mode = 3
+x = lambda *bs: [s.xfer2([b])[0] for b in bs]
+x(0x41, 0x01, 0x00, 0x00)  # Move forward 65536 microsteps: the polls see it run
+for _ in range(int(sys.argv[1])):
+    x(0xD0, 0, 0)
+    x(0x21, 0, 0, 0)  # GetParam(ABS_POS): a new position in most polls, so few repeat lines
+EOF
+
+# cpu_seconds OUT_TRACE COMMAND...: user+system seconds of one run (OUT_TRACE "" = unrecorded).
+cpu_seconds() {
+  local trace=$1; shift
+  rm -f "$trace"
+  local env=(L6470EMU_CHAIN="$chain" LD_PRELOAD="$preload")
+  [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
+  /usr/bin/time -f "%U %S" -o "$work/time" env "${env[@]}" "$@" >/dev/null
+  awk '{ printf "%.4f\n", $1 + $2 }' "$work/time"
+}
+
+best() { sort -g | head -1; }
+
+# bench NAME FRAMES COMMAND...
+bench() {
+  local name=$1 frames=$2; shift 2
+  local plain=() gz=() none=()
+  for ((i = 0; i < runs; ++i)); do
+    none+=("$(cpu_seconds "" "$@")")
+    plain+=("$(cpu_seconds "$work/$name.trace" "$@")")
+    gz+=("$(cpu_seconds "$work/$name.trace.gz" "$@")")
+  done
+  local n p g
+  n=$(printf '%s\n' "${none[@]}" | best)
+  p=$(printf '%s\n' "${plain[@]}" | best)
+  g=$(printf '%s\n' "${gz[@]}" | best)
+  awk -v name="$name" -v f="$frames" -v n="$n" -v p="$p" -v g="$g" 'BEGIN {
+    printf "%-28s %9d frames  unrecorded %7.3f s (%6.0f ns/frame)\n", name, f, n, n * 1e9 / f
+    printf "%-28s %9s         plain      %7.3f s (%6.0f ns/frame)  ratio %.2f\n", "", "", p, p * 1e9 / f, p / n
+    printf "%-28s %9s         .gz        %7.3f s (%6.0f ns/frame)  ratio %.2f\n", "", "", g, g * 1e9 / f, g / n
+  }'
+  local plain_size gz_size ref
+  plain_size=$(stat -c %s "$work/$name.trace")
+  gz_size=$(stat -c %s "$work/$name.trace.gz")
+  ref=$(gzip -6 -c "$work/$name.trace" | wc -c)
+  awk -v name="$name" -v p="$plain_size" -v g="$gz_size" -v r="$ref" 'BEGIN {
+    printf "%-28s sizes: plain %d B, .gz %d B, gzip -6 of the plain %d B: .gz / gzip -6 = %.2f\n", "", p, g, r, g / r
+  }'
+}
+
+echo "recording cost, virtual time, best of $runs alternating runs (load: $(cut -d' ' -f1-3 /proc/loadavg))"
+bench "C client (NOP messages)" "$c_frames" "$client" /dev/spidev0.0 "$c_frames"
+if "$python" -c 'import spidev' 2>/dev/null; then
+  bench "Python client (GetStatus)" "$((py_polls * 7 + 4))" "$python" "$work/poll.py" "$py_polls"
+else
+  echo "Python client: skipped ($python has no spidev module; Debian: python3-spidev)"
+fi

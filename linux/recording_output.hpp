@@ -1,0 +1,36 @@
+// Where the Linux front's recordings go: a plain trace file written through a MAP_SHARED
+// mapping (appending a line and updating a `repeat` count are memory writes, not system calls,
+// and the pages belong to the file, so a killed process leaves every event written), and gzip
+// files flushed by size and host time. It does not format traces (spi/trace_native.hpp does).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "spi/trace_output.hpp"
+
+namespace l6470emu {
+
+/// How often a gzip recording hands its compressed data to the OS: every 64 KiB of text or
+/// every 200 ms of host time, whichever comes first.
+inline constexpr std::size_t kRecordingGzipFlushBytes = 64 * 1024;
+inline constexpr std::int64_t kRecordingGzipFlushNs = 200'000'000;
+
+/// A plain trace file at `path` (created or truncated) written through a shared mapping. The
+/// file grows in chunks (the space is reserved with fallocate, so a full disk is an error here,
+/// never a SIGBUS later); while it is being written its length is the chunk's and the unwritten
+/// rest is zero bytes, where readers stop; close() cuts it to the trace's length. Every append
+/// becomes visible in one store (its first byte, written last), and replace_tail of a `repeat`
+/// count in one aligned 8-byte store, so a process killed at any instant leaves a trace whose
+/// every line is whole. Returns nullptr when `path` is not a regular file (a FIFO, /dev/stdout:
+/// the caller writes it the ordinary way); throws std::runtime_error (one line) when it cannot
+/// be created or mapped.
+std::unique_ptr<TraceOutput> open_mapped_trace_output(const std::string& path);
+
+/// The output of a recording at `path`: mapped (open_mapped_trace_output) for a plain file,
+/// zlib flushed every kRecordingGzipFlushBytes or kRecordingGzipFlushNs of `clock` (host
+/// monotonic ns) for a name ending in ".gz", stdio for what cannot be mapped.
+std::unique_ptr<TraceOutput> open_recording_output(const std::string& path, std::function<std::int64_t()> clock);
+
+}  // namespace l6470emu
