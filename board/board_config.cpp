@@ -3,6 +3,7 @@
 #include "board/board_config.hpp"
 
 #include "board/axis_config.hpp"
+#include "core/near_miss.hpp"
 
 #include <algorithm>
 #include <array>
@@ -111,52 +112,6 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-// Levenshtein distance, case-insensitive; only for the short words suggestions are made for.
-std::size_t edit_distance(std::string_view a_in, std::string_view b_in) {
-  const std::string a = lower(a_in), b = lower(b_in);
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
-
-// The candidates closest to `word` (at most 2 edits, and fewer than the word's length), as
-// "A" or "A or B"; "" when nothing is close.
-std::string closest(std::string_view word, const std::vector<std::string>& candidates) {
-  if (word.empty() || word.size() > 32) return "";
-  std::size_t best = 3;
-  std::vector<std::string> hits;
-  for (const auto& c : candidates) {
-    const std::size_t d = edit_distance(word, c);
-    if (d >= word.size() || d > best) continue;
-    if (d < best) hits.clear();
-    best = d;
-    hits.push_back(c);
-  }
-  std::string out;
-  for (std::size_t i = 0; i < hits.size(); ++i) out += (i == 0 ? "" : i + 1 == hits.size() ? " or " : ", ") + hits[i];
-  return out;
-}
-
-std::vector<std::string> variant_names() {
-  std::vector<std::string> names;
-  for (const Variant* v : all_variants()) names.emplace_back(v->name);
-  return names;
-}
-
-std::string variant_suggestion(std::string_view name) {
-  const std::string near = closest(name, variant_names());
-  return near.empty() ? "" : "did you mean " + near + "? ";
-}
-
 // Words users write for a key under another name.
 std::string_view key_alias(std::string_view key) {
   static constexpr std::pair<std::string_view, std::string_view> kAliases[] = {
@@ -180,7 +135,7 @@ std::string key_suggestion(std::string_view key) {
   if (const std::string_view alias = key_alias(key); !alias.empty()) return std::string(alias);
   std::vector<std::string> names;
   for (const KeySpec& k : kKeys) names.emplace_back(k.name);
-  return closest(key, names);
+  return closest_names(key, names);
 }
 
 template <typename T>
