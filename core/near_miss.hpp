@@ -9,8 +9,13 @@
 
 namespace l6470emu {
 
-/// Levenshtein distance between `a` and `b`, ignoring ASCII case.
+/// Edit distance between `a` and `b` (insertions, deletions, substitutions and swaps of two
+/// neighbouring letters, one each), ignoring ASCII case.
 std::size_t edit_distance(std::string_view a, std::string_view b);
+
+/// The candidates closest to `word` (at most 2 edits, and fewer edits than the word has
+/// characters), in the order given; none when nothing is close.
+std::vector<std::string> closest_matches(std::string_view word, const std::vector<std::string>& candidates);
 
 /// The candidates closest to `word` (at most 2 edits, and fewer edits than the word has
 /// characters), as "A", "A or B" or "A, B or C"; "" when nothing is close.

@@ -23,13 +23,11 @@ constexpr std::string_view kIntSpeedNote =
     "CONFLICT: 2^-24 step/tick as the L6470 datasheet and ST's cSPIN library say (0x408 = 246 step/s); "
     "ST's 2014 L6470 driver reads 2^-26";
 constexpr std::string_view kSlopeNote =
-    "the datasheet gives only the range (0 to 0.004 s/step) and the resolution (0.000015): an LSB of 2^-16 "
-    "fits both and its reset column (0x19 = 0.038 %, 0x29 = 0.063 %); ST's libraries use 0.004/255 (UNCONFIRMED)";
+    "UNCONFIRMED LSB: 2^-16 fits the datasheet's range (0 to 0.004), resolution (0.000015) and reset column "
+    "(0.038 %, 0.063 %); ST's libraries use 0.004/255";
 constexpr std::string_view kL6472Note = "UNCONFIRMED: one third-party header (no L6472 table was read)";
-constexpr std::string_view kGateNote = "a voltage: V_DS of the bridge MOSFETs";
-constexpr std::string_view kL6482OcdNote = "a voltage: V_DS of the bridge MOSFETs; the L6482's scale: one ST library";
-constexpr std::string_view kTvalNote =
-    "the sources write 7.8 mV per LSB from 7.8 mV to 1 V: 128 steps ending at 1000 mV make it 7.8125 mV";
+constexpr std::string_view kL6482OcdNote = "the L6482's scale: one ST library (its cSPIN header)";
+constexpr std::string_view kTvalNote = "7.8 mV in the sources: 128 steps up to 1 V make it 7.8125 mV";
 
 // Registers every variant has.
 #define L6470EMU_MOTION_SCALES(INFINITE_ACC)                                                                                     \
@@ -77,16 +75,16 @@ constexpr UnitScale kL6480[] = {
     L6470EMU_MOTION_SCALES(true),
     L6470EMU_VOLTAGE_SCALES,
     L6470EMU_ADC_SCALE,
-    UnitScale{"OCD_TH", Reg::OCD_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, kGateNote},
-    UnitScale{"STALL_TH", Reg::STALL_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, kGateNote},
+    UnitScale{"OCD_TH", Reg::OCD_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, {}},
+    UnitScale{"STALL_TH", Reg::STALL_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, {}},
     speed_scale("FS_SPD", Reg::FS_SPD, 10, 1u << 10, 1),
 };
 constexpr UnitScale kPowerstep01[] = {
     L6470EMU_MOTION_SCALES(true),
     L6470EMU_VOLTAGE_SCALES,
     L6470EMU_ADC_SCALE,
-    UnitScale{"OCD_TH", Reg::OCD_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, kGateNote},
-    UnitScale{"STALL_TH", Reg::STALL_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, kGateNote},
+    UnitScale{"OCD_TH", Reg::OCD_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, {}},
+    UnitScale{"STALL_TH", Reg::STALL_TH, 0, 5, 2, 125, 4, PhysicalUnit::mV, false, {}},
     speed_scale("FS_SPD", Reg::FS_SPD, 10, 1u << 10, 1),
     L6470EMU_TVAL_MV,
     L6470EMU_CURRENT_TIMES(std::string_view{}),

@@ -30,7 +30,7 @@ std::string variant_status_markdown();
 std::string variant_differences_markdown();
 
 /// The generated block called `name` ("l6470-registers", "l6470-status", "commands", "variant-registers",
-/// "variant-status", "variant-differences"), or "" if unknown.
+/// "variant-status", "variant-differences", "units"), or "" if unknown.
 std::string generated_block(std::string_view name);
 
 /// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of
