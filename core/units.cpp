@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/near_miss.hpp"
+
 namespace l6470emu {
 namespace {
 
@@ -187,6 +189,45 @@ const UnitScale* find_unit_scale(const Variant& variant, std::string_view name) 
   for (const UnitScale& s : unit_scales(variant))
     if (same(s.name, name)) return &s;
   return nullptr;
+}
+
+std::string why_no_unit_scale(const Variant& variant, std::string_view name) {
+  if (find_unit_scale(variant, name) != nullptr) return "";
+  const auto has_register = [&](const Variant& v) -> const RegisterInfo* {
+    for (const Variant* t : {&v, v.current_mode})
+      if (t != nullptr)
+        for (const RegisterInfo& r : t->registers)
+          if (same(r.name, name)) return &r;
+    return nullptr;
+  };
+  if (const RegisterInfo* r = has_register(variant)) {
+    std::string fields;
+    std::size_t count = 0;
+    for (const UnitScale& s : unit_scales(variant))
+      if (s.reg == r->id) fields += (count++ == 0 ? "" : " and ") + std::string(s.name);
+    if (count > 1)
+      return std::string(r->name) + " holds " + std::to_string(count) + " values: " + fields + ", each with its own scale";
+    return std::string(r->name) + " has no physical unit";
+  }
+  std::string owners;
+  std::vector<std::string> names{"SPD"};
+  for (const Variant* v : all_variants()) {
+    bool owns = has_register(*v) != nullptr;
+    for (const UnitScale& s : unit_scales(*v)) {
+      names.emplace_back(s.name);
+      owns = owns || same(s.name, name);
+    }
+    if (owns) owners += (owners.empty() ? "" : ", ") + std::string(v->name);
+  }
+  if (!owners.empty())
+    return std::string(variant.name) + " has no " + std::string(name) + " (a register of " + owners + ")";
+  const std::vector<std::string> near = closest_matches(name, names);
+  std::string hint;
+  for (std::size_t i = 0; i < near.size(); ++i)
+    hint += (i == 0 ? "; did you mean '" : i + 1 == near.size() ? " or '" : ", '") + near[i] + "'";
+  std::string shown;
+  for (unsigned char c : name.substr(0, 40)) shown += (c < 0x20 || c >= 0x7f) ? '?' : static_cast<char>(c);
+  return "unknown register '" + shown + "'" + hint + (hint.empty() ? "" : "?");
 }
 
 PhysicalValue to_physical(const UnitScale& s, std::uint32_t n) {

@@ -75,6 +75,12 @@ std::span<const UnitScale> unit_scales(const Variant& variant);
 /// TOFF_FAST or FAST_STEP.
 const UnitScale* find_unit_scale(const Variant& variant, std::string_view name);
 
+/// Why `name` has no scale on `variant`, in one line: "unknown register 'MAX_SPED'; did you
+/// mean 'MAX_SPEED'?", "L6470 has no TVAL_RUN (a register of L6472, L6482, powerSTEP01)",
+/// "CONFIG has no physical unit", "T_FAST holds two values: TOFF_FAST and FAST_STEP"; "" when
+/// it has one.
+std::string why_no_unit_scale(const Variant& variant, std::string_view name);
+
 /// The physical value of field value `n` (0 … max_field()); n above it is masked.
 PhysicalValue to_physical(const UnitScale& scale, std::uint32_t n);
 

@@ -90,31 +90,14 @@ Lookup look_up(const Variant& variant, const std::string& name) {
     return l;
   }
   l.reg = register_named(variant, name);
-  if (l.reg != nullptr) {
-    l.scales = scales_in(variant, l.reg->id);
-    if (!l.scales.empty()) return l;
-    std::string with;
-    for (const UnitScale& s : unit_scales(variant)) with += (with.empty() ? "" : ", ") + std::string(s.name);
-    throw UsageError(std::string(l.reg->name) + " has no physical unit (" + std::string(variant.name) +
-                     " registers with one: " + with + ")");
-  }
-  // Another variant's register, or a misspelling.
-  std::vector<std::string> owners, names;
-  for (const Variant* v : all_variants()) {
-    for (const UnitScale& s : unit_scales(*v)) {
-      names.emplace_back(s.name);
-      if (same_name(s.name, name) && (owners.empty() || owners.back() != v->name)) owners.emplace_back(v->name);
-    }
-    if (register_named(*v, name) != nullptr && (owners.empty() || owners.back() != v->name)) owners.emplace_back(v->name);
-  }
-  if (!owners.empty()) {
-    std::string list;
-    for (const std::string& o : owners) list += (list.empty() ? "" : ", ") + o;
-    throw UsageError(std::string(variant.name) + " has no " + name + " (a register of " + list + "; --variant)");
-  }
-  names.emplace_back("SPD");
-  throw UsageError("unknown register '" + name + "'" + did_you_mean(name, names) +
-                   " (l6470emu units --variant " + std::string(variant.name) + " lists them)");
+  if (l.reg != nullptr) l.scales = scales_in(variant, l.reg->id);
+  if (!l.scales.empty()) return l;  // T_FAST: its two fields
+  const std::string why = why_no_unit_scale(variant, name);
+  if (why.rfind("unknown register", 0) == 0)
+    throw UsageError(why + " (l6470emu units --variant " + std::string(variant.name) + " lists them)");
+  if (l.reg != nullptr)
+    throw UsageError(why + " (l6470emu units --variant " + std::string(variant.name) + " lists the registers with one)");
+  throw UsageError(why + "; --variant names the chip");
 }
 
 /// "0x041", "65", "0b1000001": a register value; nullopt when `text` is not an integer.
@@ -208,12 +191,8 @@ int convert(const Variant& variant, const UnitsArgs& a, std::ostream& out, std::
     out << flag_bits(r, n, fields) << "\n";
     return 0;
   }
-  if (l.scales.size() > 1) {
-    std::string fields;
-    for (const UnitScale* s : l.scales) fields += (fields.empty() ? "" : " and ") + std::string(s->name);
-    throw UsageError(std::string(r.name) + " holds " + std::to_string(l.scales.size()) + " values: convert " + fields +
-                     " one at a time (or give a register value)");
-  }
+  if (l.scales.size() > 1)
+    throw UsageError(why_no_unit_scale(variant, r.name) + ": convert one at a time (or give a register value)");
   const UnitScale& s = *l.scales[0];
   const double x = physical_value(s, value);
   const FieldValue f = to_register(s, x, a.saturate ? OutOfRange::saturate : OutOfRange::refuse);

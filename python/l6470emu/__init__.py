@@ -6,6 +6,7 @@ STATUS decoded (Status), and recording into native traces that replay() and deco
 motion() samples what each chip did over a trace, and l6470emu.plot draws it (matplotlib).
 The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spidev_board
 fixtures; preload_library() finds libl6470emu-preload.so for running unmodified programs.
+l6470emu.units converts register values to physical units (step/s, mA, ...) and back.
 """
 from ._l6470emu import (
     DEFAULT_MAX_FRAMES,
@@ -36,6 +37,7 @@ from ._l6470emu import (
 )
 from ._paths import preload_library, program
 from ._status import Status
+from . import units
 
 __all__ = [
     "DEFAULT_MAX_FRAMES",
@@ -64,6 +66,7 @@ __all__ = [
     "preload_library",
     "program",
     "register_table",
+    "units",
     "replay",
     "variants",
 ]

@@ -2,7 +2,7 @@
 # checks that every name here exists in the module and the other way round.
 import enum
 import os
-from typing import Callable, Iterator, List, Optional, Sequence, Union, overload
+from typing import Callable, Iterator, List, Optional, Sequence, Tuple, Union, overload
 
 from ._status import Status
 
@@ -99,6 +99,12 @@ class RegisterInfo:
 
 def variants() -> List[str]: ...
 def register_table(variant: str, current_mode: bool = False) -> List[RegisterInfo]: ...
+# What l6470emu.units is written over (private): a scale is
+# (name, register, shift, bits, offset_halves, lsb_num, lsb_den, unit, top_is_infinite, note).
+def _unit_scales(variant: str) -> List[Tuple[str, str, int, int, int, int, int, str, bool, str]]: ...
+def _unit_scale(variant: str, name: str) -> Tuple[str, str, int, int, int, int, int, str, bool, str]: ...
+def _to_physical(variant: str, name: str, value: int) -> Tuple[int, int, bool]: ...
+def _to_register(variant: str, name: str, physical: float, saturate: bool) -> int: ...
 
 class Diagnostic:
     @property

@@ -16,5 +16,7 @@ void bind_chain(py::module_& m);
 void bind_trace(py::module_& m);
 /// motion() and its Motion, ChipMotion and CommandMark: what the chips of a trace did, as series.
 void bind_motion(py::module_& m);
+/// The private functions l6470emu.units is written over (register values <-> physical units).
+void bind_units(py::module_& m);
 
 }  // namespace l6470emu::python

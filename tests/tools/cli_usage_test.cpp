@@ -122,7 +122,10 @@ TEST(UnitsCommand, BadRegistersVariantsAndValuesAreOneLineWithStatusTwo) {
                      "l6470emu units: --variant: unknown chip variant 'L6471' (did you mean L6470 or L6472? known: L6470, "
                      "L6472, L6480, L6482, powerSTEP01)");
   expect_usage_error("units TVAL_RUN 100mA",
-                     "l6470emu units: L6470 has no TVAL_RUN (a register of L6472, L6482, powerSTEP01; --variant)");
+                     "l6470emu units: L6470 has no TVAL_RUN (a register of L6472, L6482, powerSTEP01); --variant names "
+                     "the chip");
+  expect_usage_error("units CONFIG 0x2E88", "l6470emu units: CONFIG has no physical unit (l6470emu units --variant "
+                                           "L6470 lists the registers with one)");
   expect_usage_error("units MAX_SPEED 200mA", "l6470emu units: MAX_SPEED is in step/s, not 'mA'");
   expect_usage_error("units MAX_SPEED 200.5",
                      "l6470emu units: '200.5': give the unit (200.5step/s) or an integer register value (0x041)");
@@ -130,8 +133,8 @@ TEST(UnitsCommand, BadRegistersVariantsAndValuesAreOneLineWithStatusTwo) {
   expect_usage_error("units MAX_SPEED 20000step/s",
                      "l6470emu units: MAX_SPEED: 20000 step/s is above the largest value, 15609.7412109375 step/s (0x3FF)");
   expect_usage_error("units --variant L6482 T_FAST 4us",
-                     "l6470emu units: T_FAST holds 2 values: convert TOFF_FAST and FAST_STEP one at a time (or give a "
-                     "register value)");
+                     "l6470emu units: T_FAST holds 2 values: TOFF_FAST and FAST_STEP, each with its own scale: convert "
+                     "one at a time (or give a register value)");
 }
 
 }  // namespace
