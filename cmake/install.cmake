@@ -76,17 +76,40 @@ if(L6470EMU_HELP2MAN)
             -P ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
     DEPENDS l6470emu ${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
     COMMENT "Generating the l6470emu(1) man page")
-  add_custom_target(l6470emu_manpage ALL DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1)
+  # Installed compressed, as Debian's policy asks (man reads it the same everywhere).
+  add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/l6470emu.1.gz
+    COMMAND gzip -9nc ${PROJECT_BINARY_DIR}/l6470emu.1 > ${PROJECT_BINARY_DIR}/l6470emu.1.gz
+    DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1 VERBATIM)
+  add_custom_target(l6470emu_manpage ALL DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1 ${PROJECT_BINARY_DIR}/l6470emu.1.gz)
   if(L6470EMU_TESTS)  # the page in the C locale: ASCII stand-ins, never "??" (skipped without man-db)
     add_test(NAME manpage COMMAND sh ${PROJECT_SOURCE_DIR}/tests/tools/manpage_test.sh ${PROJECT_BINARY_DIR}/l6470emu.1)
     set_tests_properties(manpage PROPERTIES LABELS tools SKIP_RETURN_CODE 77)
   endif()
-  install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 else()
   message(STATUS "l6470emu: help2man not found: no man page (apt-get install help2man)")
 endif()
 
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# The copyright file (Debian's machine-readable format) and, for the .deb (a native package),
+# a Debian changelog entry for this version, compressed as the policy asks.
+install(FILES ${CMAKE_CURRENT_LIST_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
+set(L6470EMU_PACKAGE_CONTACT "l6470emu maintainers <maintainers@l6470emu.invalid>" CACHE STRING
+    "Maintainer field of the .deb and its changelog")
+string(TIMESTAMP L6470EMU_CHANGELOG_DATE "%a, %d %b %Y %H:%M:%S +0000" UTC)  # SOURCE_DATE_EPOCH if set
+file(WRITE ${PROJECT_BINARY_DIR}/changelog
+"l6470emu (${PROJECT_VERSION}) unstable; urgency=medium
+
+  * Built with CPack from the l6470emu source tree; the project's history is
+    its git log.
+
+ -- ${L6470EMU_PACKAGE_CONTACT}  ${L6470EMU_CHANGELOG_DATE}
+")
+add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/changelog.gz
+  COMMAND gzip -9nc ${PROJECT_BINARY_DIR}/changelog > ${PROJECT_BINARY_DIR}/changelog.gz
+  DEPENDS ${PROJECT_BINARY_DIR}/changelog VERBATIM)
+add_custom_target(l6470emu_changelog ALL DEPENDS ${PROJECT_BINARY_DIR}/changelog.gz)
+install(FILES ${PROJECT_BINARY_DIR}/changelog.gz DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} FILES_MATCHING PATTERN "*.md")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples DESTINATION ${CMAKE_INSTALL_DOCDIR}
   PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)

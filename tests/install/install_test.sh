@@ -4,7 +4,7 @@
 # find_package and with pkg-config, and run; the README's Arduino sketch (examples/arduino-sketch)
 # built with the installed l6470emu_add_sketch and run; every installed header compiles; the installed
 # Python module finds the installed preload library and its pytest plugin loads through the
-# entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
+# entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked (the README names exactly the packages of its Depends), lintian finds no error in it, it is unpacked
 # into a throwaway root with dpkg -x, and the consumer is built and run against that too.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
@@ -71,7 +71,8 @@ step "cmake --install into a temporary prefix"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 for f in bin/l6470emu include/l6470emu/core/chip.hpp include/l6470emu/daisychain/host.hpp \
-         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md \
+         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1.gz share/doc/l6470emu/README.md \
+         share/doc/l6470emu/copyright share/doc/l6470emu/changelog.gz \
          include/l6470emu/firmware/firmware.h include/l6470emu/firmware/arduino/Arduino.h include/l6470emu/firmware/arduino/SPI.h \
          include/l6470emu/firmware/stm32/stm32f4xx_hal.h libexec/l6470emu/l6470emu-ino; do
   [ -f "$prefix/$f" ] || fail "not installed: $f"
@@ -136,7 +137,8 @@ deb=$(ls "$work"/deb/l6470emu_*.deb)
 dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./||' >"$work/deb.files"
 for pattern in usr/bin/l6470emu 'usr/lib/.*l6470emu/libl6470emu-preload\.so' 'usr/lib/.*libl6470emu_core\.a' \
                'usr/lib/.*cmake/l6470emu/l6470emuConfig\.cmake' 'usr/lib/.*pkgconfig/l6470emu\.pc' \
-               usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1 \
+               usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1.gz \
+               usr/share/doc/l6470emu/copyright usr/share/doc/l6470emu/changelog.gz \
                usr/include/l6470emu/firmware/arduino/Arduino.h usr/include/l6470emu/firmware/stm32/stm32_hal.h \
                usr/libexec/l6470emu/l6470emu-ino 'usr/lib/.*cmake/l6470emu/l6470emuFirmware\.cmake' \
                usr/share/doc/l6470emu/README.md usr/share/doc/l6470emu/examples/cmake-consumer/main.cpp \
@@ -154,6 +156,42 @@ for d in libc6 libstdc++6 'python3 (>= 3'; do
   [[ "$depends" == *"$d"* ]] || fail ".deb Depends '$depends' lacks $d"
 done
 [[ "$depends" == *spidev* || "$depends" == *gpiod* ]] && fail ".deb Depends '$depends' names a user-side package"
+
+step "the README names exactly the packages the .deb depends on"
+# The packages of Depends ("libfuse3-3 (>= 3.12.0), python3 (<< 3.12)" -> libfuse3-3 python3), and
+# the backquoted names of the README's sentence "The `.deb` depends on ..." (up to its semicolon).
+deb_names=$(printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/[ (].*//' | sort -u | tr '\n' ' ')
+sentence=$(tr '\n' ' ' <"$source/README.md" | grep -o 'The `\.deb` depends on [^;]*;' | head -n1)
+[ -n "$sentence" ] || fail "the README has no sentence 'The \`.deb\` depends on ...'"
+readme_names=$(printf '%s\n' "$sentence" | grep -o '`[a-z0-9][a-z0-9.+-]*`' | tr -d '`' | grep -vx 'deb' | sort -u | tr '\n' ' ')
+[ "$deb_names" = "$readme_names" ] || fail "the README says the .deb depends on '$readme_names'; its Depends: '$depends'"
+python_pin=$(printf '%s\n' "$depends" | grep -o 'python3 (<< [0-9.]*)' || true)
+if [ -n "$python_pin" ]; then
+  lowest=$(printf '%s\n' "$depends" | grep -o 'python3 (>= [0-9.]*)' | sed 's/.*>= //; s/)//')
+  [[ "$sentence" == *"$lowest"* ]] || fail "the README does not say the .deb needs Python $lowest ($depends)"
+fi
+
+step "the copyright file is machine-readable and lintian finds no error"
+copyright=$(dpkg-deb --fsys-tarfile "$deb" | tar -xO ./usr/share/doc/l6470emu/copyright)
+head -n1 <<<"$copyright" | grep -qx 'Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/' \
+  || fail "usr/share/doc/l6470emu/copyright is not in the machine-readable format"
+if command -v lintian >/dev/null; then
+  # Warnings that stay, each for a reason:
+  #  maintscript-calls-ldconfig: CPack's DEB generator writes postinst/postrm calling ldconfig
+  #    for any .so under /usr/lib; the preload library is no shared library users link (it is
+  #    only ever LD_PRELOADed by path), so the call is harmless and needs no trigger.
+  #  pkg-config-unavailable-for-cross-compilation: the libraries and l6470emu.pc go to
+  #    /usr/lib (CMake's layout for this package), not the multiarch directory; the libraries
+  #    are for the host the package is built for.
+  lintian_out=$(lintian --allow-root "$deb" 2>&1 || true)
+  printf '%s\n' "$lintian_out" | sed 's/^/   lintian: /'
+  printf '%s\n' "$lintian_out" | grep -q '^E: ' && fail "lintian reports errors (above)"
+  unexpected=$(printf '%s\n' "$lintian_out" | grep '^W: ' |
+    grep -v 'maintscript-calls-ldconfig\|pkg-config-unavailable-for-cross-compilation' || true)
+  [ -z "$unexpected" ] || fail "lintian warnings without a reason given here: $unexpected"
+else
+  step "lintian not installed (scripts/setup.sh installs it): the .deb was not checked by it"
+fi
 
 step "the .deb unpacked into a throwaway root (dpkg -x)"
 root=$work/root
