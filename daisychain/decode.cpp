@@ -1,6 +1,7 @@
 // decode_trace: formats ProtocolTracker events, one line each, and rate-limits repeated
 // diagnostics so a host that always sends the wrong frame length does not drown the log.
 #include "daisychain/decode.hpp"
+#include "core/counted.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -197,7 +198,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
   const std::string name = in.header().name;
   if (options.only_chip >= 0 && static_cast<std::size_t>(options.only_chip) >= chain.size())
     throw std::invalid_argument("chip " + std::to_string(options.only_chip) + ": the chain has " +
-                                std::to_string(chain.size()) + " chips (0.." + std::to_string(chain.size() - 1) + ")");
+                                counted(chain.size(), "chip") + " (0.." + std::to_string(chain.size() - 1) + ")");
   Decoder decoder(out, options, name, ChipNumbering(options.number_from, chain.size()));
   ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); }, options.number_from);
   TraceEvent e;

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/counted.hpp"
 #include "support/trace_test_support.hpp"
 
 namespace l6470emu {
@@ -135,6 +136,15 @@ TEST(UnitsCommand, BadRegistersVariantsAndValuesAreOneLineWithStatusTwo) {
   expect_usage_error("units --variant L6482 T_FAST 4us",
                      "l6470emu units: T_FAST holds 2 values: TOFF_FAST and FAST_STEP, each with its own scale: convert "
                      "one at a time (or give a register value)");
+}
+
+TEST(Messages, CountOneThingInTheSingular) {
+  EXPECT_EQ(counted(1, "chip"), "1 chip");
+  EXPECT_EQ(counted(0, "chip"), "0 chips");
+  EXPECT_EQ(counted(3, "match", "matches"), "3 matches");
+  const RunResult r = l6470emu("decode --chip 1 " + test::fixture_path("single_chip.trace"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("l6470emu decode: --chip 1: the chain has 1 chip\n"), std::string::npos) << r.out;
 }
 
 }  // namespace
