@@ -54,6 +54,16 @@ python_module() {
   [ "$(realpath "$found")" = "$(realpath "$preload")" ] || fail "$name: preload_library() is $found, not $preload"
 }
 
+# The installed program PROGRAM's `serve` names the installed preload library PRELOAD in its
+# "run programs with" line.
+serve_names_preload() {
+  local program=$1 preload=$2 name=$3
+  step "$name: l6470emu serve names the installed preload library"
+  env -u L6470EMU_PRELOAD timeout 5 "$program" serve --socket "$work/$name.sock" >"$work/$name-serve.log" 2>&1 || true
+  grep -q "run programs with: LD_PRELOAD=$(realpath "$preload") L6470EMU_SOCKET=" "$work/$name-serve.log" \
+    || { cat "$work/$name-serve.log"; fail "$name: serve does not name $preload"; }
+}
+
 # The installed program PROGRAM draws a picture with the installed package (no PYTHONPATH).
 plot_command() {
   local program=$1 name=$2
@@ -114,6 +124,7 @@ site=$(dirname "$(dirname "$(find "$prefix" -name pytest_plugin.py -path '*/l647
 case "$site" in "$prefix"/lib/python3.[0-9]*/dist-packages) ;; *) fail "Python package in '$site', not lib/python3.X/dist-packages" ;; esac
 python_module "$site" "$preload" prefix
 plot_command "$prefix/bin/l6470emu" prefix
+serve_names_preload "$prefix/bin/l6470emu" "$preload" prefix
 
 step "prefix: the pytest plugin loads through its entry point (no conftest)"
 mkdir -p "$work/plugin"
@@ -200,5 +211,6 @@ dpkg -x "$deb" "$root"
 consumers "$root/usr" deb
 python_module "$root/usr/lib/python3/dist-packages" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
 plot_command "$root/usr/bin/l6470emu" deb
+serve_names_preload "$root/usr/bin/l6470emu" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
 
 echo "install_test: 1 passed, 0 failed"

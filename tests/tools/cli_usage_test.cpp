@@ -138,6 +138,16 @@ TEST(UnitsCommand, BadRegistersVariantsAndValuesAreOneLineWithStatusTwo) {
                      "one at a time (or give a register value)");
 }
 
+TEST(ServeCommand, NamesThePreloadLibraryItFindsBesideItself) {
+  test::TempDir dir;
+  const std::string binary = L6470EMU_BINARY;
+  const std::string preload = binary.substr(0, binary.rfind('/')) + "/libl6470emu-preload.so";
+  const RunResult r = run_command("env -u L6470EMU_PRELOAD timeout 2 " + binary + " serve --socket " + dir.file("s.sock"));
+  EXPECT_NE(r.out.find("run programs with: LD_PRELOAD=" + preload + " L6470EMU_SOCKET=" + dir.file("s.sock")),
+            std::string::npos)
+      << r.out;
+}
+
 TEST(Messages, CountOneThingInTheSingular) {
   EXPECT_EQ(counted(1, "chip"), "1 chip");
   EXPECT_EQ(counted(0, "chip"), "0 chips");

@@ -36,7 +36,10 @@ start=$(date +%s%N)
 set +e
 # One virtual CPU by default: with two, the guest's kernel hands work between vCPU threads that
 # a loaded host deschedules, and the guest's timing follows the host's load (docs/linux.md).
-timeout "${L6470EMU_VM_TIMEOUT:-300}" qemu-system-x86_64 -accel tcg -m 1024 -smp "${L6470EMU_VM_SMP:-1}" \
+# L6470EMU_VM_ICOUNT=N: the guest's clock counts executed instructions (2^N ns each), not host time.
+icount=()
+[ -n "${L6470EMU_VM_ICOUNT:-}" ] && icount=(-icount "shift=$L6470EMU_VM_ICOUNT,sleep=off")
+timeout "${L6470EMU_VM_TIMEOUT:-300}" qemu-system-x86_64 -accel tcg -m 1024 -smp "${L6470EMU_VM_SMP:-1}" "${icount[@]}" \
   -nographic -no-reboot -nic none \
   -kernel "$vm/vmlinuz" -initrd "$vm/initramfs.cpio.gz" \
   -virtfs local,path=/,mount_tag=hostroot,security_model=none,readonly=on,multidevs=remap \
