@@ -5,7 +5,7 @@
 # paths (a checkout or build under /tmp or /run too: they are bound over the guest's tmpfs);
 # /tmp/vmwork is a directory shared with the host (kept on failure when L6470EMU_VM_KEEP=1).
 # Exit 124 when the VM did not finish within L6470EMU_VM_TIMEOUT s (300). L6470EMU_VM_SMP sets
-# the guest's CPUs (default 1).
+# the guest's CPUs (default 1), L6470EMU_VM_ICOUNT its clock (below).
 set -euo pipefail
 vm=${1:?usage: run-vm.sh VM_DIR COMMAND...}
 shift
@@ -34,11 +34,11 @@ for d in "$PWD" "${L6470EMU_SOURCE:-}" "${L6470EMU_BUILD:-}"; do
 done | sort -u | awk 'NR == 1 || index($0, last "/") != 1 { print; last = $0 }' > "$work/keep"
 start=$(date +%s%N)
 set +e
-# One virtual CPU by default: with two, the guest's kernel hands work between vCPU threads that
-# a loaded host deschedules, and the guest's timing follows the host's load (docs/linux.md).
-# L6470EMU_VM_ICOUNT=N: the guest's clock counts executed instructions (2^N ns each), not host time.
+# The guest's time must not follow the host's load (docs/linux.md, "Kernel nodes"): one virtual
+# CPU (L6470EMU_VM_SMP), and a guest clock that counts executed instructions, 2^N ns each
+# (L6470EMU_VM_ICOUNT=N, default 0; "off" = the host's clock), skipping idle time.
 icount=()
-[ -n "${L6470EMU_VM_ICOUNT:-}" ] && icount=(-icount "shift=$L6470EMU_VM_ICOUNT,sleep=off")
+[ "${L6470EMU_VM_ICOUNT:-0}" != off ] && icount=(-icount "shift=${L6470EMU_VM_ICOUNT:-0},sleep=off")
 timeout "${L6470EMU_VM_TIMEOUT:-300}" qemu-system-x86_64 -accel tcg -m 1024 -smp "${L6470EMU_VM_SMP:-1}" "${icount[@]}" \
   -nographic -no-reboot -nic none \
   -kernel "$vm/vmlinuz" -initrd "$vm/initramfs.cpio.gz" \
