@@ -6,6 +6,9 @@
 # Prints each harness's executions, coverage and time. Exits non-zero when any input crashed,
 # hung or ran out of memory; that input is kept in tests/fuzz/regressions/<harness>/.
 # Usage: scripts/fuzz.sh [SECONDS_PER_HARNESS]
+# The pass is seeded (L6470EMU_FUZZ_SEED, default 1) so that CI explores the same mutations on the
+# same code: a new finding comes with a change, not with the luck of a run. Set another seed (or 0,
+# libFuzzer's random one) for longer local runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -52,7 +55,7 @@ for h in "${harnesses[@]}"; do
   mkdir -p "$scratch/$h" "tests/fuzz/regressions/$h"
   start=$(date +%s)
   rc=0
-  "$build/tests/fuzz/fuzz_$h" -max_total_time="$seconds" -timeout=25 -print_final_stats=1 "${extra[@]}" \
+  "$build/tests/fuzz/fuzz_$h" -max_total_time="$seconds" -seed="${L6470EMU_FUZZ_SEED:-1}" -timeout=25 -print_final_stats=1 "${extra[@]}" \
     -artifact_prefix="tests/fuzz/regressions/$h/" "$scratch/$h" "tests/fuzz/corpus/$h" >"$logs/$h.log" 2>&1 || rc=$?
   elapsed=$(($(date +%s) - start))
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$logs/$h.log" | tail -1)

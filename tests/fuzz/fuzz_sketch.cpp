@@ -21,7 +21,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // The prototypes, as the preprocessor finds them in the files joined (its #line lines are
   // directives, which the tokenizer skips), make the one block it may insert.
   std::string joined;
-  for (const SketchFile& f : files) joined += "#line 1 \"" + f.path + "\"\n" + f.text + "\n";
+  for (const SketchFile& f : files) {
+    joined += "#line 1 \"" + f.path + "\"\n" + f.text;
+    if (joined.back() != '\n') joined += '\n';  // as prepare_sketch ends a file: one newline, none doubled
+  }
   std::string block;
   for (const std::string& p : sketch_prototypes(joined)) block += p + "\n";
   bool inserted = block.empty();  // no prototypes: nothing is inserted anywhere
