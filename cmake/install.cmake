@@ -6,15 +6,15 @@
 # The locations themselves are set in cmake/install_dirs.cmake (included first).
 include(CMakePackageConfigHelpers)
 
-# Installed headers keep the in-tree spelling: include/l6470emu/core/chip.hpp is reached as
-# <l6470emu/core/chip.hpp>, and include/l6470emu is on the include path too, so the headers'
-# own "core/x.hpp" includes resolve (as they do from the source tree).
+# Installed headers are reached as <l6470emu/core/chip.hpp> with -I<prefix>/include only: their
+# own includes are rewritten to "l6470emu/core/x.hpp" when they are staged (install_headers.cmake),
+# so no generic core/, spi/, linux/ folder lands on a consumer's include path.
 set(layers core spi daisychain board linux)
 foreach(layer ${layers})
   set_target_properties(l6470emu_${layer} PROPERTIES EXPORT_NAME ${layer})
 endforeach()
 target_include_directories(l6470emu_core INTERFACE
-  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/l6470emu>)
+  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 target_compile_features(l6470emu_core PUBLIC cxx_std_20)
 
 # l6470emu::l6470emu: every layer at once.
@@ -36,17 +36,24 @@ install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_board l6
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/l6470emu)
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/firmware DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
-  FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h"
-  PATTERN "*_internal.hpp" EXCLUDE
-  PATTERN "sketch_prep.hpp" EXCLUDE)
 install(FILES ${CMAKE_CURRENT_LIST_DIR}/l6470emuFirmware.cmake DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
-list(TRANSFORM layers PREPEND ${PROJECT_SOURCE_DIR}/ OUTPUT_VARIABLE layer_dirs)
-install(DIRECTORY ${layer_dirs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
-  FILES_MATCHING PATTERN "*.hpp"
-  PATTERN "preload" EXCLUDE           # the preload library's own internals
-  PATTERN "*_internal.hpp" EXCLUDE
-  PATTERN "import_support.hpp" EXCLUDE)
+# The headers of every layer and of the firmware fronts, staged with their includes rewritten
+# (not the preload library's internals, *_internal.hpp, import_support.hpp, sketch_prep.hpp).
+set(header_layers ${layers} firmware)
+set(staged_include ${PROJECT_BINARY_DIR}/staged-include)
+set(public_headers)
+foreach(layer ${header_layers})
+  file(GLOB_RECURSE h CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/${layer}/*.hpp ${PROJECT_SOURCE_DIR}/${layer}/*.h)
+  list(APPEND public_headers ${h})
+endforeach()
+add_custom_command(OUTPUT ${staged_include}/stamp
+  COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${staged_include} "-DLAYERS=${header_layers}"
+          -P ${CMAKE_CURRENT_LIST_DIR}/install_headers.cmake
+  COMMAND ${CMAKE_COMMAND} -E touch ${staged_include}/stamp
+  DEPENDS ${public_headers} ${CMAKE_CURRENT_LIST_DIR}/install_headers.cmake
+  COMMENT "Staging the installed headers (includes spelled l6470emu/...)" VERBATIM)
+add_custom_target(l6470emu_staged_headers ALL DEPENDS ${staged_include}/stamp)
+install(DIRECTORY ${staged_include}/l6470emu DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT l6470emuTargets NAMESPACE l6470emu:: DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
 
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/l6470emuConfig.cmake.in

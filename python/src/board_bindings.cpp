@@ -72,7 +72,10 @@ py::dict axis_state(const Chip& chip) {
 
 void attach_axis_text(Chip& chip, const std::string& text) {
   AxisSpec spec;
-  if (const Axis* a = chip.axis()) spec = a->spec();  // items given change the axis attached
+  if (const Axis* a = chip.axis()) {  // items given change the axis attached; the rotor stays where it is
+    spec = a->spec();
+    spec.start_position = a->true_position();
+  }
   if (std::string err = parse_axis_spec(text, spec); !err.empty()) throw py::value_error("axis: " + err);
   chip.attach_axis(spec);
 }

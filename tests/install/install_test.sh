@@ -19,20 +19,35 @@ step() { echo "-- $*"; }
 # Builds and runs the CMake consumer and the pkg-config consumer against PREFIX.
 consumers() {
   local prefix=$1 name=$2
+  rm -rf "$work/clash"
+  # A consumer's own core/, spi/, daisychain/, board/ folders first on the path: any installed
+  # header still including "core/x.hpp" would reach them and stop at their #error.
+  for layer in core spi daisychain board linux firmware; do
+    mkdir -p "$work/clash/$layer"
+    for h in "$prefix"/include/l6470emu/"$layer"/*.hpp; do
+      if [ -e "$h" ]; then echo "#error \"the consumer's own $layer/$(basename "$h") was included\"" >"$work/clash/$layer/$(basename "$h")"; fi
+    done
+  done
+  leftover=$(grep -rlE '#include "(core|spi|daisychain|board|linux|firmware)/' "$prefix/include/l6470emu" || true)
+  [ -z "$leftover" ] || fail "$name: installed headers still include by the in-tree spelling: $leftover"
   step "$name: the CMake consumer (find_package(l6470emu CONFIG REQUIRED))"
+  # (with the consumer's own clashing core/, spi/, ... folders first on the path)
   cmake -S "$source/examples/cmake-consumer" -B "$work/$name-cmake" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-    -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: configure"; }
+    -DCMAKE_CXX_FLAGS="-I$work/clash" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: configure"; }
   cmake --build "$work/$name-cmake" >>"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: build"; }
   out=$("$work/$name-cmake/stepper_check") || fail "$name: stepper_check exited $?"
   [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: stepper_check printed '$out'"
 
-  step "$name: the pkg-config consumer"
+  step "$name: the pkg-config consumer (its flags only: C++20 and -I<prefix>/include come from the .pc)"
   local pc
   pc=$(dirname "$(find "$prefix" -name l6470emu.pc -print -quit)")
   [ -n "$pc" ] || fail "$name: no l6470emu.pc"
   flags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags --libs l6470emu) || fail "$name: pkg-config l6470emu"
+  cflags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags l6470emu)
+  [[ " $cflags " == *" -std=c++20 "* ]] || fail "$name: the .pc's Cflags lack -std=c++20: $cflags"
+  [[ "$cflags" != *include/l6470emu* ]] || fail "$name: the .pc puts include/l6470emu on the include path: $cflags"
   # shellcheck disable=SC2086
-  c++ -std=c++20 -O1 -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
+  c++ -O1 -I"$work/clash" -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
   out=$("$work/$name-pc") || fail "$name: pkg-config consumer exited $?"
   [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: pkg-config consumer printed '$out'"
 
