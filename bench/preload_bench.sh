@@ -119,8 +119,10 @@ fi
 echo
 printf '%-46s %14s\n' "CUSE SPI_IOC_MESSAGE ioctls (serve --cuse)" "per second"
 # Measured by tests/vm (ctest -L vm -V prints "GetStatus: N messages in S s = R ioctls/s"): a
-# static client in a QEMU guest without KVM (TCG), every ioctl three round trips to the daemon.
-printf '%-46s %14s\n' "in the QEMU guest (TCG), recorded from tests/vm" "~3029"
+# static client in a QEMU guest without KVM (TCG), every ioctl three round trips to the daemon,
+# in guest time counted in instructions (-icount shift=0: 1 ns each), so independent of the
+# host's load (10632 and 10634 at load averages 9 and 27; docs/linux.md, "Kernel nodes").
+printf '%-46s %14s\n' "in the QEMU guest (TCG, -icount), from tests/vm" "~10630"
 if [[ "$cuse" =~ ^[0-9.]+$ ]]; then
   printf '%-46s %14.0f\n' "on this host (wall clock, bus-bound)" "$cuse"
 else

@@ -3,7 +3,7 @@
 #include "board/board_config.hpp"
 
 #include "board/axis_config.hpp"
-#include "board/suggest.hpp"
+#include "core/near_miss.hpp"
 
 #include <algorithm>
 #include <array>
@@ -114,17 +114,6 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-std::vector<std::string> variant_names() {
-  std::vector<std::string> names;
-  for (const Variant* v : all_variants()) names.emplace_back(v->name);
-  return names;
-}
-
-std::string variant_suggestion(std::string_view name) {
-  const std::string near = closest(name, variant_names());
-  return near.empty() ? "" : "did you mean " + near + "? ";
-}
-
 // Words users write for a key under another name.
 std::string_view key_alias(std::string_view key) {
   static constexpr std::pair<std::string_view, std::string_view> kAliases[] = {
@@ -150,7 +139,7 @@ std::string key_suggestion(std::string_view key) {
   if (const std::string_view alias = key_alias(key); !alias.empty()) return std::string(alias);
   std::vector<std::string> names;
   for (const KeySpec& k : kKeys) names.emplace_back(k.name);
-  return closest(key, names);
+  return closest_names(key, names);
 }
 
 template <typename T>

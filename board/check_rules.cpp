@@ -5,7 +5,7 @@
 #include <cctype>
 #include <vector>
 
-#include "board/suggest.hpp"
+#include "core/near_miss.hpp"
 
 namespace l6470emu {
 namespace {
@@ -95,7 +95,7 @@ std::string_view to_string(CheckLevel level) {
 std::optional<CheckLevel> parse_check_level(std::string_view text, std::string& error) {
   for (CheckLevel l : {CheckLevel::off, CheckLevel::warn, CheckLevel::error})
     if (text == to_string(l)) return l;
-  const std::string near = closest(text, {"off", "warn", "error"});
+  const std::string near = closest_names(text, {"off", "warn", "error"});
   error = "must be off, warn or error, not " + quoted(text) + (near.empty() ? "" : " (did you mean " + near + "?)");
   return std::nullopt;
 }
@@ -114,7 +114,7 @@ std::optional<RuleSet> parse_rule_list(std::string_view text, std::string& error
     }
     const auto rule = rule_named(item);
     if (!rule) {
-      const std::string near = closest(item, names());
+      const std::string near = closest_names(item, names());
       error = "names no rule " + quoted(item) + " (" + (near.empty() ? "" : "did you mean " + near + "? ") +
               "rules: " + all_rule_names() + ")";
       return std::nullopt;

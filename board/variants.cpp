@@ -2,6 +2,7 @@
 #include <string>
 
 #include "board/board_config.hpp"
+#include "core/near_miss.hpp"
 
 namespace l6470emu {
 
@@ -11,13 +12,6 @@ const Variant* lookup_variant(std::string_view name) {
   return find_variant(name);
 }
 
-std::string known_variant_names() {
-  std::string out;
-  for (const Variant* v : all_variants()) {
-    if (!out.empty()) out += ", ";
-    out += v->name;
-  }
-  return out;
-}
+std::string known_variant_names() { return known_variant_list(); }
 
 }  // namespace l6470emu

@@ -6,15 +6,15 @@
 # The locations themselves are set in cmake/install_dirs.cmake (included first).
 include(CMakePackageConfigHelpers)
 
-# Installed headers keep the in-tree spelling: include/l6470emu/core/chip.hpp is reached as
-# <l6470emu/core/chip.hpp>, and include/l6470emu is on the include path too, so the headers'
-# own "core/x.hpp" includes resolve (as they do from the source tree).
+# Installed headers are reached as <l6470emu/core/chip.hpp> with -I<prefix>/include only: their
+# own includes are rewritten to "l6470emu/core/x.hpp" when they are staged (install_headers.cmake),
+# so no generic core/, spi/, linux/ folder lands on a consumer's include path.
 set(layers core spi daisychain board linux)
 foreach(layer ${layers})
   set_target_properties(l6470emu_${layer} PROPERTIES EXPORT_NAME ${layer})
 endforeach()
 target_include_directories(l6470emu_core INTERFACE
-  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/l6470emu>)
+  $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 target_compile_features(l6470emu_core PUBLIC cxx_std_20)
 
 # l6470emu::l6470emu: every layer at once.
@@ -36,17 +36,24 @@ install(TARGETS l6470emu_core l6470emu_spi l6470emu_daisychain l6470emu_board l6
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_LIBEXECDIR}/l6470emu)
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/firmware DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
-  FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h"
-  PATTERN "*_internal.hpp" EXCLUDE
-  PATTERN "sketch_prep.hpp" EXCLUDE)
 install(FILES ${CMAKE_CURRENT_LIST_DIR}/l6470emuFirmware.cmake DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
-list(TRANSFORM layers PREPEND ${PROJECT_SOURCE_DIR}/ OUTPUT_VARIABLE layer_dirs)
-install(DIRECTORY ${layer_dirs} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/l6470emu
-  FILES_MATCHING PATTERN "*.hpp"
-  PATTERN "preload" EXCLUDE           # the preload library's own internals
-  PATTERN "*_internal.hpp" EXCLUDE
-  PATTERN "import_support.hpp" EXCLUDE)
+# The headers of every layer and of the firmware fronts, staged with their includes rewritten
+# (not the preload library's internals, *_internal.hpp, import_support.hpp, sketch_prep.hpp).
+set(header_layers ${layers} firmware)
+set(staged_include ${PROJECT_BINARY_DIR}/staged-include)
+set(public_headers)
+foreach(layer ${header_layers})
+  file(GLOB_RECURSE h CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/${layer}/*.hpp ${PROJECT_SOURCE_DIR}/${layer}/*.h)
+  list(APPEND public_headers ${h})
+endforeach()
+add_custom_command(OUTPUT ${staged_include}/stamp
+  COMMAND ${CMAKE_COMMAND} -DSRC=${PROJECT_SOURCE_DIR} -DOUT=${staged_include} "-DLAYERS=${header_layers}"
+          -P ${CMAKE_CURRENT_LIST_DIR}/install_headers.cmake
+  COMMAND ${CMAKE_COMMAND} -E touch ${staged_include}/stamp
+  DEPENDS ${public_headers} ${CMAKE_CURRENT_LIST_DIR}/install_headers.cmake
+  COMMENT "Staging the installed headers (includes spelled l6470emu/...)" VERBATIM)
+add_custom_target(l6470emu_staged_headers ALL DEPENDS ${staged_include}/stamp)
+install(DIRECTORY ${staged_include}/l6470emu DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(EXPORT l6470emuTargets NAMESPACE l6470emu:: DESTINATION ${L6470EMU_INSTALL_CMAKEDIR})
 
 configure_package_config_file(${CMAKE_CURRENT_LIST_DIR}/l6470emuConfig.cmake.in
@@ -76,13 +83,40 @@ if(L6470EMU_HELP2MAN)
             -P ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
     DEPENDS l6470emu ${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
     COMMENT "Generating the l6470emu(1) man page")
-  add_custom_target(l6470emu_manpage ALL DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1)
-  install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  # Installed compressed, as Debian's policy asks (man reads it the same everywhere).
+  add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/l6470emu.1.gz
+    COMMAND gzip -9nc ${PROJECT_BINARY_DIR}/l6470emu.1 > ${PROJECT_BINARY_DIR}/l6470emu.1.gz
+    DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1 VERBATIM)
+  add_custom_target(l6470emu_manpage ALL DEPENDS ${PROJECT_BINARY_DIR}/l6470emu.1 ${PROJECT_BINARY_DIR}/l6470emu.1.gz)
+  if(L6470EMU_TESTS)  # the page in the C locale: ASCII stand-ins, never "??" (skipped without man-db)
+    add_test(NAME manpage COMMAND sh ${PROJECT_SOURCE_DIR}/tests/tools/manpage_test.sh ${PROJECT_BINARY_DIR}/l6470emu.1)
+    set_tests_properties(manpage PROPERTIES LABELS tools SKIP_RETURN_CODE 77)
+  endif()
+  install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 else()
   message(STATUS "l6470emu: help2man not found: no man page (apt-get install help2man)")
 endif()
 
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+# The copyright file (Debian's machine-readable format) and, for the .deb (a native package),
+# a Debian changelog entry for this version, compressed as the policy asks.
+install(FILES ${CMAKE_CURRENT_LIST_DIR}/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR})
+set(L6470EMU_PACKAGE_CONTACT "l6470emu maintainers <maintainers@l6470emu.invalid>" CACHE STRING
+    "Maintainer field of the .deb and its changelog")
+string(TIMESTAMP L6470EMU_CHANGELOG_DATE "%a, %d %b %Y %H:%M:%S +0000" UTC)  # SOURCE_DATE_EPOCH if set
+file(WRITE ${PROJECT_BINARY_DIR}/changelog
+"l6470emu (${PROJECT_VERSION}) unstable; urgency=medium
+
+  * Built with CPack from the l6470emu source tree; the project's history is
+    its git log.
+
+ -- ${L6470EMU_PACKAGE_CONTACT}  ${L6470EMU_CHANGELOG_DATE}
+")
+add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/changelog.gz
+  COMMAND gzip -9nc ${PROJECT_BINARY_DIR}/changelog > ${PROJECT_BINARY_DIR}/changelog.gz
+  DEPENDS ${PROJECT_BINARY_DIR}/changelog VERBATIM)
+add_custom_target(l6470emu_changelog ALL DEPENDS ${PROJECT_BINARY_DIR}/changelog.gz)
+install(FILES ${PROJECT_BINARY_DIR}/changelog.gz DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR} FILES_MATCHING PATTERN "*.md")
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples DESTINATION ${CMAKE_INSTALL_DOCDIR}
   PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)

@@ -5,16 +5,14 @@
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME l6470emu)
 set(CPACK_PACKAGE_VENDOR "l6470emu")
-set(L6470EMU_PACKAGE_CONTACT "l6470emu maintainers <maintainers@l6470emu.invalid>" CACHE STRING
-    "Maintainer field of the .deb")
 set(CPACK_PACKAGE_CONTACT "${L6470EMU_PACKAGE_CONTACT}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "register-level emulator of the ST L6470-family SPI motion engines")
 set(CPACK_PACKAGE_DESCRIPTION
-    "Emulates the L6470, L6472, L6480, L6482 and powerSTEP01 byte-exactly on SPI, in daisy\n\
-chains, in virtual time: C++ libraries and headers (CMake package and pkg-config),\n\
-an LD_PRELOAD library that gives unmodified programs /dev/spidevB.C and\n\
-/dev/gpiochipN, the l6470emu program (replay, decode, convert traces; serve),\n\
-and the l6470emu Python module with its pytest plugin.")
+    "Emulates the L6470, L6472, L6480, L6482 and powerSTEP01 byte-exactly on SPI,\n\
+in daisy chains, in virtual time: C++ libraries and headers (CMake package and\n\
+pkg-config), an LD_PRELOAD library that gives unmodified programs\n\
+/dev/spidevB.C and /dev/gpiochipN, the l6470emu program (replay, decode,\n\
+convert traces; serve), and the l6470emu Python module with its pytest plugin.")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_STRIP_FILES ON)  # the program and the preload library

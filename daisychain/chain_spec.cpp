@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 
+#include "core/near_miss.hpp"
 #include "spi/import_support.hpp"  // quote(): input in messages, cut short, control characters as \xNN
 
 namespace l6470emu {
@@ -36,11 +37,9 @@ std::vector<const Variant*> parse_chain_spec(std::string_view spec) {
       }
     }
     const Variant* v = find_variant(name);
-    if (v == nullptr) {
-      std::string known;
-      for (const Variant* a : all_variants()) known += (known.empty() ? "" : ", ") + std::string(a->name);
-      throw std::invalid_argument("unknown chip variant " + detail::quote(name) + " (" + known + ")");
-    }
+    if (v == nullptr)
+      throw std::invalid_argument("unknown chip variant " + detail::quote(name) + " (" + variant_suggestion(name) +
+                                  "known: " + known_variant_list() + ")");
     if (count == 0) throw std::invalid_argument("chain item " + detail::quote(item) + " has no chips");
     if (out.size() + count > Chain::kMaxChips)
       throw std::invalid_argument("a chain has at most " + std::to_string(Chain::kMaxChips) + " chips");

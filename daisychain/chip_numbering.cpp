@@ -1,5 +1,6 @@
 // Chip numbering conventions: names, parsing and the line that says which one is in use.
 #include "daisychain/chip_numbering.hpp"
+#include "core/counted.hpp"
 
 #include <cctype>
 #include <stdexcept>
@@ -37,7 +38,7 @@ std::string describe_numbering(NumberFrom from) {
 
 std::string trace_chip_outside_chain(std::size_t chip, std::size_t chips) {
   return "event for chip " + std::to_string(chip) + " (trace files count from the MISO end), but the chain has " +
-         std::to_string(chips) + " chips (see --chain)";
+         counted(chips, "chip") + " (see --chain)";
 }
 
 }  // namespace l6470emu

@@ -1,8 +1,10 @@
 // decode_trace: formats ProtocolTracker events, one line each, and rate-limits repeated
 // diagnostics so a host that always sends the wrong frame length does not drown the log.
 #include "daisychain/decode.hpp"
+#include "core/counted.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <iterator>
@@ -94,8 +96,10 @@ class Decoder {
            numbering_.number_of(chip) == static_cast<std::size_t>(options_.only_chip);
   }
 
-  /// A pin or fault line at `t`; `previous_seconds` is when the event before it ended.
-  void pin(const TraceEvent& e, double t, double previous_seconds) {
+  /// A pin or fault line at `t`; `previous_seconds` is when the event before it ended. For a
+  /// BUSY/FLAG observation, `edge_seconds` is when the emulated chip's output took the observed
+  /// level (NaN when it did not by then), `at_edge` whether that was the observation's own tick.
+  void pin(const TraceEvent& e, double t, double previous_seconds, double edge_seconds = NAN, bool at_edge = false) {
     if (!shown(e.chip)) return;
     std::string what;
     const bool level = e.value != 0;
@@ -114,10 +118,18 @@ class Decoder {
         const bool first = seen_outputs_.insert({e.chip, static_cast<int>(e.pin)}).second;
         if (first) {
           what += ", seen at (its level when watching began)";
+        } else if (at_edge) {
+          // Recorded at the edge's own tick (a program waiting on the line makes the board step
+          // to each edge): the line is the edge, nothing to add.
         } else {
           char buf[64];
-          std::snprintf(buf, sizeof buf, "%.6f", previous_seconds);
-          what += std::string(", seen at (the edge was not watched: it came after t=") + buf + " s)";
+          if (edge_seconds == edge_seconds) {
+            std::snprintf(buf, sizeof buf, "%.6f", edge_seconds);
+            what += std::string(", seen at (the edge was not watched: the emulator's came at t=") + buf + " s)";
+          } else {
+            std::snprintf(buf, sizeof buf, "%.6f", previous_seconds);
+            what += std::string(", seen at (the edge was not watched: it came after t=") + buf + " s)";
+          }
         }
       }
     } else if (e.kind == TraceEventKind::load) {
@@ -209,7 +221,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
   const std::string name = in.header().name;
   if (options.only_chip >= 0 && static_cast<std::size_t>(options.only_chip) >= chain.size())
     throw std::invalid_argument("chip " + std::to_string(options.only_chip) + ": the chain has " +
-                                std::to_string(chain.size()) + " chips (0.." + std::to_string(chain.size() - 1) + ")");
+                                counted(chain.size(), "chip") + " (0.." + std::to_string(chain.size() - 1) + ")");
   Decoder decoder(out, options, name, ChipNumbering(options.number_from, chain.size()));
   ProtocolTracker tracker(chain, [&decoder](const ProtocolEvent& e) { decoder.on_event(e); }, options.number_from);
   DivergenceWatch watch(name, ChipNumbering(options.number_from, chain.size()));
@@ -238,6 +250,29 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
     }
     if (e.chip >= chain.size())
       throw TraceError(name, e.line, trace_chip_outside_chain(e.chip, chain.size()));
+    const bool output = e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG);
+    // Where the emulated output took the observed level: a copy of the chip before the event,
+    // searched up to the observation's tick.
+    Tick edge = kNever;
+    if (output && chain.now() <= e.tick) {
+      Chip probe = chain.chip(e.chip);
+      probe.set_diagnostic_sink({});
+      const auto level_at = [&](Tick tick) {
+        Chip c = probe;
+        c.advance_to(tick);
+        return (e.pin == TracePin::BUSY ? c.busy_sync_pin() : c.flag_pin()) == (e.value != 0);
+      };
+      if (level_at(probe.now())) {
+        edge = probe.now();  // it changed with the event before (a frame's CS rising edge)
+      } else if (level_at(e.tick)) {
+        Tick lo = probe.now(), hi = e.tick;  // not at lo, at hi
+        while (hi - lo > 1) {
+          const Tick mid = lo + (hi - lo) / 2;
+          (level_at(mid) ? hi : lo) = mid;
+        }
+        edge = hi;
+      }
+    }
     tracker.apply(e);
     const double t = display_seconds(e.tick, e.source_time);
     if (e.kind == TraceEventKind::advance) continue;  // time only
@@ -246,7 +281,12 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       watch.observation(e, e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin());
       check(diverged);
     }
-    decoder.pin(e, t, previous);
+    if (output && edge != kNever) {
+      const double before = static_cast<double>(e.tick - edge) / static_cast<double>(kTicksPerSecond);
+      decoder.pin(e, t, previous, t - before, edge == e.tick);
+    } else {
+      decoder.pin(e, t, previous);
+    }
     // Outputs looked at together share one bound; an input or fault is an event of its own.
     if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) previous = t;
     decoder.flush(std::min(tracker.pending_answer_seconds(), t));

@@ -99,4 +99,15 @@ void ChainHost::hard_stop(std::size_t k) { frame_byte(k, 0xB8); }
 void ChainHost::soft_hiz(std::size_t k) { frame_byte(k, 0xA0); }
 void ChainHost::hard_hiz(std::size_t k) { frame_byte(k, 0xA8); }
 
+bool ChainHost::wait_until_idle(std::size_t k, Tick timeout) {
+  const Tick deadline = bus_.now() + timeout;
+  for (;;) {
+    if (chain_.chip(k).busy_sync_pin()) return true;
+    const Tick now = bus_.now();
+    if (now >= deadline) return false;
+    const Tick next = chain_.chip(k).next_event_tick();
+    bus_.advance_to(next == kNever || next > deadline ? deadline : std::max(next, now + 1));
+  }
+}
+
 }  // namespace l6470emu

@@ -9,6 +9,7 @@
 
 #include "core/registers.hpp"
 #include "daisychain/chain.hpp"
+#include "daisychain/chip_status.hpp"
 #include "spi/spi_device.hpp"
 
 namespace l6470emu {
@@ -48,6 +49,31 @@ class ChainHost {
   void hard_stop(std::size_t k);
   void soft_hiz(std::size_t k);
   void hard_hiz(std::size_t k);
+
+  // ---- typed forms (Direction, SwitchAction, ChipStatus) -----------------------------------
+
+  void run(std::size_t k, Direction dir, std::uint32_t spd) { run(k, dir == Direction::forward, spd); }
+  void step_clock(std::size_t k, Direction dir) { step_clock(k, dir == Direction::forward); }
+  void move(std::size_t k, Direction dir, std::uint32_t n_step) { move(k, dir == Direction::forward, n_step); }
+  void go_to_dir(std::size_t k, Direction dir, std::int32_t abs_pos) { go_to_dir(k, dir == Direction::forward, abs_pos); }
+  void go_until(std::size_t k, SwitchAction act, Direction dir, std::uint32_t spd) {
+    go_until(k, act == SwitchAction::copy_to_mark, dir == Direction::forward, spd);
+  }
+  void release_sw(std::size_t k, SwitchAction act, Direction dir) {
+    release_sw(k, act == SwitchAction::copy_to_mark, dir == Direction::forward);
+  }
+  /// GetStatus, decoded with chip k's layout (the chip clears its latched flags).
+  ChipStatus status(std::size_t k) { return ChipStatus(get_status(k), chain_.chip(k).status_layout()); }
+  /// GetParam(STATUS), decoded: the same bits, nothing cleared.
+  ChipStatus peek_status(std::size_t k) {
+    return ChipStatus(static_cast<std::uint16_t>(get_param(k, Reg::STATUS)), chain_.chip(k).status_layout());
+  }
+  /// Lets time pass until chip k's BUSY pin is high (its command done), at most `timeout`
+  /// ticks, without a frame on the bus: time jumps from one of the chip's events to the next
+  /// and stops at the tick BUSY rises. Returns whether it did (false: still busy at the timeout).
+  bool wait_until_idle(std::size_t k, Tick timeout);
+  /// The same with the timeout in milliseconds.
+  bool wait_until_idle_ms(std::size_t k, std::uint64_t timeout_ms) { return wait_until_idle(k, ticks_from_ms(timeout_ms)); }
 
   /// Lets `ticks` of virtual time pass.
   void wait(Tick ticks) { bus_.advance_to(bus_.now() + ticks); }

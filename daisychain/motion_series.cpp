@@ -4,6 +4,7 @@
 // sampled at its own tick; a regular grid adds the curve in between. Long runs are thinned
 // per time slice afterwards.
 #include "daisychain/motion_series.hpp"
+#include "core/counted.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -132,9 +133,8 @@ class Sampler {
       for (std::size_t u = 0; u < chain.size(); ++u) chips.push_back(u);
     for (std::size_t u : chips) {
       if (u >= chain.size())
-        throw std::invalid_argument("chip " + std::to_string(u) + ": the chain has " + std::to_string(chain.size()) +
-                                    " chips (0.." + std::to_string(chain.size() - 1) + "; " + numbering.description() +
-                                    ")");
+        throw std::invalid_argument("chip " + std::to_string(u) + ": the chain has " + counted(chain.size(), "chip") +
+                                    " (0.." + std::to_string(chain.size() - 1) + "; " + numbering.description() + ")");
       const std::size_t k = numbering.index_of(u);
       if (wanted_[k] >= 0) continue;
       wanted_[k] = static_cast<int>(series_.size());

@@ -1,6 +1,7 @@
 // FirmwareRuntime: time and its costs, the pins as the board wires them, edges turned into
 // pending interrupts, delivery, SPI controllers, the end of a run.
 #include "firmware/runtime.hpp"
+#include "core/counted.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -573,7 +574,7 @@ void FirmwareRuntime::check_rules() {
 void FirmwareRuntime::stop_at_limit() {
   std::string why = "firmware run stopped at its time limit: " + seconds_text(now_) + " of virtual time (limit=" +
                     limit_text(timing_.limit_ticks) + ")";
-  if (front_ == FirmwareFront::arduino) why += "; loop() had run " + std::to_string(loops) + " times";
+  if (front_ == FirmwareFront::arduino) why += "; loop() had run " + counted(loops, "time");
   stop(0, why);
 }
 

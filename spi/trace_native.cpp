@@ -2,6 +2,7 @@
 // `repeat` lines, and writing with one flush per event and runs of repeated frames
 // collapsed. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
+#include "core/counted.hpp"
 
 #include "spi/import_support.hpp"
 #include "spi/trace_file.hpp"
@@ -311,8 +312,8 @@ void NativeTraceReader::parse_repeat(std::string_view rest, std::string_view tim
   const Kept& last = kept_[(kept_next_ + kMaxRepeatGroup - 1) % kMaxRepeatGroup];
   if (period == 0) fail("repeat: period " + quoted(period_tok) + " is 0: repetitions take time" + form);
   if (period < last.tick + last.duration - first.tick)
-    fail("repeat: period " + quoted(period_tok) + " is shorter than the " + std::to_string(group) +
-         " frames it repeats (" + format_microseconds(last.tick + last.duration - first.tick) + " us from the first CS "
+    fail("repeat: period " + quoted(period_tok) + " is shorter than the " + counted(group, "frame") +
+         " it repeats (" + format_microseconds(last.tick + last.duration - first.tick) + " us from the first CS "
          "falling edge to the last CS rising edge): repetitions would overlap");
   const Tick limit = kMaxNativeTraceTick - last.duration;  // the last repetition's CS rising edge fits too
   if (open) {
@@ -460,8 +461,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     if (max_frames_ != 0 && frames_ >= max_frames_) fail("the trace holds " + too_many_frames(max_frames_));
     ++frames_;
     if (in_miso && miso_.size() != mosi_.size())
-      fail("frame has " + std::to_string(mosi_.size()) + " MOSI bytes but " + std::to_string(miso_.size()) +
-           " MISO bytes");
+      fail("frame has " + counted(mosi_.size(), "MOSI byte") + " but " + counted(miso_.size(), "MISO byte"));
     e.mosi = mosi_;
     if (in_miso) e.miso = miso_;
     if (any_unknown) e.miso_known = known_;

@@ -13,6 +13,7 @@
 #include <ostream>
 
 #include "daisychain/chain_spec.hpp"
+#include "core/counted.hpp"
 #include "daisychain/emulated_vcd.hpp"
 #include "spi/export_umockdev.hpp"
 #include "spi/export_vcd.hpp"
@@ -176,7 +177,7 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err) {
       std::unique_ptr<TraceReader> reader = file.read();
       const UmockdevExportStats s = export_umockdev_ioctl(*reader, *dst, args.device);
       if (s.frames_without_miso)
-        err << "note: " << s.frames_without_miso << " frames without a complete MISO: written without R (don't care)\n";
+        err << "note: " << counted(s.frames_without_miso, "frame") << " without a complete MISO: written without R (don't care)\n";
     } else {
       const Trace trace = file.load();
       if (args.no_emulation) {

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "daisychain/chain_spec.hpp"
+#include "core/counted.hpp"
 #include "daisychain/decode.hpp"
 #include "tools/progress.hpp"
 #include "tools/trace_commands.hpp"
@@ -29,17 +30,18 @@ int run_decode(const DecodeArgs& args, std::ostream& out, std::ostream& err) {
     options.number_from = number_from;
     if (args.chip >= 0 && static_cast<std::size_t>(args.chip) >= chain.size())
       throw std::invalid_argument("--chip " + std::to_string(args.chip) + ": the chain has " +
-                                  std::to_string(chain.size()) + " chips");
+                                  counted(chain.size(), "chip"));
     std::unique_ptr<TraceReader> reader = file.read();
     // The log goes to standard output: a bar on the terminal only when that is elsewhere.
     ProgressBar bar = isatty(STDOUT_FILENO) == 1 ? ProgressBar(err, false, "") : ProgressBar::on_stderr("decoding " + file.path());
     ProgressTraceReader watched(*reader, bar);
     const DecodeSummary s = decode_trace(watched, chain, out, options);
     bar.finish();
-    out << "# " << s.frames << " frames, " << s.commands << " commands, " << s.answers << " answers, " << s.diagnostics
-        << " diagnostics";
+    out << "# " << counted(s.frames, "frame") << ", " << counted(s.commands, "command") << ", "
+        << counted(s.answers, "answer") << ", " << counted(s.diagnostics, "diagnostic");
     if (s.suppressed) out << " (" << s.suppressed << " not shown: --max-repeats 0 shows all)";
-    if (s.answer_mismatches) out << ", " << s.answer_mismatches << " answers the emulator would give differently (see replay)";
+    if (s.answer_mismatches)
+      out << ", " << counted(s.answer_mismatches, "answer") << " the emulator would give differently (see replay)";
     out << "\n";
     if (s.divergence.found) {
       // Said at the end too, and by the exit status: the log after that point is a model.

@@ -113,7 +113,8 @@ void add_plot_command(CLI::App& app) {
   p->add_option("--number-from", a->number_from,
                 "chip 0 is the chip driving MISO (miso, the default) or the one reading the host's MOSI (mosi)");
   p->add_option("--from", a->from, "window start, seconds from the trace's start (a capture's own clock counts from 0 here)");
-  p->add_option("--to", a->to, "window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)");
+  p->add_option("--to", a->to,
+                "window end, seconds (default: the trace's end, plus up to 1 s while a move goes on, drawn 4% longer)");
   p->add_option("--chain", a->chain,
                 "the emulated chain (3, 2*L6470,L6480), or the board description of one chain (\"chips=L6470 "
                 "axis.0=stops=0..256000,switch=home@0\"); default: the trace's own");
@@ -131,7 +132,7 @@ void add_plot_command(CLI::App& app) {
                     std::to_string(kDefaultMaxTraceFrames) + "; 0 = no limit)");
   p->add_option("--title", a->title, "the picture's title (default: the file and the chain)");
   p->add_option("--size", a->size, "width x height in inches (default 10x7.5)");
-  p->add_option("--dpi", a->dpi, "PNG resolution (default 100)");
+  p->add_option("--dpi", a->dpi, "PNG resolution, and of the images an SVG embeds for dense series (default 100)");
   p->callback([a, p] { run_plot(*a, *p); });
 }
 

@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "daisychain/chain_spec.hpp"
+#include "core/counted.hpp"
 #include "daisychain/replay.hpp"
 #include "tools/progress.hpp"
 #include "tools/trace_commands.hpp"
@@ -41,7 +42,7 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
     });
     bar.finish();
 
-    out << file.path() << ": " << r.frames << " frames, " << r.bytes_compared << " MISO bytes compared";
+    out << file.path() << ": " << counted(r.frames, "frame") << ", " << counted(r.bytes_compared, "MISO byte") << " compared";
     if (r.bytes_unknown) out << " (" << r.bytes_unknown << " not captured)";
     if (r.pin_checks) out << ", " << r.pin_checks << " BUSY/FLAG levels checked";
     if (r.matched()) {
@@ -51,8 +52,8 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
     if (r.stopped_early) {
       out << ": DIVERGED (stopped at the first divergence; --continue reports them all)\n";
     } else {
-      out << ": DIVERGED in " << r.divergent_frames << " frames";
-      if (r.pin_mismatches) out << " and " << r.pin_mismatches << " pin levels";
+      out << ": DIVERGED in " << counted(r.divergent_frames, "frame");
+      if (r.pin_mismatches) out << " and " << counted(r.pin_mismatches, "pin level");
       if (r.divergences.size() < r.divergent_frames + r.pin_mismatches)
         out << " (" << r.divergences.size() << " reported; --max-reports)";
       out << "\n";

@@ -9,6 +9,7 @@
 #include "linux/device_paths.hpp"
 #include "linux/serve/control.hpp"
 #include "linux/serve/daemon.hpp"
+#include "tools/install_paths.hpp"
 #include "tools/kernel_nodes.hpp"
 
 namespace l6470emu {
@@ -125,7 +126,7 @@ std::optional<int> ServeCommands::run() {
       }
       front_ends = kernel_front_ends(cuse_, uhid_, access);
     }
-    return run_daemon(config, socket, std::cout, std::cerr, front_ends);
+    return run_daemon(config, socket, std::cout, std::cerr, front_ends, preload_library_path(own_program_path()));
   }
   if (ctl_ && *ctl_) {
     std::vector<std::string> all = {command_word_};

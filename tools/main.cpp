@@ -4,7 +4,9 @@
 #include <iostream>
 #include <sstream>
 
+#include "tools/cli_errors.hpp"
 #include "tools/cmd_plot.hpp"
+#include "tools/cmd_units.hpp"
 #include "tools/cmd_serve.hpp"
 #include "tools/demo.hpp"
 #include "tools/tables.hpp"
@@ -49,15 +51,17 @@ int main(int argc, char** argv) {
   std::string readme;
   auto* tables = app.add_subcommand("tables", "print the tables the model uses, as Markdown");
   tables->add_option("--table", table, "which table")
-      ->check(CLI::IsMember({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
-                             "variant-differences", "sanitizer-rules"}));
+      ->check(l6470emu::one_of({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
+                                "variant-differences", "sanitizer-rules", "units"}));
   tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
 
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::add_trace_commands(app);             // replay, decode, convert
   l6470emu::add_plot_command(app);               // plot (python3 -m l6470emu.plot)
+  l6470emu::add_units_command(app);              // units (register values <-> step/s, mA, ...)
 
-  CLI11_PARSE(app, argc, argv);
+  // Every usage error: one line, a suggestion for a near miss, exit status 2.
+  if (auto status = l6470emu::parse_command_line(app, argc, argv, std::cout, std::cerr)) return *status;
   if (auto status = serve_commands.run()) return *status;
   if (*demo) return l6470emu::run_demo(chips, seconds, std::cout);
   if (*tables) {

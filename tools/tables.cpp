@@ -2,6 +2,7 @@
 #include "tools/tables.hpp"
 
 #include "board/check_rules.hpp"
+#include "tools/cmd_units.hpp"
 
 #include <array>
 #include <cstdio>
@@ -275,6 +276,7 @@ std::string generated_block(std::string_view name) {
   if (name == "l6470-registers") return register_table_markdown(l6470());
   if (name == "l6470-status") return status_table_markdown(l6470());
   if (name == "commands") return command_table_markdown();
+  if (name == "units") return units_table_markdown();
   return "";
 }
 

@@ -34,7 +34,7 @@ std::string variant_differences_markdown();
 std::string sanitizer_rules_markdown();
 
 /// The generated block called `name` ("l6470-registers", "l6470-status", "commands", "variant-registers",
-/// "variant-status", "variant-differences", "sanitizer-rules"), or "" if unknown.
+/// "variant-status", "variant-differences", "sanitizer-rules", "units"), or "" if unknown.
 std::string generated_block(std::string_view name);
 
 /// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of

@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "tools/cli_errors.hpp"
+
 #include <csignal>
 #include <iostream>
 #include <memory>
@@ -58,7 +60,7 @@ void add_trace_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("TRACE", a.path, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
       ->required();
   sub->add_option("--format", a.format, "input format (default: recognised from the content)")
-      ->check(CLI::IsMember({"auto", "native", "saleae", "umockdev", "ftrace", "sigrok", "vcd"}));
+      ->check(one_of({"auto", "native", "saleae", "umockdev", "ftrace", "sigrok", "vcd"}));
   sub->add_option("--chain", a.chain,
                   "the emulated chain, chip 0 (MISO end) first: N, N*VARIANT or a list (3, 2*L6470,L6480), or the "
                   "board description of one chain (\"chips=L6470 axis.0=stops=0..256000,switch=home@0\"); "
@@ -70,7 +72,7 @@ void add_trace_options(CLI::App* sub, TraceArgs& a) {
                   "the stream to take when the file has several: Saleae analyzer name, ftrace device (spi0.0), "
                   "sigrok decoder (spi-1)");
   sub->add_option("--framing", a.framing, "ftrace CS frames: auto, cs (spi_set_cs), transfer, message")
-      ->check(CLI::IsMember({"auto", "cs", "transfer", "message"}));
+      ->check(one_of({"auto", "cs", "transfer", "message"}));
   sub->add_option("--sigrok-decoder", a.sigrok_decoder,
                   "sigrok-cli decoder for VCD/.sr captures (default spi:clk=SCK:mosi=MOSI:miso=MISO:cs=CS:cpol=1:cpha=1)");
   sub->add_option("--max-frames", a.max_frames,
@@ -124,7 +126,7 @@ void add_trace_commands(CLI::App& app) {
   c->add_option("-o,--output", convert->output, "file to write (- = standard output; a name ending in .gz is gzip-compressed)")
       ->required();
   c->add_option("--to", convert->to, "output format (default: from the extension before any .gz: .vcd, .ioctl, else native)")
-      ->check(CLI::IsMember({"auto", "native", "vcd", "ioctl"}));
+      ->check(one_of({"auto", "native", "vcd", "ioctl"}));
   c->add_option("--device", convert->device, "umockdev: the spidev node the recording is for");
   c->add_option("--timescale-ns", convert->timescale_ns, "VCD time unit in ns (1, 10 or 100)")
       ->check(CLI::IsMember({1u, 10u, 100u}));

@@ -15,3 +15,18 @@ def test_a_move_ends_on_target_and_leaves_the_other_chip_alone(spidev_board):
     assert "chip 1   Move(REV, 3200 microsteps)" in log
     assert "chip 0   Move" not in log
     assert spidev_board.replay().matched  # the recording replays byte-exact
+
+
+@pytest.mark.l6470_chain("2xL6470")
+def test_the_driver_class_in_the_test_process(l6470_board, monkeypatch):
+    # The driver's own spidev.SpiDev becomes the board's; its time.sleep/monotonic are the board's
+    # (the fixture's patch_time), so wait_idle's polling takes virtual time only.
+    import stepper_driver
+    monkeypatch.setattr(stepper_driver.spidev, "SpiDev", l6470_board.SpiDev)
+    chain = stepper_driver.StepperChain(2)
+    chain.status(1)
+    chain.move(1, 6400)
+    chain.wait_idle(1)
+    assert chain.position(1) == 6400 and chain.position(0) == 0
+    assert l6470_board.seconds > 0.1           # the move took virtual time
+    assert "chip 1   Move(FWD, 6400 microsteps)" in l6470_board.decode()

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "board/check_rules.hpp"
-#include "board/suggest.hpp"
+#include "core/near_miss.hpp"
 #include "linux/log.hpp"
 #include "linux/preload/state.hpp"
 
@@ -56,7 +56,7 @@ std::string unknown_environment_variables(char** env) {
     bool is_known = false;
     for (const auto& k : known) is_known = is_known || k == name;
     if (is_known) continue;
-    const std::string near = closest(name, known);
+    const std::string near = closest_names(name, known);
     std::string line = "l6470emu: unknown environment variable " + name.substr(0, 80) + ": nothing reads it";
     if (!near.empty()) line += " (did you mean " + near + "?)";
     line += "; the preload reads L6470EMU_CHAIN, _CONFIG, _SOCKET, _LOG, _TRACE, _SHM, _CHECK, _CHECK_ALLOW\n";

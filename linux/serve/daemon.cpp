@@ -215,7 +215,7 @@ std::string default_socket_path() {
 }
 
 int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err,
-               const FrontEnds& front_ends) {
+               const FrontEnds& front_ends, const std::string& preload_library) {
   sockaddr_un addr;
   if (!fill_address(socket_path, addr)) {
     err << "l6470emu serve: socket path too long or empty: " << socket_path << "\n";
@@ -317,7 +317,8 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   out << "  " << describe_numbering(config.numbering) << " (ctl and diagnostics; numbering=)\n";
   for (std::size_t i = 0; i < board.chain_count(); ++i)
     if (const std::string path = board.recording_path(i); !path.empty()) out << "  recording to " << path << "\n";
-  out << "run programs with: LD_PRELOAD=<path>/libl6470emu-preload.so L6470EMU_SOCKET=" << socket_path << " <program>\n";
+  out << "run programs with: LD_PRELOAD=" << (preload_library.empty() ? "<path>/libl6470emu-preload.so" : preload_library)
+      << " L6470EMU_SOCKET=" << socket_path << " <program>\n";
   out.flush();
 
   bool warned_descriptors = false, warned_clients = false;

@@ -22,10 +22,11 @@ class DeviceBoard;
 /// it prints to `out` goes before the daemon's "run programs with" line.
 using FrontEnds = std::function<std::shared_ptr<void>(DeviceBoard& board, std::ostream& out, std::string& error)>;
 
-/// Serves `config` on `socket_path` until SIGINT or SIGTERM. Prints one line when ready.
+/// Serves `config` on `socket_path` until SIGINT or SIGTERM. Prints one line when ready, naming
+/// `preload_library` as the LD_PRELOAD to use ("<path>/libl6470emu-preload.so" when empty).
 /// Returns the exit status (non-zero when the socket or a front end cannot be set up).
 int run_daemon(const BoardConfig& config, const std::string& socket_path, std::ostream& out, std::ostream& err,
-               const FrontEnds& front_ends = {});
+               const FrontEnds& front_ends = {}, const std::string& preload_library = {});
 
 /// Sends one control command to the daemon at `socket_path`; prints its answer.
 int run_ctl(const std::string& socket_path, const std::string& command, std::ostream& out, std::ostream& err);

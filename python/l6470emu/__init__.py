@@ -6,8 +6,11 @@ a driver sanitizer (check="error" by default: the first broken rule of the chip 
 SanitizerError with its report; check_rules() lists the rules),
 STATUS decoded (Status), and recording into native traces that replay() and decode() read;
 motion() samples what each chip did over a trace, and l6470emu.plot draws it (matplotlib).
-The pytest plugin (l6470emu.pytest_plugin) gives tests the l6470_chain and spidev_board
-fixtures; preload_library() finds libl6470emu-preload.so for running unmodified programs.
+Board is a board description's board in the test process: spidev.SpiDev-like devices and
+libgpiod-like lines in virtual time (l6470emu.board). The pytest plugin (l6470emu.pytest_plugin)
+gives tests the l6470_chain, l6470_board and spidev_board fixtures; preload_library() finds
+libl6470emu-preload.so for running unmodified programs.
+l6470emu.units converts register values to physical units (step/s, mA, ...) and back.
 """
 from ._l6470emu import (
     DEFAULT_MAX_FRAMES,
@@ -43,11 +46,14 @@ from ._l6470emu import (
 )
 from ._paths import preload_library, program
 from ._status import Status
+from . import units
+from .board import Board
 
 __all__ = [
     "DEFAULT_MAX_FRAMES",
     "MAX_MOTION_POINTS",
     "TICKS_PER_SECOND",
+    "Board",
     "Bridge",
     "Chain",
     "ChipMotion",
@@ -76,6 +82,7 @@ __all__ = [
     "preload_library",
     "program",
     "register_table",
+    "units",
     "replay",
     "variants",
 ]

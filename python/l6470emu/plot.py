@@ -21,6 +21,16 @@ SECONDS_PER_TICK = 1.0 / _l6470emu.TICKS_PER_SECOND
 STEPS_PER_S_PER_SPEED_UNIT = _l6470emu.TICKS_PER_SECOND / 2.0**28
 #: Command labels are written next to their markers when a picture has at most this many.
 MAX_LABELLED_COMMANDS = 40
+#: A window with no end given is drawn this much longer (a fraction of its span) than its last
+#: event, so an edge there (the final BUSY rise) is seen; chips at rest keep their state into it.
+END_MARGIN = 0.04
+#: A pin lane still holding more level changes than this is drawn as an image in an SVG (a
+#: picture is about a thousand pixels wide), and so are the markers of a chip with more commands
+#: than MAX_VECTOR_MARKERS: vectors there would only draw over each other, in megabytes.
+MAX_VECTOR_EDGES = 1000
+MAX_VECTOR_MARKERS = 400
+#: A chip's position and speed are drawn as images in an SVG when it has more samples than this.
+MAX_VECTOR_SAMPLES = 10000
 #: The bounds of motion(): the most samples per chip, and the most frames a trace may hold by default.
 MAX_POINTS = _l6470emu.MAX_MOTION_POINTS
 DEFAULT_MAX_FRAMES = _l6470emu.DEFAULT_MAX_FRAMES
@@ -119,6 +129,90 @@ def _time_scale(motion) -> tuple:
     return 1.0, "s"
 
 
+def _pin_steps(t, levels):
+    """The samples of a pin drawn as steps (each level held until the next sample) that change
+    what is drawn: the first, each one whose level differs from the one before, and the last.
+    The same picture exactly, with one point per edge instead of one per sample."""
+    import numpy as np
+    levels = np.asarray(levels, dtype=np.float64)
+    if len(levels) <= 2:
+        return np.asarray(t, dtype=np.float64), levels
+    keep = np.empty(len(levels), dtype=bool)
+    keep[0] = keep[-1] = True
+    keep[1:-1] = levels[1:-1] != levels[:-2]
+    return np.asarray(t, dtype=np.float64)[keep], levels[keep]
+
+
+def _command_labels(ax, notes):
+    """Writes the command labels (x, y, text, colour) beside their markers and keeps any two
+    from overlapping, whatever the size, resolution or output type (see _LabelLayout)."""
+    texts = [ax.annotate(text, (x, y), xytext=(4, 6), textcoords="offset points", fontsize=7, color=colour,
+                         annotation_clip=False)
+             for x, y, text, colour in sorted(notes, key=lambda n: n[0])]
+    for t in texts:
+        t.set_in_layout(False)  # the layout below moves them; the axes' size must not follow
+    ax.add_artist(_LabelLayout(texts))
+
+
+def _label_layout_artist():
+    from matplotlib.artist import Artist
+
+    class LabelLayout(Artist):
+        """Places command labels when the figure is drawn, in the renderer's own pixels (so for
+        any size, resolution and file type), so that no two labels' boxes meet: in time order,
+        each takes the free place nearest its marker, above or under it, inside the axes if it can.
+        Drawn before the labels (lowest zorder); draws nothing itself."""
+        zorder = -1e9
+
+        def __init__(self, texts):
+            super().__init__()
+            self.texts = texts
+            self.set_in_layout(False)
+
+        def draw(self, renderer):
+            if not self.texts:
+                return
+            ax = self.axes
+            inside = ax.get_window_extent(renderer)
+            to_px = renderer.points_to_pixels(1.0)  # pixels per point
+            gap = 1.5 * to_px  # pixels kept free between two labels
+            placed = []  # (x0, y0, x1, y1) in pixels
+            for text in self.texts:
+                text.xyann = (4, 6)
+                box = text.get_window_extent(renderer)  # its place 6 points above its marker
+                _, ay = ax.transData.transform(text.xy)
+                down = (ay - 6 * to_px) - box.y1  # the shift putting it as far under the marker
+                # Where it may go: its own place, under the marker, or just above or under a
+                # label already placed; the nearest free one, inside the axes if one is.
+                shifts = {0.0, down}
+                for p in placed:
+                    shifts.update((p[3] + gap - box.y0, p[1] - gap - box.y1))
+
+                def cost(shift):
+                    r = (box.y0 + shift, box.y1 + shift)
+                    outside = not (inside.y0 <= r[0] and r[1] <= inside.y1)
+                    return (outside, shift if shift >= 0 else down - shift + 0.5)
+
+                choice = None
+                for shift in sorted((x for x in shifts if x >= 0 or x <= down), key=cost):
+                    r = (box.x0, box.y0 + shift, box.x1, box.y1 + shift)
+                    g = 0.99 * gap  # (a place computed to be `gap` away is not lost to rounding)
+                    if not any(r[0] < p[2] + g and p[0] < r[2] + g and r[1] < p[3] + g and p[1] < r[3] + g
+                               for p in placed):
+                        choice = shift
+                        break
+                # (Just above the highest label placed is always free, so a place is found.)
+                placed.append((box.x0, box.y0 + choice, box.x1, box.y1 + choice))
+                text.xyann = (4, 6 + choice / to_px)
+            self.stale = False
+
+    return LabelLayout
+
+
+def _LabelLayout(texts):
+    return _label_layout_artist()(texts)
+
+
 def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: Optional[float] = None,
            end: Optional[float] = None, format: Optional[str] = None, select: str = "", max_points: int = 4000,
            title: Optional[str] = None, size=(10.0, 7.5), position_unit: Optional[Tuple[str, float]] = None,
@@ -150,6 +244,11 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
     fig = Figure(figsize=size, layout="constrained")
     pos_ax, speed_ax, pin_ax = fig.subplots(3, 1, sharex=True, height_ratios=[3, 2, 2])
     colours = [f"C{i % 10}" for i in range(len(motion.chips))]
+    x_start, x_end = motion.start * SECONDS_PER_TICK * scale, motion.end * SECONDS_PER_TICK * scale
+    # A window given an end is drawn as given; one ending on the last event gets a margin after it.
+    # (A Motion brings its own window, which may end before the next command.)
+    margin = END_MARGIN * (x_end - x_start) if end is None and not isinstance(source, _l6470emu.Motion) else 0.0
+    x_end += margin
     total_commands = sum(len(c.commands) for c in motion.chips)
     labels: List[str] = []
     notes: List[tuple] = []  # command labels: (x, y, text, colour)
@@ -158,30 +257,33 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
         pos = np.asarray(c.abs_pos, dtype=np.float64) / per_unit
         speed = np.asarray(c.speed, dtype=np.float64) * STEPS_PER_S_PER_SPEED_UNIT
         name = f"chip {c.number} {c.variant} (1/{c.microsteps_per_step})"
-        pos_ax.plot(t, pos, color=colour, linewidth=1.6, label=name)
-        speed_ax.plot(t, speed, color=colour, linewidth=1.4)
+        # In the margin past the last event a chip at rest stays as it was (nothing moves it).
+        held = margin > 0 and len(t) > 0 and c.speed[-1] == 0
+        t_held = np.append(t, x_end) if held else t
+        dense = len(t) > MAX_VECTOR_SAMPLES  # (--max-points above it) many samples to a pixel column
+        pos_ax.plot(t_held, np.append(pos, pos[-1]) if held else pos, color=colour, linewidth=1.6, label=name,
+                    rasterized=dense)
+        speed_ax.plot(t_held, np.append(speed, speed[-1]) if held else speed, color=colour, linewidth=1.4,
+                      rasterized=dense)
         if c.commands and len(t):
             ct = np.asarray([m.tick for m in c.commands], dtype=np.float64) * SECONDS_PER_TICK * scale
             cp = np.interp(ct, t, pos)
             pos_ax.plot(ct, cp, linestyle="none", marker="v", markersize=7, color=colour,
-                        markeredgecolor="black", markeredgewidth=0.6, zorder=3)
+                        markeredgecolor="black", markeredgewidth=0.6, zorder=3,
+                        rasterized=len(ct) > MAX_VECTOR_MARKERS)  # overprinted: an image in an SVG
             notes.extend((x, y, m.name, colour) for x, y, m in zip(ct, cp, c.commands))
         # The pins as logic traces, one lane per pin (high = the upper edge of the lane, shaded).
         for k, (pin, levels) in enumerate((("BUSY", c.busy), ("FLAG", c.flag), ("SW", c.sw))):
             lane = 3.0 * (len(motion.chips) - 1 - n) + (2 - k)
-            y = lane + 0.1 + 0.7 * np.asarray(levels, dtype=np.float64)
-            pin_ax.plot(t, y, drawstyle="steps-post", color=colour, linewidth=1.2)
-            pin_ax.fill_between(t, lane + 0.1, y, step="post", color=colour, alpha=0.2, linewidth=0)
+            tp, levels = _pin_steps(t_held, list(levels) + ([levels[-1]] if held else []))
+            y = lane + 0.1 + 0.7 * levels
+            dense = len(tp) > MAX_VECTOR_EDGES  # an edge per pixel column or more: an image in an SVG
+            pin_ax.plot(tp, y, drawstyle="steps-post", color=colour, linewidth=1.2, rasterized=dense)
+            pin_ax.fill_between(tp, lane + 0.1, y, step="post", color=colour, alpha=0.2, linewidth=0,
+                                rasterized=dense)
             labels.append((lane + 0.45, f"{pin}{c.number}"))
     if total_commands <= MAX_LABELLED_COMMANDS:
-        # Labels of commands close together in time (any chip) are stacked, not overprinted.
-        close = (motion.end - motion.start) * SECONDS_PER_TICK * scale / 40
-        stack, last_x = 0, None
-        for x, y, text, colour in sorted(notes, key=lambda n: n[0]):
-            stack = stack + 1 if last_x is not None and x - last_x < close else 0
-            last_x = x if stack == 0 else last_x
-            pos_ax.annotate(text, (x, y), xytext=(4, 6 + 9 * stack), textcoords="offset points", fontsize=7,
-                            color=colour)
+        _command_labels(pos_ax, notes)  # labels of commands close in time stacked, never overprinted
     pos_ax.set_ylabel(f"ABS_POS ({pos_unit})")
     pos_ax.legend(loc="best", fontsize=8)
     pos_ax.grid(True, alpha=0.3)
@@ -192,7 +294,7 @@ def figure(source, *, chain=None, chips: Optional[Sequence[int]] = None, start: 
     pin_ax.set_ylabel("pins (high / low)")
     pin_ax.grid(True, axis="x", alpha=0.3)
     pin_ax.set_xlabel(f"time ({unit})")
-    pin_ax.set_xlim(motion.start * SECONDS_PER_TICK * scale, motion.end * SECONDS_PER_TICK * scale)
+    pin_ax.set_xlim(x_start, x_end)
     if title is None:
         name = source if isinstance(source, (str, Path)) else getattr(source, "name", None)
         title = f"{Path(name).name if isinstance(name, (str, Path)) else 'recording'}: chain {motion.chain}"
@@ -272,7 +374,8 @@ def _arguments(argv):
     p.add_argument("--from", dest="start", type=float,
                    help="window start, seconds from the trace's start (a capture's own clock counts from 0 here)")
     p.add_argument("--to", dest="end", type=float,
-                   help="window end, seconds (default: the trace's end, plus up to 1 s while a move goes on)")
+                   help="window end, seconds (default: the trace's end, plus up to 1 s while a move goes on, "
+                        "drawn 4%% longer)")
     p.add_argument("--chain", help="the emulated chain (3, 2*L6470,L6480), or the board description of one chain "
                    "(\"chips=L6470 axis.0=stops=0..256000,switch=home@0\"); default: the trace's own")
     p.add_argument("--board", help="a file with the board description of one chain to run a capture through "
@@ -287,7 +390,8 @@ def _arguments(argv):
                    help=f"the most frames the trace may hold (default {DEFAULT_MAX_FRAMES}; 0 = no limit)")
     p.add_argument("--title", help="the picture's title (default: the file and the chain)")
     p.add_argument("--size", default="10x7.5", help="width x height in inches (default 10x7.5)")
-    p.add_argument("--dpi", type=int, default=100, help="PNG resolution (default 100)")
+    p.add_argument("--dpi", type=int, default=100,
+                   help="PNG resolution, and of the images an SVG embeds for dense series (default 100)")
     return p.parse_args(argv)
 
 

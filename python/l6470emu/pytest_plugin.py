@@ -2,11 +2,17 @@
 
 Fixtures:
   l6470_chain    an l6470emu.Chain in virtual time (in-process, no OS involved)
+  l6470_board    an l6470emu.Board in virtual time in the test process: board.SpiDev / board.spidev(bus, cs)
+                 behave as spidev.SpiDev, board.gpiochip(0) as a libgpiod chip; time.sleep/monotonic of
+                 the code under test are the board's (options: the l6470_board marker)
   spidev_board   runs a program (your unmodified driver) under libl6470emu-preload.so with an
                  emulated /dev/spidevB.C and /dev/gpiochipN, recording a native trace
 
 The chips come from the l6470_chain marker, chip 0 (the MISO end) first; default one L6470:
   @pytest.mark.l6470_chain("L6470", "2xL6480")
+l6470_board's options come from its marker (all optional):
+  @pytest.mark.l6470_board(bus=0, cs=0, options="speed=1000000 axis.0=...", description=None,
+                           patch_time=True, record=True)
 
 Both fixtures run the driver sanitizer at check="error": the first broken rule of the chip's
 interface (SPI mode, frame length, an unknown or refused command, an answer never read, ...)
@@ -27,6 +33,8 @@ from typing import Dict, List, Optional, Sequence, Union
 import pytest
 
 _MARKER = "l6470_chain"
+_BOARD_MARKER = "l6470_board"
+_BOARD_OPTIONS = ("bus", "cs", "options", "description", "patch_time", "record")
 _DEFAULT_CHIPS = ("L6470",)
 
 
@@ -36,6 +44,10 @@ def pytest_configure(config):
         f"{_MARKER}(*chips, check=\"error\", check_allow=()): the chips of the l6470_chain and spidev_board "
         "fixtures, chip 0 (the MISO end) first, e.g. \"L6470\", \"2xL6480\" (default: one L6470), and the "
         "driver sanitizer's level and allowed rules")
+    config.addinivalue_line(
+        "markers",
+        f"{_BOARD_MARKER}(bus=0, cs=0, options='', description=None, patch_time=True, record=True): "
+        "how the l6470_board fixture builds its board")
 
 
 def _check(request):
@@ -70,6 +82,40 @@ def l6470_chain(request):
     chain = l6470emu.Chain(_chips(request), check=check, check_allow=allow)
     yield chain
     chain.close()
+
+
+@pytest.fixture
+def l6470_board(request, tmp_path, monkeypatch):
+    """An l6470emu.Board of the marker's chips in virtual time, in the test process.
+
+    Options (keywords of @pytest.mark.l6470_board): bus, cs (the spidev node, default 0, 0),
+    options (more board description words), description (a whole board description instead of
+    chips/bus/cs/options), patch_time (default True: time.sleep, time.monotonic and
+    time.perf_counter are the board's for the test), record (default True: a native trace in
+    the test's tmp_path, read by board.trace(), decode(), replay()). The driver sanitizer runs at
+    the l6470_chain marker's check= (default "error": l6470emu.SanitizerError with the report)
+    unless options name check= themselves.
+    """
+    import l6470emu
+
+    marker = request.node.get_closest_marker(_BOARD_MARKER)
+    opts = dict(marker.kwargs) if marker is not None else {}
+    unknown = sorted(set(opts) - set(_BOARD_OPTIONS))
+    if unknown or (marker is not None and marker.args):
+        raise pytest.UsageError(f"@pytest.mark.{_BOARD_MARKER}: unknown option(s) {unknown or list(marker.args)}; "
+                                f"the options are {', '.join(_BOARD_OPTIONS)}")
+    trace = tmp_path / "l6470_board.trace" if opts.get("record", True) else None
+    options = opts.get("options", "")
+    if "check=" not in options:  # the l6470_chain marker's check= and check_allow= (default "error")
+        check, allow = _check(request)
+        options = " ".join(w for w in [options, f"check={check}", "check.allow=" + ",".join(allow) if allow else ""] if w)
+    board = l6470emu.Board(_chips(request), bus=opts.get("bus", 0), cs=opts.get("cs", 0),
+                           options=options, description=opts.get("description"),
+                           trace_path=trace)
+    if opts.get("patch_time", True):
+        board.patch_time(monkeypatch)
+    yield board
+    board.close()
 
 
 class SpidevBoard:

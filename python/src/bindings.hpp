@@ -3,6 +3,10 @@
 
 #include <pybind11/pybind11.h>
 
+#include <string>
+
+#include "core/chip.hpp"
+
 namespace l6470emu::python {
 
 namespace py = pybind11;
@@ -16,5 +20,15 @@ void bind_chain(py::module_& m);
 void bind_trace(py::module_& m);
 /// motion() and its Motion, ChipMotion and CommandMark: what the chips of a trace did, as series.
 void bind_motion(py::module_& m);
+/// _BoardCore: a board description's board in virtual time in the test process (l6470emu.Board).
+void bind_board(py::module_& m);
+/// The axis behind `chip` as a dict (true position, lost steps, switches, ...); ValueError without one.
+py::dict axis_state(const Chip& chip);
+/// Attaches an axis from the board description's axis items (an attached axis's spec is the start).
+void attach_axis_text(Chip& chip, const std::string& text);
+/// Changes the load of the attached axis (load=, friction=, force=).
+void set_load_text(Chip& chip, const std::string& text);
+/// The private functions l6470emu.units is written over (register values <-> physical units).
+void bind_units(py::module_& m);
 
 }  // namespace l6470emu::python

@@ -10,6 +10,7 @@
 #include "convert.hpp"
 #include "daisychain/chain_spec.hpp"
 #include "py_chain.hpp"
+#include "sanitizer_failure.hpp"
 
 namespace l6470emu::python {
 namespace {
@@ -29,11 +30,6 @@ std::size_t chip_arg(const PyChain& c, py::handle k) {
   }
   throw py::type_error("chip: an int index is needed (0 drives MISO)");
 }
-
-/// A check=error failure on its way to Python (translated into l6470emu.SanitizerError).
-struct SanitizerFailure : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 PyObject* sanitizer_warning() {
   static PyObject* w = PyErr_NewExceptionWithDoc(
@@ -393,6 +389,20 @@ Time does not advance by itself: call advance() between frames as a bus would ta
           "The tick at which some chip changes on its own next (a profile phase, a move's end), or None when all are idle.");
 
   // ---- the physical world ------------------------------------------------------------
+  c.def("attach_axis", [](PyChain& p, py::handle chip, const std::string& spec) {
+        attach_axis_text(p.chain().chip(chip_arg(p, chip)), spec == "default" ? std::string() : spec);
+      }, py::arg("chip"), py::arg("spec") = "default",
+      "Puts a motor, load, stops and switches behind chip `chip` (the board description's axis items:\n"
+      "\"steps=200,load=120,stops=-2000..90000,switch=home@0\"; positions in 1/128 step). An axis already\n"
+      "attached keeps its items and its rotor position; the items given change it. From then on the\n"
+      "axis drives SW, the stall and the overcurrent conditions.");
+  c.def("axis", [](PyChain& p, py::handle chip) { return axis_state(p.chain().chip(chip_arg(p, chip))); },
+        py::arg("chip"),
+        "The axis now: position (true, 1/128 step), lost_steps, synchronised, at_stop, switches\n"
+        "(name: actuated), sw_level, stall, overcurrent, phase_current_mA, spec.");
+  c.def("set_load", [](PyChain& p, py::handle chip, const std::string& load) {
+        set_load_text(p.chain().chip(chip_arg(p, chip)), load);
+      }, py::arg("chip"), py::arg("load"), "Changes the axis's load now: \"load=G_CM2,friction=NM,force=NM\".");
   c.def("set_sw_pin", [](PyChain& p, py::handle chip, py::handle level) { p.set_sw_pin(chip_arg(p, chip), level_arg(level, "level")); },
         py::arg("chip"), py::arg("level"), "SW input level: False/0 = switch closed (pulled to ground).")
       .def("sw_pin", [](PyChain& p, py::handle chip) { return p.chain().chip(chip_arg(p, chip)).sw_pin(); }, py::arg("chip"),

@@ -18,4 +18,6 @@ PYBIND11_MODULE(_l6470emu, m) {
   l6470emu::python::bind_chain(m);
   l6470emu::python::bind_trace(m);
   l6470emu::python::bind_motion(m);
+  l6470emu::python::bind_units(m);
+  l6470emu::python::bind_board(m);
 }

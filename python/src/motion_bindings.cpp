@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "bindings.hpp"
+#include "core/counted.hpp"
 #include "convert.hpp"
 #include "trace_source.hpp"
 #include "daisychain/chain_spec.hpp"
@@ -134,8 +135,8 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       .def_readonly("commands_dropped", &PyChipMotion::commands_dropped, "commands beyond max_commands, not listed")
       .def("__len__", [](const PyChipMotion& c) { return c.ticks.size(); })
       .def("__repr__", [](const PyChipMotion& c) {
-        return "ChipMotion(chip " + std::to_string(c.number) + " " + c.variant + ", " + std::to_string(c.ticks.size()) +
-               " samples, " + std::to_string(c.commands.size()) + " commands)";
+        return "ChipMotion(chip " + std::to_string(c.number) + " " + c.variant + ", " + counted(c.ticks.size(), "sample") +
+               ", " + counted(c.commands.size(), "command") + ")";
       });
 
   py::class_<PyMotion>(m, "Motion", "What the chips of a trace did over a window: .chips holds a ChipMotion per chip asked for.")
@@ -156,7 +157,7 @@ step per tick, negative in reverse; pins as levels, False = pulled low).)")
       .def_readonly("overridden", &PyMotion::overridden,
                     "\"\" or a sentence saying that chain=/board= replaced the trace's own description")
       .def("__repr__", [](const PyMotion& p) {
-        return "Motion(chain " + p.chain + ", " + std::to_string(p.chips.size()) + " chips, ticks " +
+        return "Motion(chain " + p.chain + ", " + counted(p.chips.size(), "chip") + ", ticks " +
                std::to_string(p.start) + ".." + std::to_string(p.end) + (p.divergence ? ", DIVERGED" : "") + ")";
       });
 

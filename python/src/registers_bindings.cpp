@@ -7,6 +7,7 @@
 
 #include "bindings.hpp"
 #include "convert.hpp"
+#include "core/near_miss.hpp"
 
 namespace l6470emu::python {
 namespace {
@@ -26,11 +27,9 @@ std::array<std::string, static_cast<std::size_t>(Reg::count)> register_names() {
 
 const Variant& variant_named(const std::string& name) {
   const Variant* v = find_variant(name);
-  if (v == nullptr) {
-    std::string known;
-    for (const Variant* a : all_variants()) known += (known.empty() ? "" : ", ") + std::string(a->name);
-    throw py::value_error("unknown chip variant \"" + name + "\" (" + known + ")");
-  }
+  if (v == nullptr)
+    throw py::value_error("unknown chip variant \"" + name + "\" (" + variant_suggestion(name) +
+                          "known: " + known_variant_list() + ")");
   return *v;
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "bindings.hpp"
+#include "core/counted.hpp"
 #include "convert.hpp"
 #include "trace_source.hpp"
 #include "daisychain/chain_spec.hpp"
@@ -187,7 +188,7 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def_property_readonly("name", [](const Trace& t) { return t.header.name; }, "The file name used in messages.")
       .def_property_readonly("notes", [](const Trace& t) { return t.header.notes; }, "Importer remarks.")
       .def("__repr__", [](const Trace& t) {
-        return "Trace(" + std::to_string(t.size()) + " events, " + std::to_string(t.frame_count()) + " frames, chain " +
+        return "Trace(" + counted(t.size(), "event") + ", " + counted(t.frame_count(), "frame") + ", chain " +
                (t.header.chain.empty() ? std::string("unknown") : t.header.chain) + ")";
       });
 
@@ -233,8 +234,8 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def_readonly("number_from", &PyReplayResult::number_from, "how the reports count the chips: \"miso\" or \"mosi\"")
       .def_readonly("numbering", &PyReplayResult::numbering, "what the reports' chip numbers mean, in words")
       .def("__repr__", [](const PyReplayResult& r) {
-        return std::string("ReplayResult(") + (r.matched() ? "matched" : "diverged") + ", " + std::to_string(r.frames) +
-               " frames, " + std::to_string(r.bytes_compared) + " bytes compared)";
+        return std::string("ReplayResult(") + (r.matched() ? "matched" : "diverged") + ", " + counted(r.frames, "frame") +
+               ", " + counted(r.bytes_compared, "byte") + " compared)";
       });
 
   py::class_<DecodeResult>(m, "DecodeResult", "A trace explained: .text is the per-chip log (str() gives it too).")
@@ -265,8 +266,8 @@ text; a Chain made with record=True gives one as Chain.trace.)")
       .def_readonly("numbering", &DecodeResult::numbering, "what the log's chip numbers mean, in words")
       .def("__str__", [](const DecodeResult& d) { return d.text; })
       .def("__repr__", [](const DecodeResult& d) {
-        return "DecodeResult(" + std::to_string(d.summary.frames) + " frames, " + std::to_string(d.summary.commands) +
-               " commands, " + std::to_string(d.summary.diagnostics) + " diagnostics)";
+        return "DecodeResult(" + counted(d.summary.frames, "frame") + ", " + counted(d.summary.commands, "command") + ", " +
+               counted(d.summary.diagnostics, "diagnostic") + ")";
       });
 
   m.def(

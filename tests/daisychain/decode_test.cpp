@@ -8,6 +8,7 @@
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/decode.hpp"
 #include "daisychain/explain.hpp"
+#include "daisychain/recording_chain.hpp"
 #include "spi/trace_native.hpp"
 #include "support/trace_test_support.hpp"
 
@@ -188,6 +189,47 @@ TEST(Decode, ReadsTheRecordedFixtureWithoutSurprises) {
 namespace l6470emu {
 namespace {
 
+/// A Move of 200 full steps recorded with RecordingChain; BUSY's release is observed `late`
+/// ticks after the emulated edge (0: at the edge's own tick, as when a program waits on the line).
+std::string move_recorded(Tick late) {
+  Chain chain(1);
+  Trace trace;
+  RecordingChain rec(chain, trace);
+  const auto send = [&](std::uint8_t b) {
+    chain.advance_to(chain.now() + 40);
+    rec.select();
+    rec.exchange(b);
+    chain.advance_to(chain.now() + 7);
+    rec.deselect();
+  };
+  for (std::uint8_t b : {0x16, 0x00}) send(b);  // full steps
+  for (std::uint8_t b : {0x41, 0x00, 0x00, 0xC8}) send(b);  // Move(FWD, 200)
+  Tick lo = chain.now(), hi = lo + 4'000'000;  // busy at lo, released by hi
+  while (hi - lo > 1) {
+    const Tick mid = lo + (hi - lo) / 2;
+    Chip probe = chain.chip(0);
+    probe.advance_to(mid);
+    (probe.busy_sync_pin() ? hi : lo) = mid;
+  }
+  chain.advance_to(hi + late);
+  rec.observe_outputs();
+  return to_native_text(trace);
+}
+
+TEST(DecodeOutputs, AnEdgeRecordedAtItsOwnTickIsShownAsTheEdge) {
+  const std::string log = decode_text(move_recorded(0), "1").log;
+  EXPECT_NE(log.find("BUSY output low (busy)\n"), std::string::npos) << log;  // at the Move's CS rising edge
+  EXPECT_NE(log.find("BUSY output high (released)\n"), std::string::npos) << log;
+  EXPECT_EQ(log.find("not watched"), std::string::npos) << log;
+}
+
+TEST(DecodeOutputs, AnEdgeObservedLaterSaysWhenTheEmulatorsCame) {
+  const std::string log = decode_text(move_recorded(4000), "1").log;  // 1 ms late
+  const auto at = log.find("BUSY output high (released), seen at (the edge was not watched: the emulator's came at t=");
+  ASSERT_NE(at, std::string::npos) << log;
+  EXPECT_NE(log.find("BUSY output low (busy)\n"), std::string::npos) << log;
+}
+
 TEST(DecodeOutputs, MarksBusyAndFlagLevelsAsSeenAtNotAsExactEdges) {
   const std::string text =
       "l6470emu-trace 1\n"
@@ -202,8 +244,8 @@ TEST(DecodeOutputs, MarksBusyAndFlagLevelsAsSeenAtNotAsExactEdges) {
             std::string::npos)
       << log;
   // The FLAG edge came after the frame's CS rising edge (3.75 µs), the BUSY edge after the SW event.
-  EXPECT_NE(log.find("t=0.000005 s  chip 0   FLAG output high (no alarm), seen at (the edge was not watched: it came "
-                     "after t=0.000004 s)"),
+  EXPECT_NE(log.find("t=0.000005 s  chip 0   FLAG output high (no alarm), seen at (the edge was not watched: the "
+                     "emulator's came at t=0.000004 s)"),
             std::string::npos)
       << log;
   EXPECT_NE(log.find("BUSY output low (busy), seen at (the edge was not watched: it came after t=0.000100 s)"),

@@ -4,7 +4,7 @@
 # find_package and with pkg-config, and run; the README's Arduino sketch (examples/arduino-sketch)
 # built with the installed l6470emu_add_sketch and run; every installed header compiles; the installed
 # Python module finds the installed preload library and its pytest plugin loads through the
-# entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked, it is unpacked
+# entry point; the installed `l6470emu plot` draws with the installed package. Then `cpack -G DEB`: its file list and Depends are checked (the README names exactly the packages of its Depends), lintian finds no error in it, it is unpacked
 # into a throwaway root with dpkg -x, and the consumer is built and run against that too.
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
@@ -19,20 +19,35 @@ step() { echo "-- $*"; }
 # Builds and runs the CMake consumer and the pkg-config consumer against PREFIX.
 consumers() {
   local prefix=$1 name=$2
+  rm -rf "$work/clash"
+  # A consumer's own core/, spi/, daisychain/, board/ folders first on the path: any installed
+  # header still including "core/x.hpp" would reach them and stop at their #error.
+  for layer in core spi daisychain board linux firmware; do
+    mkdir -p "$work/clash/$layer"
+    for h in "$prefix"/include/l6470emu/"$layer"/*.hpp; do
+      if [ -e "$h" ]; then echo "#error \"the consumer's own $layer/$(basename "$h") was included\"" >"$work/clash/$layer/$(basename "$h")"; fi
+    done
+  done
+  leftover=$(grep -rlE '#include "(core|spi|daisychain|board|linux|firmware)/' "$prefix/include/l6470emu" || true)
+  [ -z "$leftover" ] || fail "$name: installed headers still include by the in-tree spelling: $leftover"
   step "$name: the CMake consumer (find_package(l6470emu CONFIG REQUIRED))"
+  # (with the consumer's own clashing core/, spi/, ... folders first on the path)
   cmake -S "$source/examples/cmake-consumer" -B "$work/$name-cmake" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-    -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: configure"; }
+    -DCMAKE_CXX_FLAGS="-I$work/clash" -DCMAKE_PREFIX_PATH="$prefix" >"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: configure"; }
   cmake --build "$work/$name-cmake" >>"$work/$name-cmake.log" 2>&1 || { cat "$work/$name-cmake.log"; fail "$name: build"; }
   out=$("$work/$name-cmake/stepper_check") || fail "$name: stepper_check exited $?"
   [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: stepper_check printed '$out'"
 
-  step "$name: the pkg-config consumer"
+  step "$name: the pkg-config consumer (its flags only: C++20 and -I<prefix>/include come from the .pc)"
   local pc
   pc=$(dirname "$(find "$prefix" -name l6470emu.pc -print -quit)")
   [ -n "$pc" ] || fail "$name: no l6470emu.pc"
   flags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags --libs l6470emu) || fail "$name: pkg-config l6470emu"
+  cflags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags l6470emu)
+  [[ " $cflags " == *" -std=c++20 "* ]] || fail "$name: the .pc's Cflags lack -std=c++20: $cflags"
+  [[ "$cflags" != *include/l6470emu* ]] || fail "$name: the .pc puts include/l6470emu on the include path: $cflags"
   # shellcheck disable=SC2086
-  c++ -std=c++20 -O1 -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
+  c++ -O1 -I"$work/clash" -o "$work/$name-pc" "$source/examples/cmake-consumer/main.cpp" $flags || fail "$name: pkg-config build"
   out=$("$work/$name-pc") || fail "$name: pkg-config consumer exited $?"
   [ "$out" = "chip 1 at 3200, chip 0 at 0" ] || fail "$name: pkg-config consumer printed '$out'"
 
@@ -54,6 +69,16 @@ python_module() {
   [ "$(realpath "$found")" = "$(realpath "$preload")" ] || fail "$name: preload_library() is $found, not $preload"
 }
 
+# The installed program PROGRAM's `serve` names the installed preload library PRELOAD in its
+# "run programs with" line.
+serve_names_preload() {
+  local program=$1 preload=$2 name=$3
+  step "$name: l6470emu serve names the installed preload library"
+  env -u L6470EMU_PRELOAD timeout 5 "$program" serve --socket "$work/$name.sock" >"$work/$name-serve.log" 2>&1 || true
+  grep -q "run programs with: LD_PRELOAD=$(realpath "$preload") L6470EMU_SOCKET=" "$work/$name-serve.log" \
+    || { cat "$work/$name-serve.log"; fail "$name: serve does not name $preload"; }
+}
+
 # The installed program PROGRAM draws a picture with the installed package (no PYTHONPATH).
 plot_command() {
   local program=$1 name=$2
@@ -71,7 +96,8 @@ step "cmake --install into a temporary prefix"
 prefix=$work/prefix
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install"; }
 for f in bin/l6470emu include/l6470emu/core/chip.hpp include/l6470emu/daisychain/host.hpp \
-         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1 share/doc/l6470emu/README.md \
+         include/l6470emu/board/board.hpp include/l6470emu/linux/device_board.hpp share/man/man1/l6470emu.1.gz share/doc/l6470emu/README.md \
+         share/doc/l6470emu/copyright share/doc/l6470emu/changelog.gz \
          include/l6470emu/firmware/firmware.h include/l6470emu/firmware/arduino/Arduino.h include/l6470emu/firmware/arduino/SPI.h \
          include/l6470emu/firmware/stm32/stm32f4xx_hal.h libexec/l6470emu/l6470emu-ino; do
   [ -f "$prefix/$f" ] || fail "not installed: $f"
@@ -113,6 +139,7 @@ site=$(dirname "$(dirname "$(find "$prefix" -name pytest_plugin.py -path '*/l647
 case "$site" in "$prefix"/lib/python3.[0-9]*/dist-packages) ;; *) fail "Python package in '$site', not lib/python3.X/dist-packages" ;; esac
 python_module "$site" "$preload" prefix
 plot_command "$prefix/bin/l6470emu" prefix
+serve_names_preload "$prefix/bin/l6470emu" "$preload" prefix
 
 step "prefix: the pytest plugin loads through its entry point (no conftest)"
 mkdir -p "$work/plugin"
@@ -136,7 +163,8 @@ deb=$(ls "$work"/deb/l6470emu_*.deb)
 dpkg-deb -c "$deb" | awk '{print $6}' | sed 's|^\./||' >"$work/deb.files"
 for pattern in usr/bin/l6470emu 'usr/lib/.*l6470emu/libl6470emu-preload\.so' 'usr/lib/.*libl6470emu_core\.a' \
                'usr/lib/.*cmake/l6470emu/l6470emuConfig\.cmake' 'usr/lib/.*pkgconfig/l6470emu\.pc' \
-               usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1 \
+               usr/include/l6470emu/core/chip.hpp usr/include/l6470emu/spi/trace.hpp usr/share/man/man1/l6470emu.1.gz \
+               usr/share/doc/l6470emu/copyright usr/share/doc/l6470emu/changelog.gz \
                usr/include/l6470emu/firmware/arduino/Arduino.h usr/include/l6470emu/firmware/stm32/stm32_hal.h \
                usr/libexec/l6470emu/l6470emu-ino 'usr/lib/.*cmake/l6470emu/l6470emuFirmware\.cmake' \
                usr/share/doc/l6470emu/README.md usr/share/doc/l6470emu/examples/cmake-consumer/main.cpp \
@@ -155,6 +183,42 @@ for d in libc6 libstdc++6 'python3 (>= 3'; do
 done
 [[ "$depends" == *spidev* || "$depends" == *gpiod* ]] && fail ".deb Depends '$depends' names a user-side package"
 
+step "the README names exactly the packages the .deb depends on"
+# The packages of Depends ("libfuse3-3 (>= 3.12.0), python3 (<< 3.12)" -> libfuse3-3 python3), and
+# the backquoted names of the README's sentence "The `.deb` depends on ..." (up to its semicolon).
+deb_names=$(printf '%s\n' "$depends" | tr ',' '\n' | sed 's/^ *//; s/[ (].*//' | sort -u | tr '\n' ' ')
+sentence=$(tr '\n' ' ' <"$source/README.md" | grep -o 'The `\.deb` depends on [^;]*;' | head -n1)
+[ -n "$sentence" ] || fail "the README has no sentence 'The \`.deb\` depends on ...'"
+readme_names=$(printf '%s\n' "$sentence" | grep -o '`[a-z0-9][a-z0-9.+-]*`' | tr -d '`' | grep -vx 'deb' | sort -u | tr '\n' ' ')
+[ "$deb_names" = "$readme_names" ] || fail "the README says the .deb depends on '$readme_names'; its Depends: '$depends'"
+python_pin=$(printf '%s\n' "$depends" | grep -o 'python3 (<< [0-9.]*)' || true)
+if [ -n "$python_pin" ]; then
+  lowest=$(printf '%s\n' "$depends" | grep -o 'python3 (>= [0-9.]*)' | sed 's/.*>= //; s/)//')
+  [[ "$sentence" == *"$lowest"* ]] || fail "the README does not say the .deb needs Python $lowest ($depends)"
+fi
+
+step "the copyright file is machine-readable and lintian finds no error"
+copyright=$(dpkg-deb --fsys-tarfile "$deb" | tar -xO ./usr/share/doc/l6470emu/copyright)
+head -n1 <<<"$copyright" | grep -qx 'Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/' \
+  || fail "usr/share/doc/l6470emu/copyright is not in the machine-readable format"
+if command -v lintian >/dev/null; then
+  # Warnings that stay, each for a reason:
+  #  maintscript-calls-ldconfig: CPack's DEB generator writes postinst/postrm calling ldconfig
+  #    for any .so under /usr/lib; the preload library is no shared library users link (it is
+  #    only ever LD_PRELOADed by path), so the call is harmless and needs no trigger.
+  #  pkg-config-unavailable-for-cross-compilation: the libraries and l6470emu.pc go to
+  #    /usr/lib (CMake's layout for this package), not the multiarch directory; the libraries
+  #    are for the host the package is built for.
+  lintian_out=$(lintian --allow-root "$deb" 2>&1 || true)
+  printf '%s\n' "$lintian_out" | sed 's/^/   lintian: /'
+  printf '%s\n' "$lintian_out" | grep -q '^E: ' && fail "lintian reports errors (above)"
+  unexpected=$(printf '%s\n' "$lintian_out" | grep '^W: ' |
+    grep -v 'maintscript-calls-ldconfig\|pkg-config-unavailable-for-cross-compilation' || true)
+  [ -z "$unexpected" ] || fail "lintian warnings without a reason given here: $unexpected"
+else
+  step "lintian not installed (scripts/setup.sh installs it): the .deb was not checked by it"
+fi
+
 step "the .deb unpacked into a throwaway root (dpkg -x)"
 root=$work/root
 dpkg -x "$deb" "$root"
@@ -162,5 +226,6 @@ dpkg -x "$deb" "$root"
 consumers "$root/usr" deb
 python_module "$root/usr/lib/python3/dist-packages" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
 plot_command "$root/usr/bin/l6470emu" deb
+serve_names_preload "$root/usr/bin/l6470emu" "$(find "$root" -name libl6470emu-preload.so -print -quit)" deb
 
 echo "install_test: 1 passed, 0 failed"

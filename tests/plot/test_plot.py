@@ -184,3 +184,103 @@ def test_a_capture_the_model_does_not_reproduce_is_marked_and_the_exit_status_sa
     r = run_plot(FIXTURES / "homing_axis_saleae.csv", "-o", tmp_path / "rig.png", "--chain",
                  "chips=L6470 axis.0=stops=-6400..300000,start=51200,switch=home@0:below:hyst=64")
     assert r.returncode == 0 and "does not reproduce" not in r.stderr, r.stderr
+def label_boxes(fig, dpi):
+    """The command labels' boxes in pixels, as drawn at `dpi` (the layout runs at each drawing)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    renderer = canvas.get_renderer()
+    return [(t.get_text(), t.get_window_extent(renderer)) for t in fig.axes[0].texts]
+
+
+def overlapping(boxes):
+    return [(a, b) for i, (a, p) in enumerate(boxes) for b, q in boxes[i + 1:]
+            if p.x0 < q.x1 and q.x0 < p.x1 and p.y0 < q.y1 and q.y0 < p.y1]
+
+
+def test_labels_of_commands_sent_at_the_same_instant_do_not_overlap(tmp_path):
+    # Three chips set up one after the other (6 us apart) and started by the same frames: nine
+    # commands, the three Moves at one tick.
+    chain = l6470emu.Chain(["L6470"] * 3, record=True)
+    for chip in range(3):
+        chain.set_param(chip, "ACC", 0x200)
+        chain.set_param(chip, "MAX_SPEED", 0x30)
+    n_step = [1000, 2000, 3000]
+    chain.frame(bytes([0x41, 0x40, 0x41]))  # Move(FWD), Move(REV), Move(FWD): byte k to chip k
+    for shift in (16, 8, 0):
+        chain.frame(bytes((n >> shift) & 0xFF for n in n_step))
+    chain.advance(seconds=0.3)
+    moves = [m.tick for c in l6470emu.motion(chain.trace).chips for m in c.commands if m.name.startswith("Move")]
+    assert len(moves) == 3 and len(set(moves)) == 1  # three commands at the same instant
+    for size, dpi in (((10.0, 7.5), 100), ((10.0, 7.5), 72), ((5.0, 4.0), 150)):  # 72: what an SVG uses
+        fig = l6470emu.plot.figure(chain, size=size)
+        boxes = label_boxes(fig, dpi)
+        assert sorted(text for text, _ in boxes) == sorted(
+            ["Move(FWD)", "Move(REV)", "Move(FWD)"] + ["SetParam(ACC)", "SetParam(MAX_SPEED)"] * 3)
+        assert overlapping(boxes) == [], (size, dpi)
+    # The trace fixtures' labels too (three_chips.trace sets up three chips in one burst).
+    for fixture in ("three_chips.trace", "single_chip.trace"):
+        boxes = label_boxes(l6470emu.plot.figure(FIXTURES / fixture), 100)
+        assert len(boxes) >= 2 and overlapping(boxes) == [], fixture
+    # And the SVG is drawn with the same layout: its labels are where the layout put them.
+    out = l6470emu.plot.plot(chain, tmp_path / "burst.svg")
+    assert out.read_text().count("SetParam(MAX_SPEED)") == 3  # (in the text elements' ids/comments)
+
+
+def test_a_window_ending_on_its_last_event_shows_the_final_busy_edge_with_time_after_it():
+    fig = l6470emu.plot.figure(FIXTURES / "three_chips.trace")
+    m = l6470emu.motion(str(FIXTURES / "three_chips.trace"))
+    chip1 = m.chips[1]
+    last_rise = max(tick for tick, before, after in zip(chip1.ticks[1:], chip1.busy, chip1.busy[1:])
+                    if after and not before)
+    # The trace ends on this edge (BUSY1 rising as chip 1's move ends) and a GetStatus after it.
+    assert 0 <= m.end - last_rise <= 0.001 * (m.end - m.start)
+    lo, hi = fig.axes[2].get_xlim()
+    edge_ms, end_ms = last_rise / l6470emu.TICKS_PER_SECOND * 1e3, m.end / l6470emu.TICKS_PER_SECOND * 1e3
+    assert hi - edge_ms >= 0.03 * (end_ms - lo)  # room after the edge
+    # BUSY1 is drawn high from its edge to the window's end (a chip at rest stays as it was).
+    busy1 = [line for line in fig.axes[2].get_lines()][3]
+    x, y = busy1.get_data()
+    assert x[-1] == pytest.approx(hi) and x[-2] == pytest.approx(edge_ms)
+    assert y[-1] == y[-2] == max(y) and y[-3] == min(y) < max(y)
+    # A window given an end is drawn exactly (see test_chosen_chips_and_window_are_the_only_ones_drawn).
+    fig = l6470emu.plot.figure(FIXTURES / "three_chips.trace", end=m.end / l6470emu.TICKS_PER_SECOND)
+    assert fig.axes[2].get_xlim()[1] == pytest.approx(end_ms)
+
+
+def polling_run(moves, n_step, pause):
+    """A 1-chip run as a driver makes it: a move, GetStatus every millisecond until BUSY rises, a pause."""
+    chain = l6470emu.Chain("L6470", record=True)
+    chain.get_status(0)
+    for i in range(moves):
+        chain.move(0, forward=i % 2 == 0, n_step=n_step * (i + 1 if n_step > 1000 else 1))
+        while not chain.busy_pin(0):  # BUSY is low while the move runs
+            chain.advance(seconds=0.001)
+            chain.get_status(0)
+        chain.advance(seconds=pause)
+        chain.get_status(0)
+    return chain
+
+
+def test_a_one_chip_svg_of_a_typical_run_stays_under_300_kB(tmp_path):
+    # Six moves over 7.4 s polled every millisecond (was 402 kB: a filled pin lane drew every sample).
+    out = l6470emu.plot.plot(polling_run(6, 25600, 0.05), tmp_path / "typical.svg")
+    assert out.stat().st_size <= 300_000, out.stat().st_size
+    assert "<image" not in out.read_text()  # all vectors still
+    # 2000 short moves, BUSY toggling 4000 times, 100 000 samples (was 10 MB): the dense parts are
+    # images, the rest vectors.
+    out = l6470emu.plot.plot(polling_run(2000, 64, 0.002), tmp_path / "dense.svg", max_points=100_000)
+    assert out.stat().st_size <= 300_000, out.stat().st_size
+    text = out.read_text()
+    assert "<image" in text and "ABS_POS" in text
+
+
+def test_a_pin_is_drawn_with_a_point_per_edge_and_the_same_steps():
+    t = np.array([0.0, 1, 2, 3, 4, 5, 6])
+    levels = [1, 1, 0, 0, 0, 1, 1]
+    tp, lp = l6470emu.plot._pin_steps(t, levels)
+    assert list(tp) == [0, 2, 5, 6] and list(lp) == [1, 0, 1, 1]
+    # The same level at every instant, read as steps-post.
+    for x in np.linspace(0, 6, 61):
+        assert lp[np.searchsorted(tp, x, side="right") - 1] == levels[np.searchsorted(t, x, side="right") - 1]

@@ -108,7 +108,7 @@ TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
   EXPECT_EQ(error_of("l6470emu-trace 0\n"), "t.trace:1: format version 0 (this l6470emu reads versions 1 to 2)");
   EXPECT_EQ(error_of(head + "0 frame D0 ZZ\n"), "t.trace:2: MOSI \"ZZ\" is not a byte (two hex digits)");
   EXPECT_EQ(error_of(head + "0 frame D0 | 0xZZ\n"), "t.trace:2: MISO \"0xZZ\" is not a byte (two hex digits, or ?? for unknown)");
-  EXPECT_EQ(error_of(head + "0 frame D0 00 | 00\n"), "t.trace:2: frame has 2 MOSI bytes but 1 MISO bytes");
+  EXPECT_EQ(error_of(head + "0 frame D0 00 | 00\n"), "t.trace:2: frame has 2 MOSI bytes but 1 MISO byte");
   EXPECT_EQ(error_of(head + "1 frame D0\n0.5 frame 00\n"),
             "t.trace:3: time 0.5 s goes backwards (the previous event was at 1.00000000 s)");
   EXPECT_EQ(error_of(head + "0 frame 10us D0\n0.000005 frame 00\n"),

@@ -1,7 +1,8 @@
 // A tiny spidev client for the umockdev replay test: sends each frame of a list as one
 // SPI_IOC_MESSAGE(1) (bits_per_word 0 and no mode ioctls, as umockdev's SPI replay needs)
-// and checks the bytes received. Usage: spidev_replay_client DEVICE FRAMES
-// FRAMES: one frame per line, "TXHEX RXHEX" (RXHEX "-" = do not check).
+// and checks the bytes received. Usage: spidev_replay_client DEVICE FRAMES [--ask-mode]
+// FRAMES: one frame per line, "TXHEX RXHEX" (RXHEX "-" = do not check). --ask-mode first reads
+// the mode, bits per word and speed as most spidev libraries do at open, and prints what each gave.
 #include <fcntl.h>
 #include <linux/spi/spidev.h>
 #include <sys/ioctl.h>
@@ -27,14 +28,24 @@ std::vector<std::uint8_t> from_hex(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: %s DEVICE FRAMES\n", argv[0]);
+  if (argc != 3 && !(argc == 4 && std::strcmp(argv[3], "--ask-mode") == 0)) {
+    std::fprintf(stderr, "usage: %s DEVICE FRAMES [--ask-mode]\n", argv[0]);
     return 2;
   }
   const int fd = open(argv[1], O_RDWR);  // open(), not openat(): umockdev's preload wraps open
   if (fd < 0) {
     std::fprintf(stderr, "open %s: %s\n", argv[1], std::strerror(errno));
     return 2;
+  }
+  if (argc == 4) {
+    std::uint8_t mode = 0, bits = 0;
+    std::uint32_t speed = 0;
+    const int m = ioctl(fd, SPI_IOC_RD_MODE, &mode);
+    std::printf("SPI_IOC_RD_MODE: %s\n", m < 0 ? std::strerror(errno) : "ok");
+    const int b = ioctl(fd, SPI_IOC_RD_BITS_PER_WORD, &bits);
+    std::printf("SPI_IOC_RD_BITS_PER_WORD: %s\n", b < 0 ? std::strerror(errno) : "ok");
+    const int h = ioctl(fd, SPI_IOC_RD_MAX_SPEED_HZ, &speed);
+    std::printf("SPI_IOC_RD_MAX_SPEED_HZ: %s\n", h < 0 ? std::strerror(errno) : "ok");
   }
   std::ifstream frames(argv[2]);
   std::string line;
