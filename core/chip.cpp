@@ -114,6 +114,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
 }
 
 void Chip::execute(const Opcode& op, std::uint32_t arg) {
+  if (command_sink_) command_sink_(op, arg);
   // Reading commands leave the motion as it is; everything else may change it.
   if (op.command != Command::GetStatus && op.command != Command::GetParam && op.command != Command::NOP)
     touched();
@@ -618,6 +619,24 @@ void Chip::set_axis_load(const LoadSpec& load) {
   sync();
   touched();
   axis_->set_load(load);
+  axis_event_known_ = false;
+  axis_settle(now_);
+}
+
+void Chip::set_axis_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper) {
+  if (!axis_) return;
+  sync();
+  touched();
+  axis_->set_stops(has_lower, lower, has_upper, upper);
+  axis_event_known_ = false;
+  axis_settle(now_);
+}
+
+void Chip::set_axis_supply(std::uint32_t supply_mV) {
+  if (!axis_) return;
+  sync();
+  touched();
+  axis_->set_supply(supply_mV);
   axis_event_known_ = false;
   axis_settle(now_);
 }

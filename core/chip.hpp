@@ -115,6 +115,12 @@ class Chip {
   const Axis* axis() const;
   /// Changes the axis's load at runtime (no effect without an axis).
   void set_axis_load(const LoadSpec& load);
+  /// Changes the axis's hard stops at runtime (no effect without an axis): a stop put where the
+  /// rotor would pass blocks it there as a built-in one does.
+  void set_axis_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper);
+  /// Changes the motor supply the axis sees (torque and current follow; no effect without an
+  /// axis). The UVLO flag is the backdoor's business (set_undervoltage).
+  void set_axis_supply(std::uint32_t supply_mV);
 
   // ---- inspection without side effects --------------------------------------
 
@@ -144,6 +150,10 @@ class Chip {
 
   /// Where diagnostics go (unknown opcodes, refused commands).
   void set_diagnostic_sink(DiagnosticSink sink) { sink_ = std::move(sink); }
+  /// Who hears of every command the chip decodes (its opcode and argument), before it runs.
+  /// Observers only (a scenario's "command seen"): the sink must not call back into the chip.
+  using CommandSink = std::function<void(const Opcode& op, std::uint32_t arg)>;
+  void set_command_sink(CommandSink sink) { command_sink_ = std::move(sink); }
 
  private:
   std::uint8_t decode_byte(std::uint8_t byte);
@@ -243,6 +253,7 @@ class Chip {
   std::uint8_t adc_code_ = 0;
 
   DiagnosticSink sink_;
+  CommandSink command_sink_;
 
   // The axis, when attached. Its events are found inside the runs of uniform ticks.
   ValuePtr<Axis> axis_;

@@ -120,6 +120,7 @@ void Chain::deselect() {
   selected_ = false;
   // A CS pulse without clocks leaves the shift registers as they are: nothing is decoded.
   if (bytes_in_frame_ == 0) return;
+  ++frames_;
   const std::size_t n = chips_.size();
   std::size_t slot = head_;
   for (std::size_t i = 0; i < n; ++i) {
