@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <sstream>
 
+#include "board/scenario_runner.hpp"
 #include "board/trace_recorder.hpp"
 #include "linux/device_board_internal.hpp"
 
@@ -187,8 +188,10 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
     check_spidev_settings_for_chip(c.spi, xfers, c.reported, [&](const std::string& s) { log_.line(c.name + ": " + s); });
   // The message starts when the bus is free: now, or when the message before it on this bus ends
   // (its caller may still be waiting for that end). The board runs the bus; spidev says what to clock.
+  if (scenario_ && !time().is_virtual()) scenario_->poll();
   run_spidev_message(board_.begin_transfer(chain), c.spi, xfers, tx, rx);
   end = board_.end_transfer(chain);
+  if (scenario_) scenario_->after_transfer();
   if (board_.has_watched_pins(chain)) wake_pump();
   if (observer_) observer_(chain, xfers, tx, rx, end);
   return total;
@@ -376,7 +379,33 @@ bool DeviceBoard::advance(Tick ticks) { return time().is_virtual() && advance_to
 bool DeviceBoard::advance_to(Tick tick) {
   if (!time().is_virtual()) return false;
   std::lock_guard lock(m_);
+  if (scenario_) {
+    scenario_->advance_to(tick);
+    return true;
+  }
   return board_.advance_to(tick);
+}
+
+void DeviceBoard::set_scenario(const Scenario& scenario) {
+  std::lock_guard lock(m_);
+  scenario_.reset();
+  scenario_ = std::make_unique<ScenarioRunner>(board_, scenario);
+}
+
+Tick DeviceBoard::scenario_next_tick() {
+  std::lock_guard lock(m_);
+  return scenario_ ? scenario_->next_tick() : kNever;
+}
+
+bool DeviceBoard::finish_scenario(ScenarioOutcome& out) {
+  std::lock_guard lock(m_);
+  if (!scenario_) return false;
+  scenario_->finish();
+  out.judged = scenario_->judged();
+  out.failures = scenario_->failures();
+  out.passed = scenario_->passed();
+  out.log = scenario_->log();
+  return true;
 }
 
 Tick DeviceBoard::next_edge_tick() {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "tools/cmd_plot.hpp"
+#include "tools/cmd_run.hpp"
 #include "tools/cmd_serve.hpp"
 #include "tools/demo.hpp"
 #include "tools/tables.hpp"
@@ -56,9 +57,11 @@ int main(int argc, char** argv) {
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::add_trace_commands(app);             // replay, decode, convert
   l6470emu::add_plot_command(app);               // plot (python3 -m l6470emu.plot)
+  l6470emu::RunCommand run_command(app);         // run
 
   CLI11_PARSE(app, argc, argv);
   if (auto status = serve_commands.run()) return *status;
+  if (auto status = run_command.run()) return *status;
   if (*demo) return l6470emu::run_demo(chips, seconds, std::cout);
   if (*tables) {
     if (!readme.empty()) return update_readme(readme);

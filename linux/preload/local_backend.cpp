@@ -3,6 +3,7 @@
 #include <mutex>
 
 #include "linux/preload/backend.hpp"
+#include "linux/preload/run.hpp"
 #include "linux/preload/virtual_time.hpp"
 
 namespace l6470emu::preload {
@@ -11,6 +12,7 @@ namespace {
 class LocalBackend final : public Backend {
  public:
   explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_), trace_(config.trace) {
+    start_run(board_);  // `l6470emu run`: the scenario, the time limit, the report at exit
     if (config.time.virtual_time) {
       // Made when the program starts (its clock is the board's from then on): the trace starts
       // with the first open of a device, so that a child that never opens one (a shell, a
@@ -25,6 +27,7 @@ class LocalBackend final : public Backend {
   const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
   NewFile open(std::size_t device, bool cloexec) override {
     if (virtual_time_) std::call_once(trace_started_, [this] { start_trace(); });
+    run_device_opened();
     return board_.open(device, cloexec);
   }
   void closed(std::uint64_t handle) override { board_.closed(handle); }
@@ -50,6 +53,7 @@ class LocalBackend final : public Backend {
     board_.mutex().unlock();
     board_.forget_pump_after_fork();
     board_.forget_recordings_after_fork();
+    run_after_fork_child();
     // The child goes on with its own copy of the board and of its virtual clock.
     if (virtual_time_) virtual_time_->after_fork_child();
   }
