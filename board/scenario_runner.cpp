@@ -53,6 +53,24 @@ std::string with_tolerance(std::int64_t v, std::int64_t tol) {
   return tol ? std::to_string(v) + " ± " + std::to_string(tol) : std::to_string(v);
 }
 
+// What an action does, in words ("SW closed", "OCD on", "hard stop at 12800").
+std::string describe(const ScenarioAction& a) {
+  switch (a.kind) {
+    case ScenarioAction::Kind::sw: return a.level ? "SW opened" : "SW closed";
+    case ScenarioAction::Kind::stby_rst: return a.level ? "STBY_RST high" : "STBY_RST low";
+    case ScenarioAction::Kind::fault:
+      if (a.fault == TraceFault::THERMAL) return "THERMAL " + std::string(thermal_name(a.value));
+      if (a.fault == TraceFault::ADCIN) return "ADCIN " + std::to_string(a.value);
+      return std::string(to_string(a.fault)) + (a.value ? " on" : " off");
+    case ScenarioAction::Kind::load:
+      return "load: inertia " + std::to_string(a.load.inertia_g_mm2) + " g·mm², friction " +
+             std::to_string(a.load.friction_uNm) + " µN·m, force " + std::to_string(a.load.force_uNm) + " µN·m";
+    case ScenarioAction::Kind::block: return "hard stop at " + std::to_string(a.position) + " (1/128 step)";
+    case ScenarioAction::Kind::supply: return "supply " + std::to_string(a.supply_mV) + " mV";
+  }
+  return "";
+}
+
 bool is_event(ScenarioTrigger::Kind k) {
   return k != ScenarioTrigger::Kind::time && k != ScenarioTrigger::Kind::end;
 }
@@ -321,8 +339,7 @@ void ScenarioRunner::fire(std::size_t i, Tick tick) {
   s.done = true;
   const ScenarioStep& st = scenario_.steps[i];
   if (st.action) {
-    log_.push_back(seconds_text(tick) + ": " + st.where + ": " + s.target_chip.label + ": " +
-                   std::string(to_string(st.action->kind)));
+    log_.push_back(seconds_text(tick) + ": " + st.where + ": " + s.target_chip.label + ": " + describe(*st.action));
     apply(*st.action, s.target_chip, st.where);
   }
   if (st.expect) judge(*st.expect, s.target_chip, st.where, tick);

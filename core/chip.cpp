@@ -68,6 +68,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   // the flags, which cannot have changed, so polling does not work the motion out.
   if (byte == 0xD0 && !collecting_) {
     // GetStatus, the polling command, straight through.
+    if (command_sink_) command_sink_(variant_->opcodes[0xD0], 0);
     load_response(status(), 2);
     clear_status_on_get_status();
     return next_response_byte();

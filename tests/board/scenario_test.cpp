@@ -94,7 +94,7 @@ TEST(ScenarioRunner, ATimedSwitchClosureReachesTheChipAtItsTickWhateverTheHostWa
   EXPECT_EQ(runner.next_tick(), kNever);
   EXPECT_FALSE(v.board.pin_level(0, 0, Pin::SW));
   ASSERT_FALSE(runner.log().empty());
-  EXPECT_EQ(runner.log()[0].rfind("0.100000 s: s.yaml:1: spidev0.0 chip 0: sw", 0), 0u) << runner.log()[0];
+  EXPECT_EQ(runner.log()[0].rfind("0.100000 s: s.yaml:1: spidev0.0 chip 0: SW closed", 0), 0u) << runner.log()[0];
   runner.finish();
   EXPECT_TRUE(runner.failures().empty());
   EXPECT_EQ(runner.judged(), 1u);
