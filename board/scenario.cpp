@@ -48,7 +48,7 @@ std::string serialize_scenario(const Scenario& s) {
     const ScenarioTrigger& t = st.when;
     json j{{"where", st.where},
            {"when", {{"kind", static_cast<unsigned>(t.kind)}, {"tick", t.tick}, {"chip", chip_json(t.chip)},
-                     {"position", t.position}, {"command", t.command}, {"count", t.count}}}};
+                     {"position", t.position}, {"command", t.command}, {"count", t.count}, {"delay", t.delay}}}};
     if (st.action) {
       const ScenarioAction& a = *st.action;
       j["do"] = {{"kind", static_cast<unsigned>(a.kind)}, {"chip", chip_json(a.chip)}, {"level", a.level},
@@ -89,6 +89,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
       st.when.position = w.at("position").get<std::int64_t>();
       st.when.command = w.at("command").get<std::string>();
       st.when.count = w.at("count").get<std::uint32_t>();
+      st.when.delay = w.at("delay").get<Tick>();
       if (js.contains("do")) {
         const json& a = js.at("do");
         ScenarioAction act;

@@ -40,6 +40,7 @@ struct ScenarioTrigger {
   std::int64_t position = 0;  ///< position, true_position
   std::string command;        ///< command: datasheet name ("GoUntil")
   std::uint32_t count = 1;    ///< events: the Nth occurrence (from `tick` on) fires
+  Tick delay = 0;             ///< events: the step happens this long after the event
   friend bool operator==(const ScenarioTrigger&, const ScenarioTrigger&) = default;
 };
 

@@ -192,6 +192,7 @@ Tick ScenarioRunner::next_tick() const {
     if (w.kind == ScenarioTrigger::Kind::time) t = std::min(t, w.tick);
     // A position trigger is armed at its `not before` tick: the host must wake then too.
     if (is_position(w.kind) && !state_[i].armed) t = std::min(t, w.tick);
+    t = std::min(t, state_[i].due);
   }
   return t;
 }
@@ -199,14 +200,16 @@ Tick ScenarioRunner::next_tick() const {
 bool ScenarioRunner::pending_events() const {
   for (std::size_t i = 0; i < state_.size(); ++i) {
     const auto k = scenario_.steps[i].when.kind;
-    if (!state_[i].done && (k == ScenarioTrigger::Kind::busy_fall || k == ScenarioTrigger::Kind::busy_rise)) return true;
+    if (!state_[i].done && state_[i].due == kNever &&
+        (k == ScenarioTrigger::Kind::busy_fall || k == ScenarioTrigger::Kind::busy_rise))
+      return true;
   }
   return false;
 }
 
 bool ScenarioRunner::pending_positions() const {
   for (std::size_t i = 0; i < state_.size(); ++i)
-    if (!state_[i].done && is_position(scenario_.steps[i].when.kind)) return true;
+    if (!state_[i].done && state_[i].due == kNever && is_position(scenario_.steps[i].when.kind)) return true;
   return false;
 }
 
@@ -254,7 +257,7 @@ void ScenarioRunner::advance_to(Tick target) {
     if (pending_events()) t = std::min(t, board_.next_edge_tick());
     if (pending_positions())
       for (std::size_t i = 0; i < state_.size(); ++i)
-        if (!state_[i].done && is_position(scenario_.steps[i].when.kind))
+        if (!state_[i].done && state_[i].due == kNever && is_position(scenario_.steps[i].when.kind))
           t = std::min(t, position_reached_within(i, now, t));
     t = std::max(t, now + 1);
     board_.advance_to(t);
@@ -282,6 +285,7 @@ void ScenarioRunner::fire_due_times(Tick now) {
     const ScenarioTrigger& w = scenario_.steps[i].when;
     if (s.done) continue;
     if (w.kind == ScenarioTrigger::Kind::time && w.tick <= now) fire(i, w.tick);
+    else if (s.due <= now) fire(i, s.due);
   }
 }
 
@@ -289,14 +293,14 @@ void ScenarioRunner::fire_positions(Tick now) {
   for (std::size_t i = 0; i < state_.size(); ++i) {
     StepState& s = state_[i];
     const ScenarioTrigger& w = scenario_.steps[i].when;
-    if (s.done || !is_position(w.kind) || w.tick > now) continue;
+    if (s.done || s.due != kNever || !is_position(w.kind) || w.tick > now) continue;
     const Chip& chip = board_.chain(s.trigger_chip.chain).chip(s.trigger_chip.chip);
     const int side = sign_of(position_of(chip, w.kind == ScenarioTrigger::Kind::true_position) - w.position);
     if (!s.armed) {
       s.armed = true;
       s.start_side = side;
     }
-    if (side == 0 || side != s.start_side) fire(i, std::max(now, chip.now()));
+    if (side == 0 || side != s.start_side) triggered(i, std::max(now, chip.now()));
   }
 }
 
@@ -320,7 +324,7 @@ void ScenarioRunner::take_events(Tick) {
     for (std::size_t i = 0; i < state_.size(); ++i) {
       StepState& s = state_[i];
       const ScenarioTrigger& w = scenario_.steps[i].when;
-      if (s.done || !is_event(w.kind) || is_position(w.kind) || ev.tick < w.tick) continue;
+      if (s.done || s.due != kNever || !is_event(w.kind) || is_position(w.kind) || ev.tick < w.tick) continue;
       if (s.trigger_chip.chain != ev.chain || s.trigger_chip.chip != ev.chip) continue;
       bool match = false;
       if (ev.busy_edge)
@@ -328,10 +332,20 @@ void ScenarioRunner::take_events(Tick) {
                 (w.kind == ScenarioTrigger::Kind::busy_rise && ev.level);
       else
         match = w.kind == ScenarioTrigger::Kind::command && same_name(w.command, ev.command);
-      if (match && ++s.seen >= w.count) fire(i, ev.tick);
+      if (match && ++s.seen >= w.count) triggered(i, ev.tick);
     }
   }
   seen_.clear();
+}
+
+void ScenarioRunner::triggered(std::size_t i, Tick tick) {
+  const Tick delay = scenario_.steps[i].when.delay;
+  if (delay == 0) {
+    fire(i, tick);
+    return;
+  }
+  state_[i].due = tick + delay;
+  if (state_[i].due <= board_.time().now()) fire(i, state_[i].due);
 }
 
 void ScenarioRunner::fire(std::size_t i, Tick tick) {
@@ -469,9 +483,9 @@ void ScenarioRunner::judge(const ScenarioExpectation& e, const Resolved& r, cons
       const bool ok = e.count == ScenarioExpectation::kAtLeastOnce ? n > 0 : n == e.count;
       const std::string expected = e.count == ScenarioExpectation::kAtLeastOnce ? std::string("sent")
                                    : e.count == 0                                ? std::string("not sent")
-                                                                                 : "sent " + std::to_string(e.count) + " times";
+                                                                                 : e.count == 1 ? std::string("sent once") : "sent " + std::to_string(e.count) + " times";
       if (!ok)
-        fail(where, "command " + e.name, tick, r, expected, n == 0 ? "not sent" : "sent " + std::to_string(n) + " times");
+        fail(where, "command " + e.name, tick, r, expected, n == 0 ? "not sent" : n == 1 ? "sent once" : "sent " + std::to_string(n) + " times");
       else
         pass(where, "command " + e.name + " " + expected);
       return;

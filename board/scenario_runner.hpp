@@ -65,6 +65,7 @@ class ScenarioRunner {
     Resolved target_chip;           // action or expectation
     std::int64_t start_side = 0;    // position triggers: sign of (position - target) when armed
     bool armed = false;
+    Tick due = kNever;              // an event with a delay came: the step happens then
   };
   struct Pulse {
     Tick start = 0;
@@ -78,6 +79,7 @@ class ScenarioRunner {
   Tick position_reached_within(std::size_t i, Tick from, Tick to);
   std::int64_t position_of(const Chip& chip, bool true_position) const;
   void fire(std::size_t i, Tick tick);
+  void triggered(std::size_t i, Tick tick);  // the event came: fire now or after its delay
   void apply(const ScenarioAction& a, const Resolved& r, const std::string& where);
   void judge(const ScenarioExpectation& e, const Resolved& r, const std::string& where, Tick tick);
   void fail(const std::string& where, const std::string& what, Tick tick, const Resolved& r, std::string expected,

@@ -46,7 +46,7 @@ struct RunReport {
   pid_t pid = 0;
   RunEnd end = RunEnd::exit;
   Tick tick = 0;                      ///< the board's time at the end
-  bool devices = false;               ///< the process opened an emulated device
+  bool devices = false;               ///< the process exchanged SPI bytes with the board
   bool scenario = false;              ///< a scenario was bound to its board
   std::vector<std::string> detail;    ///< the cause in words (the deadlock report, the sanitizer's finding)
   ScenarioOutcome outcome;

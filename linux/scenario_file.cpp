@@ -167,7 +167,7 @@ class Reader {
 
   ScenarioStep step(const YAML::Node& n) {
     if (!n.IsMap()) fail(n, "steps", "each step is a map (at: or on:, then do: or expect:)");
-    check_keys(n, "a step", {"at", "on", "after", "chip", "chain", "do", "expect"});
+    check_keys(n, "a step", {"at", "on", "after", "delay", "chip", "chain", "do", "expect"});
     ScenarioStep st;
     st.where = where_of(n);
     const ScenarioChip dflt = chip_of(n, ScenarioChip{});
@@ -176,6 +176,7 @@ class Reader {
     if (!at && !on) fail(n, "", "a step needs at: (a time or end) or on: (an event)");
     if (at) {
       if (n["after"]) fail(n["after"], "after", "only for on: (events); at: is already a time");
+      if (n["delay"]) fail(n["delay"], "delay", "only for on: (events); at: is already a time");
       if (at.IsScalar() && lower(at.Scalar()) == "end")
         st.when.kind = ScenarioTrigger::Kind::end;
       else
@@ -208,6 +209,7 @@ class Reader {
       if (kinds != 1) fail(on, "on", "names exactly one event: position, true_position, busy or command");
       if (const YAML::Node c = on["count"]) st.when.count = static_cast<std::uint32_t>(integer(c, "count", 1, 1'000'000'000));
       if (const YAML::Node a = n["after"]) st.when.tick = duration(a, "after");
+      if (const YAML::Node d = n["delay"]) st.when.delay = duration(d, "delay");
     }
     const YAML::Node act = n["do"], exp = n["expect"];
     if (act && exp) fail(exp, "expect", "a step has either do: or expect:, not both");

@@ -27,7 +27,6 @@ class LocalBackend final : public Backend {
   const std::vector<DeviceNode>& nodes() override { return board_.nodes(); }
   NewFile open(std::size_t device, bool cloexec) override {
     if (virtual_time_) std::call_once(trace_started_, [this] { start_trace(); });
-    run_device_opened();
     return board_.open(device, cloexec);
   }
   void closed(std::uint64_t handle) override { board_.closed(handle); }
@@ -36,10 +35,17 @@ class LocalBackend final : public Backend {
   }
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                    std::span<std::uint8_t> rx) override {
+    run_device_opened();
     return board_.spi_message(handle, xfers, tx, rx);
   }
-  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override { return board_.spi_read(handle, rx); }
-  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override { return board_.spi_write(handle, tx); }
+  long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
+    run_device_opened();
+    return board_.spi_read(handle, rx);
+  }
+  long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
+    run_device_opened();
+    return board_.spi_write(handle, tx);
+  }
   // The scheduler's lock before the board's: the scheduler moves the board while holding it.
   void before_fork() override {
     if (virtual_time_) virtual_time_->before_fork();

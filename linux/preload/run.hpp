@@ -23,7 +23,8 @@ Tick run_next_tick();
 /// Virtual time reached `now`: at or past the time limit the run ends here (report, status
 /// kTimeoutExitStatus), with what was recorded finished first.
 void run_time_reached(Tick now);
-/// This process opened an emulated device.
+/// This process exchanged SPI bytes with the board (its report is judged; one that only looked
+/// at a device, like `spi-config -q`, is not).
 void run_device_opened();
 /// Writes this process's report once: `cause` and its words. The first cause wins (an exit()
 /// after a reported deadlock adds nothing). The deadlock path calls it with RunEnd::deadlock and

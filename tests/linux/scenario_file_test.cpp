@@ -69,7 +69,7 @@ steps:
 TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {sw: close}\n  - at: end\n    expcet: {frames: 3}\n"),
             "l6470emu: scenario s.yaml:5: key 'expcet': unknown (did you mean expect?) in a step; known: at, on, after, "
-            "chip, chain, do, expect");
+            "delay, chip, chain, do, expect");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {sw: shut}\n"),
             "l6470emu: scenario s.yaml:3: key 'sw': 'shut' is not one of close, open");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {falt: ocd}\n"),
