@@ -268,6 +268,7 @@ std::optional<int> RunCommand::run() {
     end_tick = std::max(end_tick, b->tick);
   }
   if (cause_block) end_tick = std::max(end_tick, cause_block->tick);
+  if (wall_timeout) end_tick = std::max(end_tick, *timeout);  // killed: no report of its own
   const bool exited = WIFEXITED(wstatus);
   const int code = exited ? WEXITSTATUS(wstatus) : -1;
   const int signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;

@@ -130,6 +130,13 @@ TEST_F(RunCommand, TheSimulatedTimeLimitEndsTheRunWithItsOwnStatus) {
       << r.err;
 }
 
+TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
+  const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "200ms"}, python("time.sleep(30)\n"));
+  EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+  EXPECT_NE(r.err.find("stopped at the simulated time limit 0.200000 s at 0.200000 s of board time"), std::string::npos)
+      << r.err;
+}
+
 TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
   // The client waits for a BUSY edge an idle chip never makes; the scenario's step at 1 s is a
   // wake-up, so the deadlock is found only after it.
