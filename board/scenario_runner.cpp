@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "board/board_config.hpp"
 #include "core/commands.hpp"
 #include "core/registers.hpp"
 #include "core/variant.hpp"
@@ -101,7 +102,7 @@ ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
     if (st.when.kind == ScenarioTrigger::Kind::true_position && !tchip->axis())
       bad(s.trigger_chip.label + " has no axis (axis.K= in the board description) for true_position");
     if (st.when.kind == ScenarioTrigger::Kind::command && !is_command_name(st.when.command))
-      bad("'" + st.when.command + "' is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
+      bad(quoted_text(st.when.command) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
     if (st.when.kind == ScenarioTrigger::Kind::busy_fall || st.when.kind == ScenarioTrigger::Kind::busy_rise)
       busy_watch.emplace_back(s.trigger_chip.chain, s.trigger_chip.chip);
     if (st.action) {
@@ -118,15 +119,15 @@ ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
       s.target_chip = resolve(e.chip, w);
       const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
       if (e.kind == ScenarioExpectation::Kind::reg && !find_register(chip, e.name))
-        bad("the " + std::string(chip.variant().name) + " has no register '" + e.name + "'");
+        bad("the " + std::string(chip.variant().name) + " has no register " + quoted_text(e.name));
       if (e.kind == ScenarioExpectation::Kind::true_position && !chip.axis())
         bad(s.target_chip.label + " has no axis (axis.K= in the board description) for true_position");
       if (e.kind == ScenarioExpectation::Kind::status)
         for (const auto& [name, bit] : e.flags)
           if (status_bit(chip.status_layout(), name) < 0)
-            bad("the " + std::string(chip.variant().name) + "'s STATUS has no flag '" + name + "'");
+            bad("the " + std::string(chip.variant().name) + "'s STATUS has no flag " + quoted_text(name));
       if (e.kind == ScenarioExpectation::Kind::command && !is_command_name(e.name))
-        bad("'" + e.name + "' is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
+        bad(quoted_text(e.name) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
       if (e.kind == ScenarioExpectation::Kind::busy_pulse) {
         if (st.when.kind != ScenarioTrigger::Kind::end) bad("a BUSY pulse is judged at the end (at: end)");
         busy_watch.emplace_back(s.target_chip.chain, s.target_chip.chip);
@@ -169,7 +170,7 @@ ScenarioRunner::Resolved ScenarioRunner::resolve(const ScenarioChip& c, const st
     if (chain < 0) {
       std::string names;
       for (std::size_t i = 0; i < board_.chain_count(); ++i) names += (i ? ", " : "") + board_.chain_name(i);
-      throw std::invalid_argument(where + ": no chain '" + c.chain + "' on the board (it has " + names + ")");
+      throw std::invalid_argument(where + ": no chain " + quoted_text(c.chain) + " on the board (it has " + names + ")");
     }
   }
   const std::size_t n = board_.chip_count(static_cast<std::size_t>(chain));

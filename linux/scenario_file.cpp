@@ -85,7 +85,7 @@ class Reader {
     const YAML::Mark m = n.Mark();
     std::string where = "l6470emu: scenario " + file_;
     if (m.line >= 0) where += ":" + std::to_string(m.line + 1);
-    throw Bad(where + ": " + (key.empty() ? "" : "key '" + std::string(key) + "': ") + what);
+    throw Bad(where + ": " + (key.empty() ? "" : "key '" + shown_text(key) + "': ") + what);
   }
 
   std::string where_of(const YAML::Node& n) const {
@@ -100,7 +100,7 @@ class Reader {
       if (std::find(allowed.begin(), allowed.end(), k) == allowed.end()) {
         std::string list;
         for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, shown_text(k), "unknown" + near_miss(k, allowed) + (in.empty() ? "" : " in " + std::string(in)) +
+        fail(kv.first, k, "unknown" + near_miss(k, allowed) + (in.empty() ? "" : " in " + std::string(in)) +
                                            "; known: " + list);
       }
       if (!seen.insert(k).second) fail(kv.first, k, "given twice");
@@ -463,9 +463,9 @@ ScenarioParse parse_scenario_yaml(std::string_view text, std::string_view file) 
   } catch (const Bad& e) {
     out.error = e.what();
   } catch (const YAML::Exception& e) {
-    out.error = "l6470emu: scenario " + name + ":" + std::to_string(e.mark.line + 1) + ": not YAML: " + e.msg;
+    out.error = "l6470emu: scenario " + name + ":" + std::to_string(e.mark.line + 1) + ": not YAML: " + shown_text(e.msg, 200);
   } catch (const std::exception& e) {
-    out.error = "l6470emu: scenario " + name + ": " + e.what();
+    out.error = "l6470emu: scenario " + name + ": " + shown_text(e.what(), 200);
   }
   if (!out.error.empty()) out.scenario.reset();
   return out;
