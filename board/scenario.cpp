@@ -17,8 +17,31 @@ E enum_at(const json& j, const char* key, unsigned count) {
   return static_cast<E>(v);
 }
 
-json chip_json(const ScenarioChip& c) { return json{{"chain", c.chain}, {"number", c.number}}; }
-ScenarioChip chip_of(const json& j) { return ScenarioChip{j.at("chain").get<std::string>(), j.at("number").get<std::size_t>()}; }
+// Strings travel as hex: a scenario's names are bytes (a file need not be UTF-8), JSON strings are not.
+std::string hex(std::string_view s) {
+  static const char* digits = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : s) {
+    out += digits[c >> 4];
+    out += digits[c & 15];
+  }
+  return out;
+}
+std::string unhex(const json& j) {
+  const std::string s = j.get<std::string>();
+  if (s.size() % 2) throw std::invalid_argument("odd hex string");
+  auto value = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    throw std::invalid_argument("bad hex digit");
+  };
+  std::string out;
+  for (std::size_t i = 0; i < s.size(); i += 2) out += static_cast<char>(value(s[i]) << 4 | value(s[i + 1]));
+  return out;
+}
+
+json chip_json(const ScenarioChip& c) { return json{{"chain", hex(c.chain)}, {"number", c.number}}; }
+ScenarioChip chip_of(const json& j) { return ScenarioChip{unhex(j.at("chain")), j.at("number").get<std::size_t>()}; }
 
 }  // namespace
 
@@ -46,9 +69,9 @@ std::string serialize_scenario(const Scenario& s) {
   json steps = json::array();
   for (const ScenarioStep& st : s.steps) {
     const ScenarioTrigger& t = st.when;
-    json j{{"where", st.where},
+    json j{{"where", hex(st.where)},
            {"when", {{"kind", static_cast<unsigned>(t.kind)}, {"tick", t.tick}, {"chip", chip_json(t.chip)},
-                     {"position", t.position}, {"command", t.command}, {"count", t.count}, {"delay", t.delay}}}};
+                     {"position", t.position}, {"command", hex(t.command)}, {"count", t.count}, {"delay", t.delay}}}};
     if (st.action) {
       const ScenarioAction& a = *st.action;
       j["do"] = {{"kind", static_cast<unsigned>(a.kind)}, {"chip", chip_json(a.chip)}, {"level", a.level},
@@ -59,15 +82,15 @@ std::string serialize_scenario(const Scenario& s) {
     if (st.expect) {
       const ScenarioExpectation& e = *st.expect;
       json flags = json::array();
-      for (const auto& [name, bit] : e.flags) flags.push_back({name, bit});
-      j["expect"] = {{"kind", static_cast<unsigned>(e.kind)}, {"chip", chip_json(e.chip)}, {"name", e.name},
+      for (const auto& [name, bit] : e.flags) flags.push_back({hex(name), bit});
+      j["expect"] = {{"kind", static_cast<unsigned>(e.kind)}, {"chip", chip_json(e.chip)}, {"name", hex(e.name)},
                      {"value", e.value}, {"tolerance", e.tolerance}, {"flags", flags}, {"min_ticks", e.min_ticks},
                      {"max_ticks", e.max_ticks}, {"pulse", e.pulse}, {"count", e.count},
                      {"min_count", e.min_count}, {"max_count", e.max_count}};
     }
     steps.push_back(std::move(j));
   }
-  json out{{"l6470emu_scenario", 1}, {"name", s.name}, {"steps", steps}};
+  json out{{"l6470emu_scenario", 1}, {"name", hex(s.name)}, {"steps", steps}};
   if (s.timeout_ticks) out["timeout_ticks"] = *s.timeout_ticks;
   return out.dump();
 }
@@ -77,17 +100,17 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
     const json j = json::parse(text);
     if (j.at("l6470emu_scenario").get<int>() != 1) throw std::runtime_error("unknown version");
     Scenario s;
-    s.name = j.at("name").get<std::string>();
+    s.name = unhex(j.at("name"));
     if (j.contains("timeout_ticks")) s.timeout_ticks = j.at("timeout_ticks").get<Tick>();
     for (const json& js : j.at("steps")) {
       ScenarioStep st;
-      st.where = js.at("where").get<std::string>();
+      st.where = unhex(js.at("where"));
       const json& w = js.at("when");
       st.when.kind = enum_at<ScenarioTrigger::Kind>(w, "kind", 7);
       st.when.tick = w.at("tick").get<Tick>();
       st.when.chip = chip_of(w.at("chip"));
       st.when.position = w.at("position").get<std::int64_t>();
-      st.when.command = w.at("command").get<std::string>();
+      st.when.command = unhex(w.at("command"));
       st.when.count = w.at("count").get<std::uint32_t>();
       st.when.delay = w.at("delay").get<Tick>();
       if (js.contains("do")) {
@@ -110,10 +133,10 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
         ScenarioExpectation x;
         x.kind = enum_at<ScenarioExpectation::Kind>(e, "kind", 6);
         x.chip = chip_of(e.at("chip"));
-        x.name = e.at("name").get<std::string>();
+        x.name = unhex(e.at("name"));
         x.value = e.at("value").get<std::int64_t>();
         x.tolerance = e.at("tolerance").get<std::int64_t>();
-        for (const json& f : e.at("flags")) x.flags.emplace_back(f.at(0).get<std::string>(), f.at(1).get<bool>());
+        for (const json& f : e.at("flags")) x.flags.emplace_back(unhex(f.at(0)), f.at(1).get<bool>());
         x.min_ticks = e.at("min_ticks").get<Tick>();
         x.max_ticks = e.at("max_ticks").get<Tick>();
         x.pulse = e.at("pulse").get<std::uint32_t>();

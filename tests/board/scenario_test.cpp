@@ -246,7 +246,10 @@ TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
   const auto back = deserialize_scenario(serialize_scenario(s), error);
   ASSERT_TRUE(back) << error;
   EXPECT_EQ(*back, s);
-  EXPECT_FALSE(deserialize_scenario("{\"l6470emu_scenario\":1,\"name\":\"x\",\"steps\":[{}]}", error));
+  EXPECT_FALSE(deserialize_scenario("{\"l6470emu_scenario\":1,\"name\":\"78\",\"steps\":[{}]}", error));
+  s.name = "\xff\xfe not UTF-8";  // names are bytes
+  ASSERT_TRUE(deserialize_scenario(serialize_scenario(s), error));
+  EXPECT_EQ(deserialize_scenario(serialize_scenario(s), error)->name, s.name);
   EXPECT_NE(error.find("not a scenario"), std::string::npos);
 }
 
