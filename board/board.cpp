@@ -208,20 +208,34 @@ bool Board::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
   return level_of(c, chip, pin);
 }
 
-void Board::watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched) {
+void Board::watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched) { set_watch(chain, chip, pin, watched, false); }
+
+void Board::observe_pin(std::size_t chain, std::size_t chip, Pin pin, bool observed) {
+  set_watch(chain, chip, pin, observed, true);
+}
+
+void Board::set_watch(std::size_t chain, std::size_t chip, Pin pin, bool on, bool observer) {
   ChainState& c = state(chain);
   c.prediction_valid = false;
-  const ChainState::WatchedPin w{chip, pin};
+  ChainState::WatchedPin w{chip, pin};
   auto it = std::lower_bound(c.watched.begin(), c.watched.end(), w);
-  if (!watched) {
-    if (it != c.watched.end() && *it == w) c.watched.erase(it);
+  const bool found = it != c.watched.end() && it->same_pin(w);
+  if (!on) {
+    if (!found) return;
+    (observer ? it->by_observer : it->by_front) = false;
+    if (!it->by_front && !it->by_observer) c.watched.erase(it);
     return;
   }
-  if (it == c.watched.end() || *it != w) c.watched.insert(it, w);
+  if (!found) it = c.watched.insert(it, w);
+  (observer ? it->by_observer : it->by_front) = true;
   c.last.at(chip)[static_cast<unsigned>(pin)] = level_of(c, chip, pin);
 }
 
-bool Board::has_watched_pins(std::size_t chain) const { return !state(chain).watched.empty(); }
+bool Board::has_watched_pins(std::size_t chain) const {
+  for (const ChainState::WatchedPin& w : state(chain).watched)
+    if (w.by_front) return true;
+  return false;
+}
 
 void Board::report_changes(std::size_t chain) {
   ChainState& c = state(chain);
@@ -235,7 +249,9 @@ void Board::emit_changes(ChainState& c, Tick tick) {
     bool& last = c.last[w.chip][static_cast<unsigned>(w.pin)];
     if (level == last) continue;
     last = level;
-    if (edge_sink_) edge_sink_(PinEdge{c.index, w.chip, w.pin, level, tick});
+    const PinEdge edge{c.index, w.chip, w.pin, level, tick};
+    if (w.by_front && edge_sink_) edge_sink_(edge);
+    if (w.by_observer && observer_sink_) observer_sink_(edge);
   }
 }
 

@@ -166,7 +166,13 @@ class Board {
   /// ticks as time passes). A watch starts from the pin's level at the chain's tick, even when
   /// the pin was already watched.
   void watch_pin(std::size_t chain, std::size_t chip, Pin pin, bool watched);
-  /// Whether any pin of chain `chain` is watched.
+  /// Starts (true) or stops observing a pin for an observer of the world (a scenario): its
+  /// edges go to the observer sink at their ticks, independently of watch_pin's (the front's).
+  void observe_pin(std::size_t chain, std::size_t chip, Pin pin, bool observed);
+  /// Where the edges of observed pins go (an empty function drops them). Called inside the
+  /// board's operations: the sink must only take note, never call the board.
+  void set_observer_sink(EdgeSink sink) { observer_sink_ = std::move(sink); }
+  /// Whether any pin of chain `chain` is watched by the front.
   bool has_watched_pins(std::size_t chain) const;
   /// Raw: records the outputs of a chain being recorded and reports the changes of its watched
   /// pins, at the chain's own tick.
@@ -248,10 +254,12 @@ class Board {
   Tick predict_next_edge(ChainState& c);
   void emit_changes(ChainState& c, Tick tick);
   bool level_of(const ChainState& c, std::size_t chip, Pin pin) const;
+  void set_watch(std::size_t chain, std::size_t chip, Pin pin, bool on, bool observer);
 
   LineSink log_;
   Sanitizer sanitizer_;
   EdgeSink edge_sink_;
+  EdgeSink observer_sink_;
   BoardTime time_;
   NumberFrom numbering_ = NumberFrom::miso;
   BoardConfig config_;  // the description (board-wide keys) a recording's header carries

@@ -14,11 +14,15 @@ namespace l6470emu {
 struct Board::ChainState {
   /// One level per pin of a chip, indexed by Pin.
   using PinLevels = std::array<bool, kPinsPerChip>;
-  /// A watched pin; sorted by chip, then pin (a gpiochip's line order).
+  /// A watched pin; sorted by chip, then pin (a gpiochip's line order). Watched by the front
+  /// (its edges go to the edge sink), by the observer (to the observer sink), or both.
   struct WatchedPin {
     std::size_t chip = 0;
     Pin pin = Pin::BUSY;
-    auto operator<=>(const WatchedPin&) const = default;
+    bool by_front = false;
+    bool by_observer = false;
+    bool operator<(const WatchedPin& o) const { return chip < o.chip || (chip == o.chip && pin < o.pin); }
+    bool same_pin(const WatchedPin& o) const { return chip == o.chip && pin == o.pin; }
   };
 
   /// How one chip's diagnostics are logged: its name in the log and how many of each kind came.

@@ -55,6 +55,20 @@ void Axis::set_load(const LoadSpec& load) {
   forget_table();
 }
 
+void Axis::set_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper) {
+  spec_.has_lower_stop = has_lower;
+  spec_.lower_stop = lower;
+  spec_.has_upper_stop = has_upper;
+  spec_.upper_stop = upper;
+  table_.clear();
+}
+
+void Axis::set_supply(std::uint32_t supply_mV) {
+  if (spec_.supply.supply_mV == supply_mV) return;
+  spec_.supply.supply_mV = supply_mV;
+  table_.clear();
+}
+
 void Axis::set_drive(const DriveInputs& drive) {
   if (drive_ == drive) return;
   drive_ = drive;

@@ -61,6 +61,10 @@ class Axis {
 
   /// A new load (at runtime): inertia, friction, constant force.
   void set_load(const LoadSpec& load);
+  /// New hard stops (at runtime), 1/128 step; a rotor beyond a new stop is held at it.
+  void set_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper);
+  /// A new motor supply (at runtime), mV.
+  void set_supply(std::uint32_t supply_mV);
   /// The chip's drive registers; the cached per-speed table is rebuilt when they change.
   void set_drive(const DriveInputs& drive);
 

@@ -67,7 +67,10 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   if (!stby_level_) return 0x00;
   // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
   // the flags, which cannot have changed, so polling does not work the motion out.
-  if (byte == 0xD0 && !collecting_) return get_status(status());  // the polling command, straight through
+  if (byte == 0xD0 && !collecting_) {  // the polling command, straight through
+    if (command_sink_) command_sink_(variant_->opcodes[0xD0], 0);
+    return get_status(status());
+  }
   sync();
   if (collecting_) {
     arg_ = (arg_ << 8) | byte;
@@ -110,6 +113,7 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
 }
 
 void Chip::execute(const Opcode& op, std::uint32_t arg) {
+  if (command_sink_) command_sink_(op, arg);
   // Reading commands leave the motion as it is; everything else may change it.
   if (op.command != Command::GetStatus && op.command != Command::GetParam && op.command != Command::NOP)
     touched();
@@ -632,6 +636,24 @@ void Chip::set_axis_load(const LoadSpec& load) {
   touched();
   axis_->set_load(load);
   forget_axis_event();
+  axis_settle(now_);
+}
+
+void Chip::set_axis_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper) {
+  if (!axis_) return;
+  sync();
+  touched();
+  axis_->set_stops(has_lower, lower, has_upper, upper);
+  axis_event_known_ = false;
+  axis_settle(now_);
+}
+
+void Chip::set_axis_supply(std::uint32_t supply_mV) {
+  if (!axis_) return;
+  sync();
+  touched();
+  axis_->set_supply(supply_mV);
+  axis_event_known_ = false;
   axis_settle(now_);
 }
 

@@ -60,7 +60,7 @@ class alignas(64) Chip {
       assert(now >= now_);
       now_ = now;
       // GetStatus, the polling command, while its answer is known without working the motion out.
-      if (byte == 0xD0 && now < status_until_) {
+      if (byte == 0xD0 && now < status_until_ && !has_command_sink_) {
         const std::uint16_t status = cached_status();  // nothing latched to clear: a plain read
         response_ = status & 0xFFu;
         response_left_ = 1;
@@ -163,6 +163,12 @@ class alignas(64) Chip {
   const Axis* axis() const;
   /// Changes the axis's load at runtime (no effect without an axis).
   void set_axis_load(const LoadSpec& load);
+  /// Changes the axis's hard stops at runtime (no effect without an axis): a stop put where the
+  /// rotor would pass blocks it there as a built-in one does.
+  void set_axis_stops(bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper);
+  /// Changes the motor supply the axis sees (torque and current follow; no effect without an
+  /// axis). The UVLO flag is the backdoor's business (set_undervoltage).
+  void set_axis_supply(std::uint32_t supply_mV);
 
   // ---- inspection without side effects --------------------------------------
 
@@ -192,6 +198,13 @@ class alignas(64) Chip {
 
   /// Where diagnostics go (unknown opcodes, refused commands).
   void set_diagnostic_sink(DiagnosticSink sink) { sink_ = std::move(sink); }
+  /// Who hears of every command the chip decodes (its opcode and argument), before it runs.
+  /// Observers only (a scenario's "command seen"): the sink must not call back into the chip.
+  using CommandSink = std::function<void(const Opcode& op, std::uint32_t arg)>;
+  void set_command_sink(CommandSink sink) {
+    command_sink_ = std::move(sink);
+    has_command_sink_ = static_cast<bool>(command_sink_);
+  }
 
  private:
   std::uint8_t decode_byte(std::uint8_t byte);
@@ -261,6 +274,7 @@ class alignas(64) Chip {
   bool collecting_ = false;
   bool stby_level_ = true;
   bool ready_for_command_ = true;  // stby_level_ && !collecting_: the next byte is an opcode
+  bool has_command_sink_ = false;  // command_sink_ is set: GetStatus goes the way that reports it
   mutable bool live_bits_known_ = false;
   mutable std::uint16_t live_bits_ = 0;
   std::uint16_t latched_bits_ = 0;  // latched_ encoded in the variant's STATUS layout
@@ -332,6 +346,7 @@ class alignas(64) Chip {
   std::uint8_t adc_code_ = 0;
 
   DiagnosticSink sink_;
+  CommandSink command_sink_;
 
   // The axis, when attached. Its events are found inside the runs of uniform ticks.
   ValuePtr<Axis> axis_;

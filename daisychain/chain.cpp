@@ -172,6 +172,7 @@ void Chain::deselect() {
 void Chain::decode_shift_registers() {
   // Chip i decodes logical register i, ring_[(head_ + i) % n]: chips 0 .. n-head-1 read the
   // ring from head_ on, the others from slot 0. Each chip's answer byte replaces its register.
+  ++frames_;  // every frame the chips decode (scenario expectations count them)
   Chip* const chips = chips_.data();
   std::uint8_t* const ring = ring_.data();
   const std::size_t n = chips_.size();

@@ -61,6 +61,8 @@ class Chain final : public SpiDevice {
   /// The earliest next_event_tick() of the chips.
   Tick next_event_tick() const;
 
+  /// CS frames that clocked at least one byte, since the chain was made.
+  std::uint64_t frames() const { return frames_; }
   /// Bytes clocked since the last CS falling edge.
   std::uint64_t bytes_in_frame() const { return bytes_in_frame_; }
 
@@ -138,6 +140,7 @@ class Chain final : public SpiDevice {
   mutable bool quiet_ = false;
   bool any_standby_ = false;
   std::uint64_t bytes_in_frame_ = 0;
+  std::uint64_t frames_ = 0;
   Tick now_ = 0;
 
   // ---- the bit-level interface's state (chain_wire.cpp) ----

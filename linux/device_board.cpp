@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <sstream>
 
+#include "board/scenario_runner.hpp"
 #include "board/trace_recorder.hpp"
 #include "linux/recording_output.hpp"
 #include "linux/device_board_internal.hpp"
@@ -212,6 +213,7 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
   // node's settings drives it (its sanitizer names what the chip cannot work with); spidev says
   // what to clock.
   const WireSettings wire = spidev_wire_settings(settings);
+  if (scenario_ && !time().is_virtual()) scenario_->poll();  // `run`'s scenario: steps due by now
   const bool sliced = caller_alive && !time().is_virtual() && message.bus_ticks() > kBusSliceTicks;
   if (!sliced) {
     message.run(board_.begin_transfer(chain, wire), kNever);
@@ -260,6 +262,7 @@ long DeviceBoard::run_spi_message(std::uint64_t handle, std::span<const spi_ioc_
 long DeviceBoard::finish_spi_message(std::size_t chain, std::span<const spi_ioc_transfer> xfers,
                                      std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, Tick end,
                                      long total, std::string* check_report) {
+  if (scenario_) scenario_->after_transfer();  // `run`'s scenario: steps the message triggered
   if (observer_) observer_(chain, xfers, tx, rx, end);
   if (board_.sanitizer().failed()) {
     // check=error: the run ends here. The message happened (the chips took it as they would);
@@ -461,7 +464,33 @@ bool DeviceBoard::advance(Tick ticks) {
 bool DeviceBoard::advance_to(Tick tick) {
   if (!time().is_virtual()) return false;
   std::lock_guard lock(m_);
+  if (scenario_) {
+    scenario_->advance_to(tick);
+    return true;
+  }
   return board_.advance_to(tick);
+}
+
+void DeviceBoard::set_scenario(const Scenario& scenario) {
+  std::lock_guard lock(m_);
+  scenario_.reset();
+  scenario_ = std::make_unique<ScenarioRunner>(board_, scenario);
+}
+
+Tick DeviceBoard::scenario_next_tick() {
+  std::lock_guard lock(m_);
+  return scenario_ ? scenario_->next_tick() : kNever;
+}
+
+bool DeviceBoard::finish_scenario(ScenarioOutcome& out) {
+  std::lock_guard lock(m_);
+  if (!scenario_) return false;
+  scenario_->finish();
+  out.judged = scenario_->judged();
+  out.failures = scenario_->failures();
+  out.passed = scenario_->passed();
+  out.log = scenario_->log();
+  return true;
 }
 
 Tick DeviceBoard::next_edge_tick() {

@@ -24,6 +24,7 @@
 
 #include "board/board.hpp"
 #include "board/board_config.hpp"
+#include "board/scenario.hpp"
 #include "daisychain/chain.hpp"
 #include "linux/clock.hpp"
 #include "linux/gpio_lines.hpp"
@@ -32,6 +33,16 @@
 #include "spi/trace.hpp"
 
 namespace l6470emu {
+
+class ScenarioRunner;
+
+/// What a scenario came to when the program ended (DeviceBoard::finish_scenario).
+struct ScenarioOutcome {
+  std::size_t judged = 0;                  ///< expectations judged
+  std::vector<ScenarioFailure> failures;   ///< those that failed
+  std::vector<std::string> passed;         ///< "WHERE: what" of those that held
+  std::vector<std::string> log;            ///< what the world did, one line each
+};
 
 /// What kind of open file a handle is.
 enum class HandleKind : std::uint8_t {
@@ -199,6 +210,17 @@ class DeviceBoard {
   /// After fork() in the child: drops the parent's recordings without writing to them.
   void forget_recordings_after_fork();
 
+  // ---- a scenario (`l6470emu run`) -----------------------------------------------------
+
+  /// Binds `scenario` to the board (board/scenario_runner.hpp): from now on advance_to fires its
+  /// steps at their ticks, SPI messages its command steps (wall time: its due steps first).
+  /// Throws std::invalid_argument (one line naming the step) when it does not fit the board.
+  void set_scenario(const Scenario& scenario);
+  /// The tick of the scenario's next timed step (kNever: none, or no scenario).
+  Tick scenario_next_tick();
+  /// Ends the scenario at the board's time now (its `end` expectations judged). False: none.
+  bool finish_scenario(ScenarioOutcome& out);
+
   /// Open handles, by kind, as text (for `ctl dump`).
   std::string describe_handles();
 
@@ -264,6 +286,7 @@ class DeviceBoard {
   std::unordered_map<std::uint64_t, std::unique_ptr<Handle>> handles_;
   std::mt19937_64 handle_ids_;  // seeded from getrandom(): handle ids are capabilities
   MessageObserver observer_;
+  std::unique_ptr<ScenarioRunner> scenario_;
 
   std::mutex m_;
   // Buses a sliced message owns until it ends (its caller sleeping between slices, the lock

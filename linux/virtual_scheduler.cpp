@@ -307,6 +307,7 @@ void VirtualScheduler::decide_locked(bool forced) {
       board = board || w->w->watches_board;
     }
     if (board && hooks_.next_edge) d = std::min(d, hooks_.next_edge());
+    if (hooks_.next_world) d = std::min(d, hooks_.next_world());
     for (const auto& [id, tick] : timers_) d = std::min(d, tick);
     if (d == kNever) {
       // Every thread waits for something outside the process, or for nothing that can come.

@@ -55,6 +55,9 @@ class VirtualScheduler {
     std::function<Tick()> now;               ///< the board's tick
     std::function<void(Tick)> advance_to;    ///< moves the board to a tick (edges delivered)
     std::function<Tick()> next_edge;         ///< the board's next edge on a watched line (kNever: none)
+    /// The world's next change whatever the threads wait for (a scenario's next step, a run's
+    /// time limit; kNever: none): always a wake-up, so never a deadlock while one is to come.
+    std::function<Tick()> next_world;
     std::function<void(int)> fire_timer;     ///< a timer set with set_timer() expired
     std::function<std::int64_t()> real_ns;   ///< the real monotonic clock, ns (idle grace)
     std::function<void(std::string_view)> log;  ///< diagnostics (the idle-grace line)

@@ -1,6 +1,7 @@
 // The preload's side of the driver sanitizer and of mistyped names: the run's end under
 // check=error, unknown L6470EMU_* variables, device nodes the board does not have.
 #include "linux/preload/check_exit.hpp"
+#include "linux/preload/run.hpp"
 
 #include <unistd.h>
 
@@ -32,6 +33,8 @@ constexpr const char* kKnown[] = {
 void end_run_for_check(const std::string& report) {
   {
     Guard guard;
+    // Under `l6470emu run`: the report says why the program ended (run's own exit status for it).
+    if (in_run()) end_run(RunEnd::sanitizer, report.substr(0, report.find('\n')));
     raw_write_all(2, report.data(), report.size());
     if (!log_is_stderr()) {
       const std::string first = report.substr(0, report.find('\n'));

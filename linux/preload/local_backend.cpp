@@ -5,6 +5,7 @@
 
 #include "linux/preload/backend.hpp"
 #include "linux/preload/check_exit.hpp"
+#include "linux/preload/run.hpp"
 #include "linux/preload/virtual_time.hpp"
 
 namespace l6470emu::preload {
@@ -13,6 +14,7 @@ namespace {
 class LocalBackend final : public Backend {
  public:
   explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_), trace_(config.trace) {
+    start_run(board_);  // `l6470emu run`: the scenario, the time limit, the report at exit
     if (config.time.virtual_time) {
       // Made when the program starts (its clock is the board's from then on): the trace starts
       // with the first open of a device, so that a child that never opens one (a shell, a
@@ -36,14 +38,17 @@ class LocalBackend final : public Backend {
   // check=error: a message that broke a rule of the chip ends the run with the report.
   long spi_message(std::uint64_t handle, std::span<const spi_ioc_transfer> xfers, std::span<const std::uint8_t> tx,
                    std::span<std::uint8_t> rx) override {
+    run_device_opened();
     std::string report;
     return checked(board_.spi_message(handle, xfers, tx, rx, &report), report);
   }
   long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
+    run_device_opened();
     std::string report;
     return checked(board_.spi_read(handle, rx, &report), report);
   }
   long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
+    run_device_opened();
     std::string report;
     return checked(board_.spi_write(handle, tx, &report), report);
   }
@@ -60,6 +65,7 @@ class LocalBackend final : public Backend {
     board_.mutex().unlock();
     board_.forget_pump_after_fork();
     board_.forget_recordings_after_fork();
+    run_after_fork_child();
     // The child goes on with its own copy of the board and of its virtual clock.
     if (virtual_time_) virtual_time_->after_fork_child();
   }

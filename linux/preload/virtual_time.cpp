@@ -1,6 +1,7 @@
 // Virtual host time in the preload library: clock conversions, covered waits, the busy-wait
 // rule, the board's bus-time waiter, fork hooks.
 #include "linux/preload/virtual_time.hpp"
+#include "linux/preload/run.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -139,8 +140,12 @@ VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   VirtualScheduler::Hooks h;
   DeviceBoard& board = board_;
   h.now = [&board] { return board.time().now(); };
-  h.advance_to = [&board](Tick t) { board.advance_to(t); };
+  h.advance_to = [&board](Tick t) {
+    board.advance_to(t);
+    run_time_reached(t);  // `run --timeout`: the run ends at its simulated time limit
+  };
   h.next_edge = [&board] { return board.next_edge_tick(); };
+  h.next_world = [] { return run_next_tick(); };
   h.fire_timer = [](int fd) { fire_virtual_timerfd(fd); };
   h.real_ns = [] { return real_clock_ns(CLOCK_MONOTONIC); };
   h.log = [](std::string_view line) { log_line(line); };
@@ -197,6 +202,7 @@ std::string VirtualHostTime::describe_board() {
 }
 
 void VirtualHostTime::end_deadlocked(const std::string& report) {
+  end_run(RunEnd::deadlock, report);  // `l6470emu run` learns the cause from its report, not from the status
   // The report on standard error (as a sanitizer's), and in the log file when there is one.
   write_stderr_lines(report);
   if (!log_is_stderr()) {

@@ -1,0 +1,124 @@
+// The preload's side of `l6470emu run`: scenario, time limit, report.
+#include "linux/preload/run.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "linux/log.hpp"
+#include "linux/preload/real.hpp"
+#include "linux/preload/state.hpp"
+
+namespace l6470emu::preload {
+namespace {
+
+DeviceBoard* g_board = nullptr;
+std::string* g_report_path = nullptr;  // never freed: read at exit
+Tick g_timeout = kNever;
+std::atomic<bool> g_reported{false};
+std::atomic<bool> g_devices{false};
+
+void at_exit() { end_run(RunEnd::exit, ""); }
+
+[[noreturn]] void refuse(const std::string& line) {
+  const std::string text = line + "\n";
+  raw_write_all(2, text.data(), text.size());
+  _exit(kRunUsage);
+}
+
+}  // namespace
+
+void start_run(DeviceBoard& board) {
+  Guard guard;
+  const char* report = std::getenv(kRunReportEnv);
+  const char* scenario = std::getenv(kRunScenarioEnv);
+  const char* timeout = std::getenv(kRunTimeoutEnv);
+  if (!(report && *report) && !(scenario && *scenario) && !(timeout && *timeout)) return;
+  g_board = &board;
+  if (report && *report) g_report_path = new std::string(report);
+  if (timeout && *timeout) {
+    char* end = nullptr;
+    const unsigned long long t = std::strtoull(timeout, &end, 10);
+    if (!end || *end || t == 0) refuse(std::string("l6470emu: ") + kRunTimeoutEnv + " is not a number of ticks");
+    g_timeout = static_cast<Tick>(t);
+  }
+  if (scenario && *scenario) {
+    std::ifstream in(scenario, std::ios::binary);
+    if (!in) refuse(std::string("l6470emu: the run's scenario ") + scenario + " cannot be read");
+    std::ostringstream text;
+    text << in.rdbuf();
+    std::string error;
+    const auto s = deserialize_scenario(text.str(), error);
+    if (!s) refuse("l6470emu: " + std::string(scenario) + ": " + error);
+    try {
+      board.set_scenario(*s);
+    } catch (const std::exception& e) {
+      refuse(std::string("l6470emu: scenario ") + e.what());
+    }
+  }
+  std::atexit(at_exit);
+}
+
+bool in_run() { return g_board != nullptr; }
+
+Tick run_next_tick() {
+  if (!g_board) return kNever;
+  return std::min(g_board->scenario_next_tick(), g_timeout);
+}
+
+void run_time_reached(Tick now) {
+  if (!g_board || now < g_timeout) return;
+  end_run(RunEnd::timeout, "the simulated time limit " + seconds_text(g_timeout) + " was reached");
+  for (std::size_t c = 0; c < g_board->chain_count(); ++c) g_board->stop_recording(c);
+  for (FILE* f : {stdout, stderr})
+    if (ftrylockfile(f) == 0) {
+      fflush_unlocked(f);
+      funlockfile(f);
+    }
+  _exit(kTimeoutExitStatus);
+}
+
+void run_device_opened() { g_devices.store(true, std::memory_order_relaxed); }
+
+void end_run(RunEnd cause, std::string_view detail) {
+  if (!g_board || g_reported.exchange(true)) return;
+  Guard guard;
+  RunReport r;
+  r.pid = getpid();
+  r.end = cause;
+  r.devices = g_devices.load(std::memory_order_relaxed);
+  try {
+    r.scenario = g_board->finish_scenario(r.outcome);
+    r.tick = g_board->time().now();
+    std::size_t at = 0;
+    while (at < detail.size()) {
+      const std::size_t nl = std::min(detail.find('\n', at), detail.size());
+      if (nl > at) r.detail.emplace_back(detail.substr(at, nl - at));
+      at = nl + 1;
+    }
+  } catch (...) {
+  }
+  if (!g_report_path) return;
+  const std::string text = format_run_report(r);
+  // One write with O_APPEND: the blocks of several processes do not interleave.
+  const int fd = real::open(g_report_path->c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    log_line("the run report " + *g_report_path + " cannot be written");
+    return;
+  }
+  raw_write_all(fd, text.data(), text.size());
+  real::close(fd);
+}
+
+void run_after_fork_child() {
+  g_reported.store(false);
+  g_devices.store(false);
+}
+
+}  // namespace l6470emu::preload

@@ -1,0 +1,37 @@
+// The preload's side of `l6470emu run`: the scenario bound to the in-process board, the
+// simulated time limit, and the report of why the program ended (linux/run_report.hpp), written
+// once per process. Inactive (every call a no-op) outside a run.
+#pragma once
+
+#include <string_view>
+
+#include "core/tick.hpp"
+#include "linux/device_board.hpp"
+#include "linux/run_report.hpp"
+
+namespace l6470emu::preload {
+
+/// Reads the run's environment (kRunScenarioEnv, kRunTimeoutEnv, kRunReportEnv) and binds the
+/// scenario to `board`; the report is written at exit(). A scenario that cannot be read or does
+/// not fit the board (run checked it; another board description in a child could differ) ends
+/// the program with one line and status 2.
+void start_run(DeviceBoard& board);
+/// Whether this process is part of a run.
+bool in_run();
+/// The next tick the world changes at: the scenario's next timed step or the time limit (kNever).
+Tick run_next_tick();
+/// Virtual time reached `now`: at or past the time limit the run ends here (report, status
+/// kTimeoutExitStatus), with what was recorded finished first.
+void run_time_reached(Tick now);
+/// This process exchanged SPI bytes with the board (its report is judged; one that only looked
+/// at a device, like `spi-config -q`, is not).
+void run_device_opened();
+/// Writes this process's report once: `cause` and its words. The first cause wins (an exit()
+/// after a reported deadlock adds nothing). The deadlock path calls it with RunEnd::deadlock and
+/// the driver sanitizer's check=error path must call it with RunEnd::sanitizer and its finding
+/// before ending the program, so that `run` can tell them apart whatever the exit status.
+void end_run(RunEnd cause, std::string_view detail);
+/// fork(): the child reports for itself (it has opened nothing yet).
+void run_after_fork_child();
+
+}  // namespace l6470emu::preload

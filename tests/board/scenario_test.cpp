@@ -1,0 +1,257 @@
+// Scenarios on the OS-free Board: actions at their exact ticks and events, expectations judged
+// with what/when/which chip/expected/seen, the exchange form read back, mistakes named by step.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <stdexcept>
+#include <vector>
+
+#include "board/board.hpp"
+#include "board/scenario.hpp"
+#include "board/scenario_runner.hpp"
+#include "spi/message.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+class StillHostClock final : public HostClock {
+ public:
+  std::int64_t monotonic_ns() override { return 0; }
+  std::int64_t realtime_ns() override { return 0; }
+  void sleep_until(std::int64_t) override {}
+};
+
+BoardConfig config_of(const std::string& text) {
+  ParseResult p = parse_board_config(text, "test");
+  EXPECT_TRUE(p.config) << p.error.message;
+  return *p.config;
+}
+
+struct VirtualBoard {
+  explicit VirtualBoard(const std::string& description)
+      : board(config_of(description), [this](std::string_view line) { log.emplace_back(line); }, clock) {}
+  StillHostClock clock;
+  std::vector<std::string> log;
+  Board board;
+};
+
+// One-byte frames (a chain of one chip), as a driver sends a command.
+Tick send(Board& board, std::initializer_list<std::uint8_t> bytes) {
+  std::vector<std::uint8_t> tx(bytes);
+  std::vector<SpiTransfer> frames;
+  for (std::size_t i = 0; i < tx.size(); ++i) {
+    SpiTransfer t;
+    t.tx = std::span<const std::uint8_t>(&tx[i], 1);
+    t.len = 1;
+    t.cs_change = i + 1 != tx.size();
+    frames.push_back(t);
+  }
+  return board.transfer(0, frames);
+}
+
+ScenarioStep at_time(Tick tick, ScenarioAction a, std::string where = "s.yaml:1") {
+  ScenarioStep s;
+  s.where = std::move(where);
+  s.when.kind = ScenarioTrigger::Kind::time;
+  s.when.tick = tick;
+  s.action = a;
+  return s;
+}
+
+ScenarioStep expect_at(ScenarioTrigger when, ScenarioExpectation e, std::string where = "s.yaml:2") {
+  ScenarioStep s;
+  s.where = std::move(where);
+  s.when = std::move(when);
+  s.expect = std::move(e);
+  return s;
+}
+
+ScenarioExpectation reg(std::string name, std::int64_t value, std::int64_t tolerance = 0) {
+  ScenarioExpectation e;
+  e.kind = ScenarioExpectation::Kind::reg;
+  e.name = std::move(name);
+  e.value = value;
+  e.tolerance = tolerance;
+  return e;
+}
+
+TEST(ScenarioRunner, ATimedSwitchClosureReachesTheChipAtItsTickWhateverTheHostWaitsFor) {
+  VirtualBoard v("chips=L6470; time=virtual");
+  ScenarioAction close;
+  close.kind = ScenarioAction::Kind::sw;
+  close.level = false;
+  Scenario s;
+  s.steps.push_back(at_time(ticks_from_ms(100), close));
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation st;
+  st.kind = ScenarioExpectation::Kind::status;
+  st.flags = {{"SW_F", true}, {"SW_EVN", true}};
+  s.steps.push_back(expect_at(end, st));
+  ScenarioRunner runner(v.board, s);
+  EXPECT_EQ(runner.next_tick(), ticks_from_ms(100));
+  runner.advance_to(ticks_from_ms(1000));  // one jump, as a host sleeping a second makes
+  EXPECT_EQ(runner.next_tick(), kNever);
+  EXPECT_FALSE(v.board.pin_level(0, 0, Pin::SW));
+  ASSERT_FALSE(runner.log().empty());
+  EXPECT_EQ(runner.log()[0].rfind("0.100000 s: s.yaml:1: spidev0.0 chip 0: SW closed", 0), 0u) << runner.log()[0];
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty());
+  EXPECT_EQ(runner.judged(), 1u);
+}
+
+TEST(ScenarioRunner, APositionTriggerFiresAtTheExactTickTheRegisterReachesIt) {
+  VirtualBoard v("chips=L6470; time=virtual");
+  Scenario s;
+  ScenarioTrigger at_pos;
+  at_pos.kind = ScenarioTrigger::Kind::position;
+  at_pos.position = 5000;
+  s.steps.push_back(expect_at(at_pos, reg("ABS_POS", 5000), "s.yaml:3"));
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  s.steps.push_back(expect_at(end, reg("ABS_POS", 10001), "s.yaml:4"));  // one off: must fail
+  ScenarioRunner runner(v.board, s);
+  const Tick t = send(v.board, {0x41, 0x00, 0x27, 0x10});  // Move(forward, 10000 microsteps)
+  runner.after_transfer();
+  runner.advance_to(t + ticks_from_ms(2000));
+  runner.finish();
+  ASSERT_EQ(runner.failures().size(), 1u);
+  const ScenarioFailure& f = runner.failures()[0];
+  EXPECT_EQ(f.where, "s.yaml:4");
+  EXPECT_EQ(f.what, "ABS_POS");
+  EXPECT_EQ(f.chip, "spidev0.0 chip 0");
+  EXPECT_EQ(f.expected, "10001");
+  EXPECT_EQ(f.seen, "10000");
+  EXPECT_EQ(f.tick, t + ticks_from_ms(2000));
+  EXPECT_EQ(runner.judged(), 2u);
+}
+
+TEST(ScenarioRunner, BusyPulsesCommandsAndFramesAreCountedAndJudgedAtTheEnd) {
+  VirtualBoard v("chips=L6470; time=virtual");
+  Scenario s;
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation pulse;
+  pulse.kind = ScenarioExpectation::Kind::busy_pulse;
+  pulse.pulse = 1;
+  pulse.min_ticks = ticks_from_ms(1);
+  pulse.max_ticks = ticks_from_ms(5);  // the move takes longer: fails with the length seen
+  s.steps.push_back(expect_at(end, pulse, "s.yaml:5"));
+  ScenarioExpectation sent;
+  sent.kind = ScenarioExpectation::Kind::command;
+  sent.name = "Move";
+  s.steps.push_back(expect_at(end, sent, "s.yaml:6"));
+  ScenarioExpectation not_sent = sent;
+  not_sent.name = "SoftStop";
+  not_sent.count = 0;
+  s.steps.push_back(expect_at(end, not_sent, "s.yaml:7"));
+  ScenarioExpectation frames;
+  frames.kind = ScenarioExpectation::Kind::frames;
+  frames.min_count = frames.max_count = 4;
+  s.steps.push_back(expect_at(end, frames, "s.yaml:8"));
+  ScenarioRunner runner(v.board, s);
+  const Tick t = send(v.board, {0x41, 0x00, 0x27, 0x10});
+  runner.after_transfer();
+  runner.advance_to(t + ticks_from_ms(2000));
+  runner.finish();
+  ASSERT_EQ(runner.failures().size(), 1u);
+  EXPECT_EQ(runner.failures()[0].what.rfind("BUSY pulse 1", 0), 0u);
+  EXPECT_EQ(runner.failures()[0].expected, "0.001000 s .. 0.005000 s");
+  EXPECT_NE(runner.failures()[0].seen, "still low at the end");
+  EXPECT_EQ(runner.judged(), 4u);
+}
+
+TEST(ScenarioRunner, AnActionOnACommandSeenIsAppliedWhenTheBusUseEnds) {
+  VirtualBoard v("chips=L6470; time=virtual");
+  Scenario s;
+  ScenarioStep st;
+  st.where = "s.yaml:9";
+  st.when.kind = ScenarioTrigger::Kind::command;
+  st.when.command = "run";  // names are matched ignoring case
+  ScenarioAction ocd;
+  ocd.kind = ScenarioAction::Kind::fault;
+  ocd.fault = TraceFault::OCD;
+  ocd.value = 1;
+  st.action = ocd;
+  s.steps.push_back(st);
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation flags;
+  flags.kind = ScenarioExpectation::Kind::status;
+  flags.flags = {{"OCD", false}};  // active low: 0 = overcurrent seen
+  s.steps.push_back(expect_at(end, flags));
+  ScenarioRunner runner(v.board, s);
+  send(v.board, {0xD0, 0x00, 0x00});  // GetStatus: the power-up UVLO latch released
+  EXPECT_TRUE(v.board.pin_level(0, 0, Pin::FLAG));
+  send(v.board, {0x51, 0x00, 0x10, 0x00});  // Run(forward)
+  runner.after_transfer();
+  EXPECT_FALSE(v.board.pin_level(0, 0, Pin::FLAG));
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty()) << runner.failures()[0].seen;
+}
+
+TEST(ScenarioRunner, AStepNamingWhatTheBoardLacksIsRefusedWithItsPlace) {
+  VirtualBoard v("chips=L6470,L6470; numbering=mosi");
+  Scenario s;
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation e = reg("ABS_PS", 0);
+  s.steps.push_back(expect_at(end, e, "s.yaml:12"));
+  try {
+    ScenarioRunner runner(v.board, s);
+    FAIL();
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_EQ(std::string(ex.what()), "s.yaml:12: the L6470 has no register 'ABS_PS'");
+  }
+  s.steps[0].expect = reg("ABS_POS", 0);
+  s.steps[0].expect->chip.number = 2;
+  try {
+    ScenarioRunner runner(v.board, s);
+    FAIL();
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("s.yaml:12: no chip 2 on spidev0.0 (chips 0..1"), std::string::npos) << ex.what();
+  }
+}
+
+TEST(ScenarioRunner, ChipNumbersAreTheUsersNumbering) {
+  VirtualBoard v("chips=L6470,L6480; numbering=mosi; time=virtual");
+  Scenario s;
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation e = reg("GATECFG1", 0);  // only the L6480 (chain index 1 = user chip 0) has it
+  s.steps.push_back(expect_at(end, e));
+  ScenarioRunner runner(v.board, s);
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty());
+}
+
+TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
+  Scenario s;
+  s.name = "homing";
+  s.timeout_ticks = ticks_from_ms(30'000);
+  ScenarioAction load;
+  load.kind = ScenarioAction::Kind::load;
+  load.chip = ScenarioChip{"spidev0.1", 2};
+  load.load.force_uNm = -5000;
+  s.steps.push_back(at_time(7, load));
+  ScenarioExpectation st;
+  st.kind = ScenarioExpectation::Kind::status;
+  st.flags = {{"UVLO", true}};
+  ScenarioTrigger cmd;
+  cmd.kind = ScenarioTrigger::Kind::command;
+  cmd.command = "GoUntil";
+  cmd.count = 3;
+  s.steps.push_back(expect_at(cmd, st));
+  std::string error;
+  const auto back = deserialize_scenario(serialize_scenario(s), error);
+  ASSERT_TRUE(back) << error;
+  EXPECT_EQ(*back, s);
+  EXPECT_FALSE(deserialize_scenario("{\"l6470emu_scenario\":1,\"name\":\"78\",\"steps\":[{}]}", error));
+  s.name = "\xff\xfe not UTF-8";  // names are bytes
+  ASSERT_TRUE(deserialize_scenario(serialize_scenario(s), error));
+  EXPECT_EQ(deserialize_scenario(serialize_scenario(s), error)->name, s.name);
+  EXPECT_NE(error.find("not a scenario"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace l6470emu::test

@@ -1,0 +1,27 @@
+// libFuzzer harness of scenario files (linux/scenario_file.hpp parse_scenario_yaml): any text
+// gives a scenario or one error line naming the file, never a crash; an accepted scenario goes
+// through run's exchange form (board/scenario.hpp) and reads back the same.
+#include <string_view>
+
+#include "board/scenario.hpp"
+#include "fuzz_support.hpp"
+#include "linux/scenario_file.hpp"
+
+using namespace l6470emu;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fuzz::count_input(size);
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  const ScenarioParse r = parse_scenario_yaml(text, "fuzz.yaml");
+  if (!r.scenario) {
+    FUZZ_CHECK(r.error.rfind("l6470emu: scenario fuzz.yaml", 0) == 0, "error does not name the file: %.200s",
+               r.error.c_str());
+    FUZZ_CHECK(r.error.find('\n') == std::string::npos, "error is not one line: %.200s", r.error.c_str());
+    return 0;
+  }
+  std::string error;
+  const auto back = deserialize_scenario(serialize_scenario(*r.scenario), error);
+  FUZZ_CHECK(back.has_value(), "an accepted scenario does not read back: %.200s", error.c_str());
+  FUZZ_CHECK(*back == *r.scenario, "a scenario reads back differently from its exchange form");
+  return 0;
+}

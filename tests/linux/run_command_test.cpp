@@ -1,0 +1,248 @@
+// `l6470emu run` end to end: real programs under the preload with a scenario, each way a run
+// can end mapped to its own exit status (the cause read from the preload's report, not from the
+// program's status), usage errors before the program starts, JUnit XML, and a recording of a
+// run that replays with the scenario's actions in it.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "linux/run_report.hpp"
+#include "linux/virtual_scheduler.hpp"
+#include "run_program.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+class RunCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string why = missing_prerequisites();
+    if (!why.empty()) GTEST_SKIP() << why;
+    dir_ = fs::temp_directory_path() / ("l6470emu-run-test-" + std::to_string(getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string file(const std::string& name, const std::string& text) {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << text;
+    return path;
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  static RunResult run(std::vector<std::string> args, const std::vector<std::string>& program) {
+    std::vector<std::string> argv{l6470emu_program(), "run"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.push_back("--");
+    argv.insert(argv.end(), program.begin(), program.end());
+    return run_program(argv, {}, 60);
+  }
+  // A Python driver: `body` runs with `s` an open spidev (mode 3) and status() reading GetStatus.
+  std::vector<std::string> python(const std::string& body) {
+    return {system_python(), file("driver.py", "import spidev, time, sys\n"
+                                               "s = spidev.SpiDev(); s.open(0, 0); s.mode = 3; s.max_speed_hz = 1000000\n"
+                                               "def status():\n"
+                                               "    r = [s.xfer2([b])[0] for b in (0xD0, 0, 0)]\n"
+                                               "    return r[1] << 8 | r[2]\n" +
+                                                   body)};
+  }
+  fs::path dir_;
+};
+
+const char* kSwitchScenario = R"(name: switch
+steps:
+  - at: 100ms
+    do: {sw: close}
+  - at: end
+    expect: {status: {SW_F: 1}}
+  - at: end
+    expect: {register: ABS_POS, value: 5, tolerance: 1}
+)";
+
+TEST_F(RunCommand, AFailedExpectationIsStatusOneAndSaysWhatWhenWhichChipExpectedAndSeen) {
+  const RunResult r = run({"--chain", "chips=L6470", "--scenario", file("s.yaml", kSwitchScenario)},
+                          python("time.sleep(0.5)\nstatus()\n"));
+  EXPECT_EQ(r.status, kRunExpectationFailed) << r.err;
+  EXPECT_NE(r.err.find("s.yaml:7: spidev0.0 chip 0: ABS_POS at 0.5"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(": expected 5 ± 1, seen 0\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("2 expectations, 1 failed; exit 1: an expectation failed"), std::string::npos) << r.err;
+}
+
+TEST_F(RunCommand, AllExpectationsHeldIsStatusZeroAndTheJUnitReportIsWellFormed) {
+  const std::string scenario = file("s.yaml", R"(steps:
+  - at: 100ms
+    do: {sw: close}
+  - at: end
+    expect: {status: {SW_F: 1}}
+  - at: end
+    expect: {command: GetStatus, count: 1}
+  - at: end
+    expect: {frames: 3}
+)");
+  const std::string junit = path("report.xml");
+  const RunResult r = run({"--chain", "chips=L6470", "--scenario", scenario, "--junit", junit},
+                          python("time.sleep(0.5)\nstatus()\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  // JUnit as CI systems read it: testsuites > testsuite > testcase, counts that add up.
+  const RunResult check = run_program(
+      {system_python(), "-c",
+       "import sys, xml.etree.ElementTree as ET\n"
+       "root = ET.parse(sys.argv[1]).getroot()\n"
+       "assert root.tag == 'testsuites', root.tag\n"
+       "suites = root.findall('testsuite'); assert len(suites) == 1\n"
+       "cases = suites[0].findall('testcase')\n"
+       "assert int(suites[0].get('tests')) == len(cases) == 4, len(cases)\n"
+       "assert int(suites[0].get('failures')) == 0 and int(suites[0].get('errors')) == 0\n"
+       "assert all(c.get('classname') and c.get('name') for c in cases)\n"
+       "float(suites[0].get('time'))\n"
+       "print('ok')\n",
+       junit});
+  EXPECT_EQ(check.out, "ok\n") << check.err;
+}
+
+TEST_F(RunCommand, AFailedExpectationIsAFailureElementInTheJUnitReport) {
+  const std::string junit = path("report.xml");
+  run({"--chain", "chips=L6470", "--scenario", file("s.yaml", kSwitchScenario), "--junit", junit},
+      python("time.sleep(0.5)\nstatus()\n"));
+  const RunResult check = run_program(
+      {system_python(), "-c",
+       "import sys, xml.etree.ElementTree as ET\n"
+       "s = ET.parse(sys.argv[1]).getroot().find('testsuite')\n"
+       "f = [c for c in s.findall('testcase') if c.find('failure') is not None]\n"
+       "assert s.get('failures') == '1' and len(f) == 1\n"
+       "print(f[0].get('name'), '|', f[0].find('failure').get('message'))\n",
+       junit});
+  EXPECT_EQ(check.out, path("s.yaml") + ":7: ABS_POS | expected 5 ± 1, seen 0\n") << check.err;
+}
+
+TEST_F(RunCommand, TheSimulatedTimeLimitEndsTheRunWithItsOwnStatus) {
+  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "2s"}, python("time.sleep(3600)\n"));
+  EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+  EXPECT_NE(r.err.find("stopped at the simulated time limit 2.000000 s at 2.000000 s of virtual time"), std::string::npos)
+      << r.err;
+}
+
+TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
+  const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "200ms"}, python("time.sleep(30)\n"));
+  EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+  EXPECT_NE(r.err.find("stopped at the simulated time limit 0.200000 s at 0.200000 s of board time"), std::string::npos)
+      << r.err;
+}
+
+TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
+  // The client waits for a BUSY edge an idle chip never makes; the scenario's step at 1 s is a
+  // wake-up, so the deadlock is found only after it.
+  const RunResult r = run({"--chain", "bus=0 cs=0 chips=L6470", "--scenario",
+                           file("s.yaml", "steps:\n  - at: 1s\n    do: {sw: close}\n")},
+                          {client("virtual_deadlock"), "read"});
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("deadlock at t=1.000000 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("deadlocked in virtual time at 1.000000 s"), std::string::npos) << r.err;
+}
+
+TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
+  for (const char* code : {"3", "86"}) {
+    const RunResult r = run({"--chain", "chips=L6470"}, {"/bin/sh", "-c", std::string("exit ") + code});
+    EXPECT_EQ(r.status, kRunProgramFailed) << code << r.err;
+    EXPECT_NE(r.err.find(std::string("exited with status ") + code), std::string::npos) << r.err;
+  }
+  const RunResult killed = run({"--chain", "chips=L6470"}, {"/bin/sh", "-c", "kill -9 $$"});
+  EXPECT_EQ(killed.status, kRunProgramFailed) << killed.err;
+  EXPECT_NE(killed.err.find("was killed by signal 9"), std::string::npos) << killed.err;
+}
+
+TEST_F(RunCommand, ASanitizerEndIsTakenFromTheReportNotFromTheStatus) {
+  // The driver sanitizer (check=error) ends programs with status 86 as a deadlock does; its
+  // report block (preload::end_run(RunEnd::sanitizer, ...)) is what tells run. Written here by
+  // hand, as the sanitizer's error path writes it.
+  const RunResult r = run({"--chain", "chips=L6470"},
+                          {"/bin/sh", "-c",
+                           "printf 'l6470emu-run-report 1\\npid 1\\nend sanitizer\\ntick 40\\ndevices 1\\nscenario 0\\n"
+                           "judged 0\\ndetail CS held low across two commands\\n.\\n' >> \"$L6470EMU_RUN_REPORT\"; exit 86"});
+  EXPECT_EQ(r.status, kRunSanitizerError) << r.err;
+  EXPECT_NE(r.err.find("stopped by the driver sanitizer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("  CS held low across two commands\n"), std::string::npos) << r.err;
+}
+
+TEST_F(RunCommand, UsageAndScenarioErrorsAreStatusTwoAndTheProgramNeverStarts) {
+  const std::string marker = path("started");
+  const std::vector<std::string> program{"/bin/sh", "-c", "touch " + marker};
+  RunResult r = run({"--chain", "chips=L6470", "--scenario", file("bad.yaml", "steps:\n  - at: 1s\n    do: {sw: shut}\n")},
+                    program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_EQ(r.err, "l6470emu: scenario " + path("bad.yaml") + ":3: key 'sw': 'shut' is not one of close, open\n");
+  r = run({"--chain", "chips=L6470,L6470", "--scenario",
+           file("chip.yaml", "steps:\n  - at: end\n    expect: {register: ABS_POS, value: 0, chip: 2}\n")},
+          program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_NE(r.err.find("chip.yaml:2: no chip 2 on spidev0.0 (chips 0..1"), std::string::npos) << r.err;
+  r = run({"--chain", "chips=L6470", "--timeout", "soon"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  r = run({"--chain", "chips=L6471"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  r = run({}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_FALSE(fs::exists(marker));
+}
+
+TEST_F(RunCommand, ARecordingOfARunReplaysWithTheScenariosActionsInIt) {
+  const std::string trace = path("run.trace");
+  const RunResult r = run({"--chain", "chips=L6470", "--scenario", file("s.yaml", R"(steps:
+  - at: 100ms
+    do: {sw: close}
+  - at: 200ms
+    do: {fault: ocd}
+  - at: end
+    expect: {status: {SW_F: 1, OCD: 0}}
+)"),
+                           "--record", trace},
+                          python("status()\ntime.sleep(0.5)\nprint(hex(status()))\n"));
+  ASSERT_EQ(r.status, kRunPassed) << r.err;
+  std::ifstream in(trace);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("pin 0 SW 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("fault 0 OCD on"), std::string::npos) << text;
+  // The replay gets the same MISO only with the switch and the fault where the run had them.
+  const RunResult replay = run_program({l6470emu_program(), "replay", trace});
+  EXPECT_EQ(replay.status, 0) << replay.out << replay.err;
+  // Without the actions the same frames diverge: the recording is what carries them.
+  std::string without;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find(" SW ") == std::string::npos && line.find(" fault ") == std::string::npos) without += line + "\n";
+  const RunResult diverged = run_program({l6470emu_program(), "replay", "--no-pins", file("bare.trace", without)});
+  EXPECT_EQ(diverged.status, 1) << diverged.out << diverged.err;
+}
+
+TEST(RunReport, BlocksReadBackAndACutBlockIsSkipped) {
+  RunReport a;
+  a.pid = 42;
+  a.end = RunEnd::timeout;
+  a.tick = 8'000'000;
+  a.devices = true;
+  a.scenario = true;
+  a.detail = {"the limit\twas reached"};
+  a.outcome.judged = 2;
+  a.outcome.failures.push_back(ScenarioFailure{"s.yaml:3", "ABS_POS", 7, "spidev0.0 chip 1", "0", "12"});
+  a.outcome.passed = {"s.yaml:4: frames = 3"};
+  const std::string text = format_run_report(a) + "l6470emu-run-report 1\npid 43\nend exit\n";
+  const auto blocks = parse_run_reports(text);
+  ASSERT_EQ(blocks.size(), 1u);
+  EXPECT_EQ(blocks[0].pid, 42);
+  EXPECT_EQ(blocks[0].end, RunEnd::timeout);
+  EXPECT_EQ(blocks[0].detail[0], "the limit was reached");
+  ASSERT_EQ(blocks[0].outcome.failures.size(), 1u);
+  EXPECT_EQ(blocks[0].outcome.failures[0].seen, "12");
+  EXPECT_EQ(blocks[0].outcome.failures[0].tick, 7u);
+}
+
+}  // namespace
+}  // namespace l6470emu::test

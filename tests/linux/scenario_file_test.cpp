@@ -1,0 +1,107 @@
+// Scenario files: the YAML schema of docs/scenarios.md read into the model, and every mistake
+// one line naming the file, the line and the key, with the near miss when there is one.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "linux/scenario_file.hpp"
+
+namespace l6470emu::test {
+namespace {
+
+std::string error_of(const std::string& text) {
+  const ScenarioParse p = parse_scenario_yaml(text, "s.yaml");
+  EXPECT_FALSE(p.scenario);
+  return p.error;
+}
+
+TEST(ScenarioFile, AHomingScenarioReadsIntoStepsWithTheirLines) {
+  const ScenarioParse p = parse_scenario_yaml(R"(name: homing
+timeout: 30s
+steps:
+  - at: 250ms
+    do: {sw: close, chip: 1}
+  - on: {position: -1000, chip: 0}
+    after: 10ms
+    do: {fault: ocd}
+  - on: {command: GoUntil, count: 2}
+    chain: spidev0.0
+    do: {load: {force_uNm: -20000}}
+  - at: end
+    chip: 1
+    expect: {register: ABS_POS, value: 0, tolerance: 3}
+  - at: end
+    expect: {status: {OCD: 0, UVLO: 1}}
+  - at: end
+    expect: {busy_pulse: {min: 1ms, max: 2.5s, pulse: 1}}
+  - at: end
+    expect: {command: SoftStop, sent: false}
+  - at: end
+    expect: {frames: {min: 4}}
+)",
+                                              "home.yaml");
+  ASSERT_TRUE(p.scenario) << p.error;
+  const Scenario& s = *p.scenario;
+  EXPECT_EQ(s.name, "homing");
+  EXPECT_EQ(s.timeout_ticks, Tick{30} * kTicksPerSecond);
+  ASSERT_EQ(s.steps.size(), 8u);
+  EXPECT_EQ(s.steps[0].where, "home.yaml:4");
+  EXPECT_EQ(s.steps[0].when.tick, ticks_from_ms(250));
+  EXPECT_EQ(s.steps[0].action->kind, ScenarioAction::Kind::sw);
+  EXPECT_FALSE(s.steps[0].action->level);
+  EXPECT_EQ(s.steps[0].action->chip.number, 1u);
+  EXPECT_EQ(s.steps[1].when.kind, ScenarioTrigger::Kind::position);
+  EXPECT_EQ(s.steps[1].when.position, -1000);
+  EXPECT_EQ(s.steps[1].when.tick, ticks_from_ms(10));
+  EXPECT_EQ(s.steps[1].action->fault, TraceFault::OCD);
+  EXPECT_EQ(s.steps[2].when.count, 2u);
+  EXPECT_EQ(s.steps[2].action->chip.chain, "spidev0.0");
+  EXPECT_EQ(s.steps[2].action->load.force_uNm, -20000);
+  EXPECT_EQ(s.steps[3].expect->chip.number, 1u);
+  EXPECT_EQ(s.steps[3].expect->tolerance, 3);
+  EXPECT_EQ(s.steps[4].expect->flags.size(), 2u);
+  EXPECT_EQ(s.steps[5].expect->max_ticks, Tick{10'000'000});
+  EXPECT_EQ(s.steps[6].expect->count, 0u);
+  EXPECT_EQ(s.steps[7].expect->min_count, 4u);
+  EXPECT_EQ(s.steps[7].where, "home.yaml:21");
+}
+
+TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {sw: close}\n  - at: end\n    expcet: {frames: 3}\n"),
+            "l6470emu: scenario s.yaml:5: key 'expcet': unknown (did you mean expect?) in a step; known: at, on, after, "
+            "delay, chip, chain, do, expect");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {sw: shut}\n"),
+            "l6470emu: scenario s.yaml:3: key 'sw': 'shut' is not one of close, open");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {falt: ocd}\n"),
+            "l6470emu: scenario s.yaml:3: key 'falt': unknown (did you mean fault?) in do:; known: sw, stby_rst, fault, "
+            "thermal, adcin, load, block, supply_mV, clear, chip, chain");
+  EXPECT_EQ(error_of("steps:\n  - at: 1.0000001s\n    do: {sw: close}\n"),
+            "l6470emu: scenario s.yaml:2: key 'at': expects a duration (250ns, 1us, 10ms, 2.5s, 1min: whole ticks of "
+            "250 ns), got '1.0000001s'");
+  EXPECT_EQ(error_of("steps:\n  - at: end\n    expect: {register: ABS_POS, value: zero}\n"),
+            "l6470emu: scenario s.yaml:3: key 'value': expects a whole number, got 'zero'");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    expect: {busy_pulse: {max: 1s}}\n"),
+            "l6470emu: scenario s.yaml:3: key 'busy_pulse': BUSY pulses are judged at the end: write at: end");
+  EXPECT_EQ(error_of("steps:\n  - at: [1s\n"), "l6470emu: scenario s.yaml:3: not YAML: end of sequence flow not found");
+  EXPECT_EQ(error_of(""), "l6470emu: scenario s.yaml: the file is empty: a scenario needs steps:");
+  EXPECT_EQ(error_of(std::string(100, '[')), "l6470emu: scenario s.yaml:1: nested deeper than a scenario can be");
+}
+
+TEST(ScenarioFile, DurationsAreWholeTicksOfTheChip) {
+  EXPECT_EQ(parse_scenario_duration("250ns"), Tick{1});
+  EXPECT_EQ(parse_scenario_duration("1us"), Tick{4});
+  EXPECT_EQ(parse_scenario_duration("2.5s"), Tick{10'000'000});
+  EXPECT_EQ(parse_scenario_duration("3"), Tick{12'000'000});
+  EXPECT_EQ(parse_scenario_duration("1min"), Tick{240'000'000});
+  EXPECT_FALSE(parse_scenario_duration("100ns"));
+  EXPECT_FALSE(parse_scenario_duration("-1s"));
+  EXPECT_FALSE(parse_scenario_duration("1 fortnight"));
+  EXPECT_FALSE(parse_scenario_duration("99999999999999999999s"));
+}
+
+TEST(ScenarioFile, AMissingFileIsOneLine) {
+  EXPECT_EQ(load_scenario_file("/nonexistent/s.yaml").error, "l6470emu: scenario /nonexistent/s.yaml: cannot be read");
+}
+
+}  // namespace
+}  // namespace l6470emu::test

@@ -1,0 +1,356 @@
+// `l6470emu run`: the board checked, the scenario checked against it (both before the program
+// starts: usage errors are status 2), the program run under the preload, its report read back.
+#include "tools/cmd_run.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "board/board.hpp"
+#include "board/scenario_runner.hpp"
+#include "linux/board_config_file.hpp"
+#include "linux/clock.hpp"
+#include "linux/run_report.hpp"
+#include "linux/scenario_file.hpp"
+#include "linux/virtual_scheduler.hpp"
+
+extern char** environ;
+
+namespace l6470emu {
+namespace {
+
+std::string dir_of(const std::string& path) {
+  const std::size_t slash = path.rfind('/');
+  return slash == std::string::npos ? "." : path.substr(0, slash);
+}
+
+bool is_file(const std::string& p) { return access(p.c_str(), R_OK) == 0; }
+
+// $L6470EMU_PRELOAD, else next to this program (a build tree), else where the install put it.
+std::string find_preload(std::string& error) {
+  if (const char* given = std::getenv("L6470EMU_PRELOAD"); given && *given) {
+    if (is_file(given)) return given;
+    error = std::string("L6470EMU_PRELOAD=") + given + ": no such file";
+    return "";
+  }
+  char self[4096];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+  const std::string exe = n > 0 ? std::string(self, static_cast<std::size_t>(n)) : std::string();
+  const std::string here = dir_of(exe);
+  for (const std::string& p : {here + "/libl6470emu-preload.so",
+                               here + "/../" + std::string(L6470EMU_PRELOAD_RELDIR) + "/libl6470emu-preload.so"})
+    if (is_file(p)) return p;
+  error = "libl6470emu-preload.so not found next to " + exe + " or in ../" + L6470EMU_PRELOAD_RELDIR +
+          " (set L6470EMU_PRELOAD)";
+  return "";
+}
+
+std::string temp_file(const std::string& what, const std::string& content) {
+  const char* dir = std::getenv("TMPDIR");
+  std::string path = std::string(dir && *dir ? dir : "/tmp") + "/l6470emu-run-" + what + "-XXXXXX";
+  const int fd = mkstemp(path.data());
+  if (fd < 0) throw std::runtime_error("cannot create a temporary file in " + dir_of(path));
+  std::size_t at = 0;
+  while (at < content.size()) {
+    const ssize_t w = write(fd, content.data() + at, content.size() - at);
+    if (w <= 0) {
+      close(fd);
+      throw std::runtime_error("cannot write " + path);
+    }
+    at += static_cast<std::size_t>(w);
+  }
+  close(fd);
+  return path;
+}
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string xml(std::string_view s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
+        else out += c;
+    }
+  }
+  return out;
+}
+
+std::string seconds_number(Tick t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6f", static_cast<double>(t) / static_cast<double>(kTicksPerSecond));
+  return buf;
+}
+
+const char* status_words(int status) {
+  switch (status) {
+    case kRunPassed: return "passed";
+    case kRunExpectationFailed: return "an expectation failed";
+    case kRunTimedOut: return "the simulated time limit was reached";
+    case kRunDeadlocked: return "the program deadlocked in virtual time";
+    case kRunSanitizerError: return "the driver sanitizer found a broken rule";
+    case kRunProgramFailed: return "the program failed";
+    default: return "the program did not run to a report";
+  }
+}
+
+}  // namespace
+
+RunCommand::RunCommand(CLI::App& app) {
+  cmd_ = app.add_subcommand("run", "run a program against an emulated board with a scenario, and judge it");
+  cmd_->footer(
+      "Exit status: 0 passed, 1 an expectation failed, 2 usage/board/scenario error (the program never started), "
+      "3 simulated time limit reached, 4 deadlock in virtual time, 5 driver sanitizer error, 6 the program exited "
+      "non-zero or was killed, 7 the program could not be started or left no report. docs/scenarios.md");
+  auto* board = cmd_->add_option("--board", board_file_, "board description file (as L6470EMU_CONFIG)");
+  auto* chain = cmd_->add_option("--chain", chain_, "board description text (as L6470EMU_CHAIN), e.g. 'chips=L6470'");
+  board->excludes(chain);
+  cmd_->add_option("--scenario", scenario_file_, "scenario file (YAML, docs/scenarios.md)");
+  cmd_->add_option("--time", time_, "the program's clock: virtual (default: the board's time) or wall")
+      ->check(CLI::IsMember({"virtual", "wall"}));
+  cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
+  cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
+  cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
+  cmd_->add_flag("--verbose,-v", verbose_, "also print what the world did, step by step, and every expectation that held");
+  cmd_->add_option("program", program_, "the program and its arguments (after --)")->required();
+}
+
+std::optional<int> RunCommand::run() {
+  if (!*cmd_) return std::nullopt;
+  auto usage = [](const std::string& line) {
+    std::cerr << line << "\n";
+    return kRunUsage;
+  };
+  // 1. The board.
+  if (board_file_.empty() && chain_.empty()) return usage("l6470emu run: give the board: --board FILE or --chain DESC");
+  ParseResult parsed = board_file_.empty() ? parse_board_config(chain_, "--chain") : load_board_config_file(board_file_);
+  if (!parsed.config) return usage(parsed.error.message);
+  BoardConfig config = std::move(*parsed.config);
+  if (config.chains.empty()) return usage("l6470emu run: the board description has no chain (chips=...)");
+  config.time.virtual_time = time_ == "virtual";
+  config.socket.clear();
+  if (!record_.empty()) config.trace = record_;
+
+  // 2. The scenario, read and checked against the board.
+  Scenario scenario;
+  if (!scenario_file_.empty()) {
+    ScenarioParse sp = load_scenario_file(scenario_file_);
+    if (!sp.scenario) return usage(sp.error);
+    scenario = std::move(*sp.scenario);
+    try {
+      Board probe(config, [](std::string_view) {}, real_host_clock());
+      ScenarioRunner check(probe, scenario);
+    } catch (const std::invalid_argument& e) {
+      return usage(std::string("l6470emu: scenario ") + e.what());
+    }
+  } else {
+    scenario.name = "run";
+  }
+  std::optional<Tick> timeout = scenario.timeout_ticks;
+  if (!timeout_.empty()) {
+    timeout = parse_scenario_duration(timeout_);
+    if (!timeout || *timeout == 0)
+      return usage("l6470emu run: --timeout " + quoted_text(timeout_) + " is not a duration (30, 2.5s, 250ms, 1min)");
+  }
+  std::string error;
+  const std::string preload = find_preload(error);
+  if (preload.empty()) return usage("l6470emu run: " + error);
+
+  // 3. The program, under the preload, with the run's environment.
+  std::string scenario_path, report_path;
+  try {
+    scenario_path = temp_file("scenario", serialize_scenario(scenario));
+    report_path = temp_file("report", "");
+  } catch (const std::exception& e) {
+    return usage(std::string("l6470emu run: ") + e.what());
+  }
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view v(*e);
+    for (const char* drop : {"L6470EMU_CONFIG=", "L6470EMU_SOCKET=", "L6470EMU_TRACE=", "L6470EMU_CHAIN=", "LD_PRELOAD=",
+                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS="})
+      if (v.starts_with(drop)) goto next;
+    env.emplace_back(v);
+  next:;
+  }
+  {
+    const char* old = std::getenv("LD_PRELOAD");
+    env.push_back("LD_PRELOAD=" + preload + (old && *old ? std::string(" ") + old : std::string()));
+  }
+  env.push_back("L6470EMU_CHAIN=" + describe_board_config(config));
+  env.push_back(std::string(kRunScenarioEnv) + "=" + scenario_path);
+  env.push_back(std::string(kRunReportEnv) + "=" + report_path);
+  if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
+  std::vector<char*> envp, argv;
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  for (auto& a : program_) argv.push_back(a.data());
+  argv.push_back(nullptr);
+
+  pid_t pid = 0;
+  const int spawn_error = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), envp.data());
+  if (spawn_error != 0) {
+    std::cerr << "l6470emu run: cannot start " << program_[0] << ": " << std::strerror(spawn_error) << "\n";
+    unlink(scenario_path.c_str());
+    unlink(report_path.c_str());
+    return kRunNotStarted;
+  }
+  int wstatus = 0;
+  bool wall_timeout = false;
+  if (timeout && !config.time.virtual_time) {
+    // Wall time: the limit in simulated seconds is limit / scale seconds of real time.
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 / config.time.scale));
+    while (true) {
+      const pid_t r = waitpid(pid, &wstatus, WNOHANG);
+      if (r == pid) break;
+      if (std::chrono::steady_clock::now() >= deadline) {
+        wall_timeout = true;
+        kill(pid, SIGKILL);
+        waitpid(pid, &wstatus, 0);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  } else {
+    while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+    }
+  }
+
+  // 4. What it came to.
+  const std::vector<RunReport> blocks = parse_run_reports(read_all(report_path));
+  unlink(scenario_path.c_str());
+  unlink(report_path.c_str());
+  std::optional<RunEnd> cause;
+  const RunReport* cause_block = nullptr;
+  for (const RunReport& b : blocks)
+    if (b.end != RunEnd::exit && !cause) {
+      cause = b.end;
+      cause_block = &b;
+    }
+  if (wall_timeout) cause = RunEnd::timeout;
+  std::vector<const RunReport*> judged;
+  for (const RunReport& b : blocks)
+    if (b.devices && b.scenario) judged.push_back(&b);
+  if (judged.empty())
+    for (const RunReport& b : blocks)
+      if (b.pid == pid) judged.push_back(&b);
+  std::size_t expectations = 0;
+  std::vector<ScenarioFailure> failures;
+  std::vector<std::string> passed, world;
+  Tick end_tick = 0;
+  for (const RunReport* b : judged) {
+    expectations += b->outcome.judged;
+    failures.insert(failures.end(), b->outcome.failures.begin(), b->outcome.failures.end());
+    passed.insert(passed.end(), b->outcome.passed.begin(), b->outcome.passed.end());
+    world.insert(world.end(), b->outcome.log.begin(), b->outcome.log.end());
+    end_tick = std::max(end_tick, b->tick);
+  }
+  if (cause_block) end_tick = std::max(end_tick, cause_block->tick);
+  if (wall_timeout) end_tick = std::max(end_tick, *timeout);  // killed: no report of its own
+  const bool exited = WIFEXITED(wstatus);
+  const int code = exited ? WEXITSTATUS(wstatus) : -1;
+  const int signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;
+  std::string ended;
+  if (cause == RunEnd::timeout)
+    ended = "stopped at the simulated time limit " + seconds_text(*timeout);
+  else if (cause == RunEnd::deadlock)
+    ended = "deadlocked in virtual time";
+  else if (cause == RunEnd::sanitizer)
+    ended = "stopped by the driver sanitizer";
+  else if (exited)
+    ended = "exited with status " + std::to_string(code);
+  else
+    ended = std::string("was killed by signal ") + std::to_string(signal) + " (" + strsignal(signal) + ")";
+
+  int status = kRunPassed;
+  std::string why;
+  if (cause == RunEnd::timeout) status = kRunTimedOut;
+  else if (cause == RunEnd::deadlock) status = kRunDeadlocked;
+  else if (cause == RunEnd::sanitizer) status = kRunSanitizerError;
+  else if (!exited || code != 0) status = kRunProgramFailed;
+  else if (!failures.empty()) status = kRunExpectationFailed;
+  else if (judged.empty() && !scenario.steps.empty()) {
+    status = kRunNotStarted;
+    why = " (it left no report: it ended by _exit() or a signal before exit(), or the preload was not loaded)";
+  }
+
+  std::ostream& out = std::cerr;
+  out << "l6470emu run: " << program_[0] << " " << ended << " at " << seconds_text(end_tick)
+      << (config.time.virtual_time ? " of virtual time" : " of board time") << "\n";
+  if (cause_block)
+    for (const auto& d : cause_block->detail) out << "  " << d << "\n";
+  if (verbose_) {
+    for (const auto& w : world) out << "  world: " << w << "\n";
+    for (const auto& p : passed) out << "  held: " << p << "\n";
+  }
+  for (const ScenarioFailure& f : failures)
+    out << "  FAILED " << f.where << ": " << f.chip << ": " << f.what << " at " << seconds_text(f.tick) << ": expected "
+        << f.expected << ", seen " << f.seen << "\n";
+  out << "l6470emu run: " << expectations << " expectation" << (expectations == 1 ? "" : "s") << ", "
+      << failures.size() << " failed; exit " << status << ": " << status_words(status) << why << "\n";
+
+  if (!junit_.empty()) {
+    std::ostringstream x;
+    const std::string suite = scenario.name.empty() ? "run" : scenario.name;
+    const bool program_failed = status == kRunTimedOut || status == kRunDeadlocked || status == kRunSanitizerError ||
+                                status == kRunProgramFailed || status == kRunNotStarted;
+    const std::size_t tests = 1 + passed.size() + failures.size();
+    const std::string time = seconds_number(end_tick);
+    x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+    x << "<testsuites name=\"l6470emu run\" tests=\"" << tests << "\" failures=\"" << failures.size() << "\" errors=\""
+      << (program_failed ? 1 : 0) << "\" time=\"" << time << "\">\n";
+    x << "  <testsuite name=\"" << xml(suite) << "\" tests=\"" << tests << "\" failures=\"" << failures.size()
+      << "\" errors=\"" << (program_failed ? 1 : 0) << "\" skipped=\"0\" time=\"" << time << "\">\n";
+    const std::string cls = "l6470emu.run." + xml(suite);
+    x << "    <testcase classname=\"" << cls << "\" name=\"" << xml("program " + program_[0]) << "\" time=\"" << time << "\">";
+    if (program_failed) {
+      x << "\n      <error type=\"" << xml(status_words(status)) << "\" message=\"" << xml(program_[0] + " " + ended + why)
+        << "\">";
+      if (cause_block)
+        for (const auto& d : cause_block->detail) x << xml(d) << "\n";
+      x << "</error>\n    ";
+    }
+    x << "</testcase>\n";
+    for (const auto& p : passed) x << "    <testcase classname=\"" << cls << "\" name=\"" << xml(p) << "\" time=\"0\"/>\n";
+    for (const ScenarioFailure& f : failures) {
+      x << "    <testcase classname=\"" << cls << "\" name=\"" << xml(f.where + ": " + f.what) << "\" time=\"0\">\n";
+      x << "      <failure type=\"expectation\" message=\"" << xml("expected " + f.expected + ", seen " + f.seen) << "\">"
+        << xml(f.chip + " at " + seconds_text(f.tick) + ": " + f.what + ": expected " + f.expected + ", seen " + f.seen)
+        << "</failure>\n    </testcase>\n";
+    }
+    if (verbose_ || !world.empty()) {
+      x << "    <system-out>";
+      for (const auto& w : world) x << xml(w) << "\n";
+      x << "</system-out>\n";
+    }
+    x << "  </testsuite>\n</testsuites>\n";
+    std::ofstream j(junit_, std::ios::trunc);
+    j << x.str();
+    if (!j) std::cerr << "l6470emu run: cannot write the JUnit report " << junit_ << "\n";
+  }
+  return status;
+}
+
+}  // namespace l6470emu

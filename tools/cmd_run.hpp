@@ -1,0 +1,25 @@
+// `l6470emu run`: builds a board, runs an unmodified program against it through the preload
+// library (virtual time by default), applies a scenario, and ends with a report, a JUnit file
+// and an exit status a CI reads (linux/run_report.hpp's RunStatus; docs/scenarios.md).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <optional>
+
+namespace l6470emu {
+
+/// Adds `run` to `app`; run() returns its exit status once `app` is parsed and `run` was chosen.
+class RunCommand {
+ public:
+  explicit RunCommand(CLI::App& app);
+  std::optional<int> run();
+
+ private:
+  CLI::App* cmd_ = nullptr;
+  std::string board_file_, chain_, scenario_file_, time_ = "virtual", timeout_, junit_, record_;
+  bool verbose_ = false;
+  std::vector<std::string> program_;
+};
+
+}  // namespace l6470emu
