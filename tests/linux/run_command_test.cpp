@@ -172,6 +172,21 @@ TEST_F(RunCommand, ASanitizerEndIsTakenFromTheReportNotFromTheStatus) {
   EXPECT_NE(r.err.find("  CS held low across two commands\n"), std::string::npos) << r.err;
 }
 
+TEST_F(RunCommand, AMode0DriverIsStoppedByTheSanitizerWithStatusFiveUnlessTheDescriptionSaysCheck) {
+  // The most common bring-up mistake: a py-spidev driver that never sets mode 3. A run checks at
+  // check=error by default; the preload's sanitizer path writes its report block, run says 5.
+  const std::vector<std::string> program{
+      system_python(), file("mode0.py", "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.max_speed_hz = 1000000\n"
+                                        "print([s.xfer2([b])[0] for b in (0x38, 0, 0)])\n")};
+  RunResult r = run({"--chain", "L6470"}, program);
+  EXPECT_EQ(r.status, kRunSanitizerError) << r.err;
+  EXPECT_NE(r.err.find("stopped by the driver sanitizer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("SPI_MODE on spidev0.0, chip 0"), std::string::npos) << r.err;
+  r = run({"--chain", "chips=L6470 check=warn"}, program);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "[0, 46, 8]\n") << r.err;  // CONFIG 0x2E88 read in mode 0: the stale latch's 0 for bit 7
+}
+
 TEST_F(RunCommand, UsageAndScenarioErrorsAreStatusTwoAndTheProgramNeverStarts) {
   const std::string marker = path("started");
   const std::vector<std::string> program{"/bin/sh", "-c", "touch " + marker};
