@@ -372,7 +372,7 @@ void ScenarioRunner::apply(const ScenarioAction& a, const Resolved& r, const std
       board_.inject_fault(r.chain, r.chip, a.fault, a.value);
       return;
     case ScenarioAction::Kind::load:
-      board_.with_chain(r.chain, [&](Chain& c) { c.chip(r.chip).set_axis_load(a.load); });
+      board_.set_axis_load(r.chain, r.chip, a.load);  // recorded as a load event: replays with it
       return;
     case ScenarioAction::Kind::block:
       board_.with_chain(r.chain, [&](Chain& c) {

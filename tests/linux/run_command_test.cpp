@@ -237,6 +237,22 @@ TEST_F(RunCommand, ARecordingOfARunReplaysWithTheScenariosActionsInIt) {
   EXPECT_EQ(diverged.status, 1) << diverged.out << diverged.err;
 }
 
+TEST_F(RunCommand, AScenariosLoadChangeIsALoadEventOfTheRecording) {
+  const std::string trace = path("load.trace");
+  const RunResult r = run({"--chain", "chips=L6470 axis.0=switch=home@-12800", "--scenario", file("load.yaml", R"(steps:
+  - at: 50ms
+    do: {load: {inertia_g_mm2: 5000, friction_uNm: 200000, force_uNm: 0}}
+)"),
+                           "--record", trace},
+                          python("status()\ntime.sleep(0.2)\nstatus()\n"));
+  ASSERT_EQ(r.status, kRunPassed) << r.err;
+  std::ifstream in(trace);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("0.05000000 load 0 inertia=5000 friction=200000 force=0"), std::string::npos) << text;
+  const RunResult replay = run_program({l6470emu_program(), "replay", trace});
+  EXPECT_EQ(replay.status, 0) << replay.out << replay.err;
+}
+
 TEST(RunReport, BlocksReadBackAndACutBlockIsSkipped) {
   RunReport a;
   a.pid = 42;
