@@ -271,6 +271,7 @@ long DeviceBoard::finish_spi_message(std::size_t chain, std::span<const spi_ioc_
     if (check_report == nullptr) {
       // Nobody to end (a kernel node's caller): the report goes to the log, the call fails.
       log_.line(report->substr(report->find("driver sanitizer")));
+      if (!first_unended_check_failure_) first_unended_check_failure_ = std::move(*report);
       return -EIO;
     }
     *check_report = std::move(*report);
@@ -491,6 +492,11 @@ bool DeviceBoard::finish_scenario(ScenarioOutcome& out) {
   out.passed = scenario_->passed();
   out.log = scenario_->log();
   return true;
+}
+
+std::optional<std::string> DeviceBoard::first_unended_check_failure() {
+  std::lock_guard lock(m_);
+  return first_unended_check_failure_;
 }
 
 Tick DeviceBoard::next_edge_tick() {

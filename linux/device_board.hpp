@@ -15,6 +15,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -220,6 +221,10 @@ class DeviceBoard {
   Tick scenario_next_tick();
   /// Ends the scenario at the board's time now (its `end` expectations judged). False: none.
   bool finish_scenario(ScenarioOutcome& out);
+  /// The driver sanitizer's first report for a caller that could not be ended (a kernel node's:
+  /// its call failed with EIO and the report went to the log); nullopt while none. `run
+  /// --nodes kernel` ends with it.
+  std::optional<std::string> first_unended_check_failure();
 
   /// Open handles, by kind, as text (for `ctl dump`).
   std::string describe_handles();
@@ -287,6 +292,7 @@ class DeviceBoard {
   std::mt19937_64 handle_ids_;  // seeded from getrandom(): handle ids are capabilities
   MessageObserver observer_;
   std::unique_ptr<ScenarioRunner> scenario_;
+  std::optional<std::string> first_unended_check_failure_;
 
   std::mutex m_;
   // Buses a sliced message owns until it ends (its caller sleeping between slices, the lock

@@ -12,7 +12,7 @@ packages=(
   sigrok-cli clang libclang-rt-14-dev
   python3-dev pybind11-dev python3-pybind11 python3-pytest python3-pytest-xdist python3-numpy python3-matplotlib help2man man-db dpkg-dev lintian
   libfuse3-dev qemu-system-x86 busybox-static cpio kmod
-  libyaml-cpp-dev spi-tools
+  libyaml-cpp-dev spi-tools golang-go
 )
 
 missing=()

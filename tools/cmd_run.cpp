@@ -9,10 +9,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <sstream>
 #include <thread>
 
@@ -20,9 +22,12 @@
 #include "board/scenario_runner.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
+#include "linux/device_board.hpp"
 #include "linux/run_report.hpp"
 #include "linux/scenario_file.hpp"
+#include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"
+#include "tools/kernel_nodes.hpp"
 
 extern char** environ;
 
@@ -115,6 +120,219 @@ const char* status_words(int status) {
   }
 }
 
+// How the program ended, and the report blocks of the processes that used the board.
+struct ProgramEnd {
+  pid_t pid = 0;
+  int wstatus = 0;
+  bool wall_timeout = false;  // killed at the wall-clock limit by run itself
+  std::vector<RunReport> blocks;
+};
+
+// Our environment, less what would point the program at another board or report.
+std::vector<std::string> program_environment(bool keep_ld_preload) {
+  std::vector<std::string> env;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view v(*e);
+    bool drop = !keep_ld_preload && v.starts_with("LD_PRELOAD=");
+    for (const char* name : {"L6470EMU_CONFIG=", "L6470EMU_SOCKET=", "L6470EMU_TRACE=", "L6470EMU_CHAIN=",
+                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS="})
+      drop = drop || v.starts_with(name);
+    if (!drop) env.emplace_back(v);
+  }
+  return env;
+}
+
+// Starts the program; false (and one line said) when it cannot be.
+bool spawn_program(const std::vector<std::string>& program, std::vector<std::string> env,
+                   const posix_spawnattr_t* attr, pid_t& pid) {
+  std::vector<std::string> args = program;
+  std::vector<char*> envp, argv;
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const int error = posix_spawnp(&pid, argv[0], nullptr, attr, argv.data(), envp.data());
+  if (error == 0) return true;
+  std::cerr << "l6470emu run: cannot start " << program[0] << ": " << std::strerror(error) << "\n";
+  return false;
+}
+
+// Waits for the program; in wall time a limit in simulated seconds is limit / scale seconds of
+// real time, after which run kills it.
+void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config) {
+  if (timeout && !config.time.virtual_time) {
+    const auto deadline =
+        std::chrono::steady_clock::now() +
+        std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 / config.time.scale));
+    while (true) {
+      const pid_t r = waitpid(run.pid, &run.wstatus, WNOHANG);
+      if (r == run.pid) return;
+      if (std::chrono::steady_clock::now() >= deadline) {
+        run.wall_timeout = true;
+        kill(run.pid, SIGKILL);
+        waitpid(run.pid, &run.wstatus, 0);
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  while (waitpid(run.pid, &run.wstatus, 0) < 0 && errno == EINTR) {
+  }
+}
+
+// The preload builds the board in every process of the run and appends a report block per
+// process to a file; the scenario reaches it as a file too. Returns -1 once the program ran.
+int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::optional<Tick> timeout,
+                      const std::vector<std::string>& program, ProgramEnd& run) {
+  std::string error;
+  const std::string preload = find_preload(error);
+  if (preload.empty()) {
+    std::cerr << "l6470emu run: " << error << "\n";
+    return kRunUsage;
+  }
+  std::string scenario_path, report_path;
+  try {
+    scenario_path = temp_file("scenario", serialize_scenario(scenario));
+    report_path = temp_file("report", "");
+  } catch (const std::exception& e) {
+    std::cerr << "l6470emu run: " << e.what() << "\n";
+    return kRunUsage;
+  }
+  std::vector<std::string> env = program_environment(false);
+  const char* old = std::getenv("LD_PRELOAD");
+  env.push_back("LD_PRELOAD=" + preload + (old && *old ? std::string(" ") + old : std::string()));
+  env.push_back("L6470EMU_CHAIN=" + describe_board_config(config));
+  env.push_back(std::string(kRunScenarioEnv) + "=" + scenario_path);
+  env.push_back(std::string(kRunReportEnv) + "=" + report_path);
+  if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
+  const bool started = spawn_program(program, std::move(env), nullptr, run.pid);
+  if (started) {
+    wait_for_program(run, timeout, config);
+    run.blocks = parse_run_reports(read_all(report_path));
+  }
+  unlink(scenario_path.c_str());
+  unlink(report_path.c_str());
+  return started ? -1 : kRunNotStarted;
+}
+
+// The board in this process, served by the daemon's code on a thread of its own through the
+// kernel's nodes only (CUSE spidev, UHID CP2112 gpiochips; its socket in a private directory),
+// the scenario bound to it; the program started as it is, in wall time, so that what no preload
+// reaches (a static or Go program, a setuid one) is judged the same way. Returns -1 once the
+// program ran.
+int run_on_kernel_nodes(const BoardConfig& config, const Scenario& scenario, bool has_scenario,
+                        std::optional<Tick> timeout, const std::vector<std::string>& program, ProgramEnd& run) {
+  const char* tmp = std::getenv("TMPDIR");
+  std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/l6470emu-run-XXXXXX";
+  if (!mkdtemp(dir.data())) {
+    std::cerr << "l6470emu run: cannot create a directory in " << dir_of(dir) << ": " << std::strerror(errno) << "\n";
+    return kRunUsage;
+  }
+  // The daemon's thread takes SIGINT, SIGTERM and SIGHUP through its signalfd: every thread of
+  // this process blocks them from here on; the program gets the mask and dispositions we had.
+  sigset_t stop_signals, old_mask;
+  sigemptyset(&stop_signals);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&stop_signals, sig);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, &old_mask);
+
+  struct Shared {
+    std::mutex m;
+    std::condition_variable cv;
+    DeviceBoard* board = nullptr;
+    bool daemon_ended = false;
+  } shared;
+  const FrontEnds nodes = kernel_front_ends(true, true, NodeAccess{});
+  const FrontEnds front_ends = [&](DeviceBoard& board, std::ostream&, std::string& error) -> std::shared_ptr<void> {
+    std::ostringstream where;
+    std::shared_ptr<void> kept = nodes(board, where, error);
+    if (!kept) return nullptr;
+    if (has_scenario) board.set_scenario(scenario);  // checked against a board like it before
+    std::cerr << "l6470emu run: the program reaches the board through the kernel's nodes:\n" << where.str();
+    std::lock_guard lock(shared.m);
+    shared.board = &board;
+    shared.cv.notify_all();
+    return kept;
+  };
+  std::ostringstream daemon_out, daemon_err;  // the daemon thread's until it is joined
+  std::thread daemon([&] {
+    run_daemon(config, dir + "/serve.sock", daemon_out, daemon_err, front_ends);
+    std::lock_guard lock(shared.m);
+    shared.daemon_ended = true;
+    shared.cv.notify_all();
+  });
+  DeviceBoard* board = nullptr;
+  {
+    std::unique_lock lock(shared.m);
+    shared.cv.wait(lock, [&] { return shared.board || shared.daemon_ended; });
+    board = shared.board;
+  }
+  const auto end_daemon = [&] {
+    if (board) kill(getpid(), SIGTERM);  // to the daemon's signalfd: every thread blocks it
+    daemon.join();
+    // The daemon saw the signal on its signalfd without taking it: taken here, or it would end
+    // this process once unblocked.
+    const timespec now{0, 0};
+    while (sigtimedwait(&stop_signals, nullptr, &now) > 0) {
+    }
+    pthread_sigmask(SIG_SETMASK, &old_mask, nullptr);
+    rmdir(dir.c_str());
+    std::string said = daemon_err.str();
+    for (std::size_t at = 0; at < said.size();) {
+      const std::size_t nl = std::min(said.find('\n', at), said.size());
+      std::cerr << "l6470emu run: " << std::string_view(said).substr(at, nl - at) << "\n";
+      at = nl + 1;
+    }
+    const std::string out = daemon_out.str();
+    for (std::size_t at = out.find("recorded "); at != std::string::npos; at = out.find("recorded ", at + 1))
+      std::cerr << "l6470emu run: " << out.substr(at, out.find('\n', at) - at) << "\n";
+  };
+  if (!board) {
+    end_daemon();
+    std::cerr << "l6470emu run: the kernel's nodes could not be made (root, and the modules cuse, uhid and "
+                 "hid-cp2112, are needed); the program was not started\n";
+    return kRunNotStarted;
+  }
+
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) sigaddset(&defaults, sig);  // the daemon ignores SIGPIPE
+  posix_spawnattr_setsigmask(&attr, &old_mask);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  const bool started = spawn_program(program, program_environment(true), &attr, run.pid);
+  posix_spawnattr_destroy(&attr);
+  if (started) {
+    wait_for_program(run, timeout, config);
+    {
+      std::lock_guard lock(shared.m);
+      if (shared.daemon_ended) board = nullptr;  // a SIGINT or SIGTERM to run stopped the board first
+    }
+    if (!board) {
+      end_daemon();
+      std::cerr << "l6470emu run: stopped by a signal before the program ended\n";
+      return kRunProgramFailed;
+    }
+    RunReport r;
+    r.pid = run.pid;
+    r.devices = true;  // whatever it did, it was the only program of the run
+    r.scenario = board->finish_scenario(r.outcome);
+    r.tick = board->time().now();
+    if (const auto report = board->first_unended_check_failure()) {
+      r.end = RunEnd::sanitizer;
+      for (std::size_t at = 0; at < report->size();) {
+        const std::size_t nl = std::min(report->find('\n', at), report->size());
+        if (nl > at) r.detail.emplace_back(report->substr(at, nl - at));
+        at = nl + 1;
+      }
+    }
+    run.blocks.push_back(std::move(r));
+  }
+  end_daemon();
+  return started ? -1 : kRunNotStarted;
+}
+
 }  // namespace
 
 RunCommand::RunCommand(CLI::App& app) {
@@ -132,6 +350,11 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
+  cmd_->add_option("--nodes", nodes_,
+                   "how the program reaches the board: preload (default: LD_PRELOAD, in this program's process) or "
+                   "kernel (the kernel's own /dev/spidevB.C and /dev/gpiochipN through CUSE and UHID, wall time; root, "
+                   "modules cuse uhid hid-cp2112: static and Go programs too)")
+      ->check(CLI::IsMember({"preload", "kernel"}));
   cmd_->add_flag("--verbose,-v", verbose_, "also print what the world did, step by step, and every expectation that held");
   cmd_->add_option("program", program_, "the program and its arguments (after --)")->required();
 }
@@ -150,7 +373,10 @@ std::optional<int> RunCommand::run() {
   if (!parsed.config) return usage(parsed.error.message);
   BoardConfig config = std::move(*parsed.config);
   if (config.chains.empty()) return usage("l6470emu run: the board description has no chain (chips=...)");
-  config.time.virtual_time = time_ == "virtual";
+  const bool kernel = nodes_ == "kernel";
+  if (kernel && cmd_->count("--time") > 0 && time_ == "virtual")
+    return usage("l6470emu run: --nodes kernel runs in wall time (the kernel's clocks are not the board's); leave out --time virtual");
+  config.time.virtual_time = !kernel && time_ == "virtual";
   config.socket.clear();
   // A test run fails on a broken rule of the chip unless the description says otherwise: the
   // driver sanitizer runs at check=error (status 5) when no check= is given.
@@ -183,75 +409,18 @@ std::optional<int> RunCommand::run() {
     if (!timeout || *timeout == 0)
       return usage("l6470emu run: --timeout " + quoted_text(timeout_) + " is not a duration (30, 2.5s, 250ms, 1min)");
   }
-  std::string error;
-  const std::string preload = find_preload(error);
-  if (preload.empty()) return usage("l6470emu run: " + error);
-
-  // 3. The program, under the preload, with the run's environment.
-  std::string scenario_path, report_path;
-  try {
-    scenario_path = temp_file("scenario", serialize_scenario(scenario));
-    report_path = temp_file("report", "");
-  } catch (const std::exception& e) {
-    return usage(std::string("l6470emu run: ") + e.what());
-  }
-  std::vector<std::string> env;
-  for (char** e = environ; *e; ++e) {
-    const std::string_view v(*e);
-    for (const char* drop : {"L6470EMU_CONFIG=", "L6470EMU_SOCKET=", "L6470EMU_TRACE=", "L6470EMU_CHAIN=", "LD_PRELOAD=",
-                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS="})
-      if (v.starts_with(drop)) goto next;
-    env.emplace_back(v);
-  next:;
-  }
-  {
-    const char* old = std::getenv("LD_PRELOAD");
-    env.push_back("LD_PRELOAD=" + preload + (old && *old ? std::string(" ") + old : std::string()));
-  }
-  env.push_back("L6470EMU_CHAIN=" + describe_board_config(config));
-  env.push_back(std::string(kRunScenarioEnv) + "=" + scenario_path);
-  env.push_back(std::string(kRunReportEnv) + "=" + report_path);
-  if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
-  std::vector<char*> envp, argv;
-  for (auto& e : env) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  for (auto& a : program_) argv.push_back(a.data());
-  argv.push_back(nullptr);
-
-  pid_t pid = 0;
-  const int spawn_error = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), envp.data());
-  if (spawn_error != 0) {
-    std::cerr << "l6470emu run: cannot start " << program_[0] << ": " << std::strerror(spawn_error) << "\n";
-    unlink(scenario_path.c_str());
-    unlink(report_path.c_str());
-    return kRunNotStarted;
-  }
-  int wstatus = 0;
-  bool wall_timeout = false;
-  if (timeout && !config.time.virtual_time) {
-    // Wall time: the limit in simulated seconds is limit / scale seconds of real time.
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 / config.time.scale));
-    while (true) {
-      const pid_t r = waitpid(pid, &wstatus, WNOHANG);
-      if (r == pid) break;
-      if (std::chrono::steady_clock::now() >= deadline) {
-        wall_timeout = true;
-        kill(pid, SIGKILL);
-        waitpid(pid, &wstatus, 0);
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-  } else {
-    while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
-    }
-  }
+  // 3. The program: under the preload (the board in its own process), or as it is against the
+  // kernel's nodes of a board in this process.
+  ProgramEnd run;
+  const int started = kernel ? run_on_kernel_nodes(config, scenario, !scenario_file_.empty(), timeout, program_, run)
+                             : run_under_preload(config, scenario, timeout, program_, run);
+  if (started >= 0) return started;
+  const pid_t pid = run.pid;
+  const int wstatus = run.wstatus;
+  const bool wall_timeout = run.wall_timeout;
+  const std::vector<RunReport>& blocks = run.blocks;
 
   // 4. What it came to.
-  const std::vector<RunReport> blocks = parse_run_reports(read_all(report_path));
-  unlink(scenario_path.c_str());
-  unlink(report_path.c_str());
   std::optional<RunEnd> cause;
   const RunReport* cause_block = nullptr;
   for (const RunReport& b : blocks)

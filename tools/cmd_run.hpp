@@ -1,6 +1,7 @@
 // `l6470emu run`: builds a board, runs an unmodified program against it through the preload
-// library (virtual time by default), applies a scenario, and ends with a report, a JUnit file
-// and an exit status a CI reads (linux/run_report.hpp's RunStatus; docs/scenarios.md).
+// library (virtual time by default) or the kernel's own device nodes (CUSE, UHID; wall time),
+// applies a scenario, and ends with a report, a JUnit file and an exit status a CI reads
+// (linux/run_report.hpp's RunStatus; docs/scenarios.md).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,7 +18,7 @@ class RunCommand {
 
  private:
   CLI::App* cmd_ = nullptr;
-  std::string board_file_, chain_, scenario_file_, time_ = "virtual", timeout_, junit_, record_;
+  std::string board_file_, chain_, scenario_file_, time_ = "virtual", nodes_ = "preload", timeout_, junit_, record_;
   bool verbose_ = false;
   std::vector<std::string> program_;
 };

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 
@@ -149,7 +150,7 @@ TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
 }
 
 TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
-  for (const char* code : {"3", "86"}) {
+  for (const char* code : {"3", "86", "87"}) {
     const RunResult r = run({"--chain", "chips=L6470"}, {"/bin/sh", "-c", std::string("exit ") + code});
     EXPECT_EQ(r.status, kRunProgramFailed) << code << r.err;
     EXPECT_NE(r.err.find(std::string("exited with status ") + code), std::string::npos) << r.err;
@@ -160,7 +161,7 @@ TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
 }
 
 TEST_F(RunCommand, ASanitizerEndIsTakenFromTheReportNotFromTheStatus) {
-  // The driver sanitizer (check=error) ends programs with status 86 as a deadlock does; its
+  // The driver sanitizer (check=error) ends programs with status 86 (a deadlock with 87); its
   // report block (preload::end_run(RunEnd::sanitizer, ...)) is what tells run. Written here by
   // hand, as the sanitizer's error path writes it.
   const RunResult r = run({"--chain", "chips=L6470"},
@@ -205,6 +206,26 @@ TEST_F(RunCommand, UsageAndScenarioErrorsAreStatusTwoAndTheProgramNeverStarts) {
   EXPECT_EQ(r.status, kRunUsage);
   r = run({}, program);
   EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_FALSE(fs::exists(marker));
+}
+
+TEST_F(RunCommand, KernelNodesRunInWallTimeAndWithoutThemTheProgramNeverStarts) {
+  // The kernel's nodes themselves are exercised in the VM test (tests/vm: a static Go driver);
+  // here what any machine can show: the refusals, before and when the nodes cannot be made.
+  const std::string marker = path("started");
+  const std::vector<std::string> program{"/bin/sh", "-c", "touch " + marker};
+  RunResult r = run({"--nodes", "kernel", "--time", "virtual", "--chain", "chips=L6470"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_NE(r.err.find("--nodes kernel runs in wall time"), std::string::npos) << r.err;
+  r = run({"--nodes", "kernle", "--chain", "chips=L6470"}, program);
+  EXPECT_EQ(r.status, kRunUsage) << r.err;
+  if (access("/dev/cuse", R_OK | W_OK) == 0 && access("/dev/uhid", R_OK | W_OK) == 0) {
+    std::cout << "this machine can make CUSE and UHID nodes: the refusal without them is not shown here\n";
+  } else {
+    r = run({"--nodes", "kernel", "--chain", "chips=L6470"}, program);
+    EXPECT_EQ(r.status, kRunNotStarted) << r.err;
+    EXPECT_NE(r.err.find("the kernel's nodes could not be made"), std::string::npos) << r.err;
+  }
   EXPECT_FALSE(fs::exists(marker));
 }
 

@@ -89,6 +89,41 @@ echo "daemon exit $?"
 gpiodetect | grep -q cp2112_gpio && fail "the cp2112 gpiochips are still there after the daemon stopped"
 echo "nodes gone"
 
+step "l6470emu run --nodes kernel: a static Go driver homes against the axis's switch, judged by a scenario"
+go_client="$B/tests/vm/clients/homing_go"
+if [ -x "$go_client" ]; then
+  file "$go_client" 2>/dev/null | grep -q "statically linked" || echo "(file(1) absent or homing_go not static)"
+  "$B/l6470emu" run --nodes kernel --board "$S/examples/run/homing.board" --scenario "$S/examples/run/homing.yaml" \
+    --junit /tmp/run_go.xml -- "$go_client" > /tmp/run_go.log 2>&1
+  rc=$?
+  cat /tmp/run_go.log
+  [ $rc -eq 0 ] || fail "run --nodes kernel of the Go client exited $rc, expected 0"
+  grep -q "^homed: ABS_POS 0$" /tmp/run_go.log || fail "the Go client did not print 'homed: ABS_POS 0'"
+  grep -q "kernel node /dev/spidev0.0 (CUSE" /tmp/run_go.log || fail "run did not name the CUSE node"
+  grep -q "5 expectations, 0 failed; exit 0" /tmp/run_go.log || fail "run did not judge the scenario's 5 expectations"
+  grep -q "<testsuite name=\"homing against the switch\" tests=\"6\" failures=\"0\" errors=\"0\"" /tmp/run_go.xml ||
+    fail "the JUnit report: $(cat /tmp/run_go.xml)"
+  [ -e /dev/spidev0.0 ] && fail "/dev/spidev0.0 still there after run ended"
+  # The same driver, a scenario that cannot hold: the failure is named and run exits 1.
+  printf 'name: wrong home\nsteps:\n  - at: end\n    expect: {register: ABS_POS, value: 5}\n' > /tmp/wrong_home.yaml
+  "$B/l6470emu" run --nodes kernel --board "$S/examples/run/homing.board" --scenario /tmp/wrong_home.yaml \
+    -- "$go_client" > /tmp/run_go_wrong.log 2>&1
+  rc=$?
+  cat /tmp/run_go_wrong.log
+  [ $rc -eq 1 ] || fail "a failed expectation through the kernel's nodes exited $rc, expected 1"
+  grep -q "FAILED /tmp/wrong_home.yaml:3: spidev0.0 chip 0: ABS_POS at .*: expected 5, seen 0" /tmp/run_go_wrong.log ||
+    fail "the failed expectation was not named"
+  # A driver in mode 0 is caught by the sanitizer through the kernel's nodes too: status 5.
+  printf 'import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.max_speed_hz = 1000000\nprint(s.xfer2([0xD0]))\n' > /tmp/mode0.py
+  "$B/l6470emu" run --nodes kernel --chain L6470 -- $PY /tmp/mode0.py > /tmp/run_mode0.log 2>&1
+  rc=$?
+  cat /tmp/run_mode0.log
+  [ $rc -eq 5 ] || fail "a mode-0 driver through the kernel's nodes exited $rc, expected 5 (the sanitizer)"
+  grep -q "mode 0" /tmp/run_mode0.log || fail "the sanitizer's report does not name mode 0"
+else
+  echo "SKIPPED: no Go toolchain on the host (Debian's golang-go), so tests/vm/clients/homing_go was not built"
+fi
+
 # Last, because Debian 6.1's hid-cp2112 may leave the kernel unwell after it (see below).
 start_daemon
 step "python3-spidev and python3-libgpiod: a move seen on BUSY through the kernel's gpiochip"
