@@ -353,7 +353,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (time_tok[0] < '0' || time_tok[0] > '9') {
     if (time_tok == "chain" || time_tok == "board") fail("'" + std::string(time_tok) + "' must come before the first event");
     if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
-    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault ...')");
+    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault|load|advance ...')");
   }
 
   // Time: seconds, decimal (the writer uses 8 decimals: exact ticks).
@@ -766,6 +766,7 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
       for (Held& h : run_) h.tick += run_period_;
       partial_ = 0;
       ++line_count_;
+      ++run_repetitions_;
       if (open_runs()) {
         // The count and the end of its line, in the 8-byte word that also holds the first byte
         // of the frame lines after it: one store makes them the repetition's count instead.
@@ -799,7 +800,7 @@ void NativeTraceWriter::look_for_run() {
   for (std::size_t k = 1; k <= kMaxRepeatGroup && copies * k <= n; ++k) {
     const Held* c = &recent_[n - k];
     const Tick period = c[0].tick - recent_[n - 2 * k].tick;
-    if (period == 0) continue;
+    if (period == 0 || c[k - 1].tick + c[k - 1].duration - c[0].tick > period) continue;  // as the reader requires
     bool same = true;
     for (std::size_t copy = 1; copy < copies && same; ++copy) {
       const Held* a = &recent_[n - (copy + 1) * k];
@@ -819,6 +820,7 @@ void NativeTraceWriter::look_for_run() {
       run_bodies_[j] += '\n';
     }
     line_count_ = 0;
+    run_repetitions_ = 0;
     line_base_ = run_.back().tick;
     checkpoint_tick_ = run_.back().tick;
     if (open_runs()) write_open_repeat_line();
@@ -863,8 +865,18 @@ void NativeTraceWriter::end_run() {
     write_repeat_line();
     for (const Held& h : partial) write_line(h.event());
   }
-  recent_ = std::move(run_);
-  for (Held& h : partial) recent_.push_back(std::move(h));
+  // The recent frames mirror a reader's ring of frame lines: the group's lines now stand for
+  // the last repetition (moved on in place) and the unfinished repetition's lines follow. When
+  // no repetition came (two alike frames inside a longer poll, say) the lines before the run
+  // are all still there, so the longer group can still be found.
+  if (run_repetitions_ == 0) {
+    for (Held& h : partial) recent_.push_back(std::move(h));
+    const std::size_t cap = 3 * kMaxRepeatGroup;
+    if (recent_.size() > cap) recent_.erase(recent_.begin(), recent_.end() - static_cast<std::ptrdiff_t>(cap));
+  } else {
+    recent_ = std::move(run_);
+    for (Held& h : partial) recent_.push_back(std::move(h));
+  }
   run_.clear();
   partial_ = 0;
   // A new run may start right away among these frames (but not one that includes the old run's

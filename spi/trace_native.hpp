@@ -204,6 +204,7 @@ class NativeTraceWriter final : public TraceSink {
   std::size_t partial_ = 0;  // frames of the repetition under way (the group's first ones, a period on)
   std::vector<std::string> run_bodies_;  // open runs: each group frame's line after its time, with the newline
   std::uint64_t line_count_ = 0;  // repetitions the run's repeat line stands for
+  std::uint64_t run_repetitions_ = 0;  // repetitions of the run so far, on every line
   Tick line_base_ = 0;            // tick of the group's last frame as the file has it before that line
   std::uint64_t count_offset_ = 0;  // open line: where its count field starts in the output
   Tick checkpoint_tick_ = 0;
