@@ -50,6 +50,10 @@ struct RuleInfo {
   std::string_view name;       ///< stable name, as check.allow= takes it
   std::string_view about;      ///< one line: what the rule is
   std::string_view datasheet;  ///< where the datasheet states it (L6470 rev 3 numbering)
+  /// CONFIRMED: the datasheet (or a public report of silicon) states the rule and what breaking
+  /// it does; UNCONFIRMED: the limit is stated but what the chip then does, or the rule itself,
+  /// is our reading. One line, the mark first.
+  std::string_view mark;
 };
 
 /// Every rule, in Rule order.

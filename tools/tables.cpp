@@ -262,9 +262,10 @@ std::string variant_differences_markdown() {
 }
 
 std::string sanitizer_rules_markdown() {
-  std::string out = "| rule (check.allow=) | what it is about | datasheet |\n|---|---|---|\n";
+  std::string out = "| rule (check.allow=) | what it is about | datasheet | mark |\n|---|---|---|---|\n";
   for (const RuleInfo& r : rule_table())
-    out += "| `" + std::string(r.name) + "` | " + std::string(r.about) + " | " + std::string(r.datasheet) + " |\n";
+    out += "| `" + std::string(r.name) + "` | " + std::string(r.about) + " | " + std::string(r.datasheet) + " | " +
+           std::string(r.mark) + " |\n";
   return out;
 }
 

@@ -72,18 +72,26 @@ class Board:
     number of L6470s), on /dev/spidev{bus}.{cs} with its pins on a gpiochip; options: more board
     description words ("speed=1000000 mode=3 axis.0=..."). description: a whole board
     description instead (several chains separated by ';', docs/linux.md). trace_path: record
-    every chain into this native trace (trace(), decode(), replay() read it).
+    every chain into this native trace (trace(), decode(), replay() read it). check: the driver
+    sanitizer, "error" (default: the first broken rule of the chip raises l6470emu.SanitizerError
+    with the report), "warn" (a log line) or "off"; check_allow: rule names let pass. A
+    description or options naming check= themselves win.
     """
 
     def __init__(self, chips: Union[str, int, Sequence[str]] = "L6470", *, bus: int = 0, cs: int = 0,
                  options: str = "", description: Optional[str] = None,
-                 trace_path: Optional[Union[str, os.PathLike]] = None):
+                 trace_path: Optional[Union[str, os.PathLike]] = None,
+                 check: str = "error", check_allow: Sequence[str] = ()):
         if description is None:
             description = f"bus={bus} cs={cs} chips={_chips_word(chips)}"
             if options:
                 description += " " + options
         if "time=" not in description:
             description += " time=virtual"
+        if "check=" not in description:
+            if isinstance(check_allow, str):
+                raise TypeError(f"check_allow is a sequence of rule names, not {check_allow!r}")
+            description += f" check={check}" + (" check.allow=" + ",".join(check_allow) if check_allow else "")
         #: the board description the board was built from
         self.description: str = description
         self._core = _BoardCore(description, "l6470emu.Board")

@@ -278,6 +278,7 @@ TEST(SanitizerBoard, TheReportHasEverythingOnItsLinesAndTheRuleTableIsComplete) 
     EXPECT_EQ(rule_named(r.name), r.rule);
     EXPECT_FALSE(r.about.empty());
     EXPECT_FALSE(r.datasheet.empty());
+    EXPECT_TRUE(r.mark.starts_with("CONFIRMED") || r.mark.starts_with("UNCONFIRMED")) << r.name << ": " << r.mark;
   }
 }
 

@@ -97,6 +97,17 @@ TEST_P(Sanitizer, UnderCheckErrorTheProgramEndsWithTheReportAndTheSanitizersStat
   EXPECT_EQ(r.err.find("driver sanitizer", r.err.find("driver sanitizer") + 1), std::string::npos) << r.err;
 }
 
+TEST_P(Sanitizer, TheEnvironmentAloneSetsTheLevel) {
+  // No check= in the description: L6470EMU_CHECK=error by itself ends the program.
+  const Case& c = cases()[GetParam()];
+  const RunResult r = run_program(argv(c), {{"LD_PRELOAD", preload_library()},
+                                            {"L6470EMU_CHAIN", std::string("bus=0 cs=0 chips=") + c.chips},
+                                            {"L6470EMU_CHECK", "error"}});
+  EXPECT_EQ(r.status, kSanitizerExitStatus) << r.out << r.err;
+  EXPECT_EQ(r.out.find("ran to the end"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find(std::string("check.allow=") + c.rule), std::string::npos) << r.err;
+}
+
 TEST_P(Sanitizer, UnderCheckWarnTheProgramRunsOnAndTheLogNamesTheRule) {
   const Case& c = cases()[GetParam()];
   if (*c.python == '\0') GTEST_SKIP() << "the C client prints no end line";

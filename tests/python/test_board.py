@@ -78,7 +78,7 @@ def test_spidev_attributes_behave_as_py_spidev_before_open_after_open_and_after_
 
 
 def test_the_mode_is_kept_in_the_device_and_shared_by_every_open_file_as_in_the_kernel():
-    board = l6470emu.Board("L6470")
+    board = l6470emu.Board("L6470", check="warn")
     a, b = board.spidev(0, 0), board.spidev(0, 0)
     a.mode = 1
     b.close()
@@ -86,6 +86,17 @@ def test_the_mode_is_kept_in_the_device_and_shared_by_every_open_file_as_in_the_
     assert b.mode == 1  # a second open reads the device's mode
     a.xfer2([0x00])
     assert "SPI_MODE: the host clocks in SPI mode 1" in board.log()  # handed to the board, which says so
+
+
+def test_a_board_checks_at_error_unless_told_otherwise():
+    board = l6470emu.Board("L6470")
+    spi = board.spidev(0, 0)  # mode 0, spidev's default
+    with pytest.raises(l6470emu.SanitizerError) as e:
+        spi.xfer2([0x00])
+    assert "SPI mode 0 (CPOL=0, CPHA=0)" in str(e.value)
+    # check= of the description, or check_allow=, let it pass.
+    for quiet in (l6470emu.Board("L6470", options="check=warn"), l6470emu.Board("L6470", check_allow=["SPI_MODE"])):
+        assert quiet.spidev(0, 0).xfer2([0x00]) == [0x00]
 
 
 def test_spidev_is_a_context_manager_and_ends_closed():
@@ -98,7 +109,7 @@ def test_spidev_is_a_context_manager_and_ends_closed():
 
 
 def test_a_message_takes_its_bus_time_and_nothing_else_moves_time():
-    board = l6470emu.Board("L6470", options="speed=1000000")
+    board = l6470emu.Board("L6470", options="speed=1000000", check="warn")  # 3 bytes in one frame on purpose
     spi = board.spidev(0, 0)
     spi.mode = 3
     t0 = board.tick
@@ -218,8 +229,10 @@ def test_an_unknown_fixture_option_is_named(request):
 
 
 def test_a_board_with_two_chains_opens_each_spidev_and_gpiochip():
-    board = l6470emu.Board(description="chips=L6470 bus=0 cs=0 gpiochip=0; chips=L6480 bus=1 cs=2 gpiochip=3")
-    assert board.spidev(1, 2).xfer2([0x00]) == [0x00]
+    board = l6470emu.Board(description="chips=L6470 bus=0 cs=0 gpiochip=0; chips=L6480 bus=1 cs=2 gpiochip=3 mode=3")
+    spi = board.spidev(1, 2)
+    spi.mode = 3
+    assert spi.xfer2([0x00]) == [0x00]
     assert board.gpiochip("/dev/gpiochip3").find_line("BUSY") is not None
     with pytest.raises(FileNotFoundError):
         board.gpiochip(7)
