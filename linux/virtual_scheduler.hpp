@@ -23,8 +23,9 @@ namespace l6470emu {
 
 /// The exit status of a program that virtual time found deadlocked: every thread waits in a
 /// covered call and nothing can ever wake any of them (see VirtualScheduler). Distinct from the
-/// statuses programs and tools commonly use (0-5, 23, 64-78, 99, 124-127, 128 + a signal).
-inline constexpr int kDeadlockExitStatus = 86;
+/// statuses programs and tools commonly use (0-5, 23, 64-78, 99, 124-127, 128 + a signal) and
+/// from the driver sanitizer's 86 (board/check_rules.hpp), so a plain program's status says which.
+inline constexpr int kDeadlockExitStatus = 87;
 
 /// Virtual time for the threads of one process.
 ///

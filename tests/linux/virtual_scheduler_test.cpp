@@ -419,7 +419,7 @@ TEST(VirtualSchedulerDeadlock, EveryThreadWaitingOnWhatOnlyTheProcessCouldEndIsR
   const std::string& r = reports[0];
   EXPECT_EQ(r.rfind("virtual time: deadlock at t=0.000000 s: every thread waits and nothing can wake any of them", 0), 0u)
       << r;
-  EXPECT_NE(r.find("the run ends with exit status 86"), std::string::npos) << r;
+  EXPECT_NE(r.find("the run ends with exit status 87"), std::string::npos) << r;
   const std::string fd = "fd " + std::to_string(pipe.fd[0]) + " (a line request), no timeout";
   EXPECT_NE(r.find("): read() on " + fd), std::string::npos) << r;
   EXPECT_NE(r.find("): poll() on " + fd), std::string::npos) << r;
