@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "core/counted.hpp"
 #include "daisychain/explain.hpp"
 
 namespace l6470emu {
@@ -265,7 +266,7 @@ void ProtocolTracker::end_frame() {
                  std::to_string(len - n - 1) + " pass through the chain undecoded; chip k decodes MOSI byte " +
                  (numbering_.from() == NumberFrom::miso ? std::to_string(len - n) + "+k" : std::to_string(len - 1) + "-k");
       } else {
-        e.text = std::to_string(len) + " bytes for a chain of " + std::to_string(n) + ": " +
+        e.text = counted(len, "byte") + " for a chain of " + std::to_string(n) + ": " +
                  (n - len == 1 ? numbering_.label(0) + " decodes a byte" : chip_range(0, n - len - 1) + " decode bytes") +
                  " left in the chain, not host bytes (" + numbering_.label(0) + " decodes " + byte_hex(chips_[0].byte) + ", " +
                  origin_of(0) + ")";

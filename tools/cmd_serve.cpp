@@ -1,6 +1,7 @@
 // `l6470emu serve` and `l6470emu ctl`.
 #include "tools/cmd_serve.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -129,6 +130,12 @@ std::optional<int> ServeCommands::run() {
     return run_daemon(config, socket, std::cout, std::cerr, front_ends, preload_library_path(own_program_path()));
   }
   if (ctl_ && *ctl_) {
+    // A command no daemon knows is a usage error here, before any daemon is asked.
+    const auto& known = control_commands();
+    if (command_word_ != "--help" && std::find(known.begin(), known.end(), command_word_) == known.end()) {
+      std::cerr << "l6470emu ctl: " << unknown_control_command(command_word_) << " (l6470emu ctl help)\n";
+      return 2;
+    }
     std::vector<std::string> all = {command_word_};
     for (const auto& extra : ctl_->remaining()) all.push_back(extra);
     if (!ctl_number_from_.empty()) {  // the daemon checks it, as when it follows the command

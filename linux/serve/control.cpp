@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "board/axis_config.hpp"
+#include "core/near_miss.hpp"
 #include "core/status.hpp"
 #include "linux/terminal_text.hpp"
 
@@ -228,7 +229,13 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       });
     });
     if (!ok) {
-      out = "ctl: no register '" + a.words[0] + "' on this variant (use the datasheet name, e.g. ABS_POS)\n";
+      std::vector<std::string> names;
+      board.with_chain(ci, [&](Chain& c) {
+        for (const RegisterInfo& r : c.chip(0).registers().registers) names.emplace_back(r.name);
+      });
+      const std::string near = closest_names(terminal_safe(a.words[0]), names);
+      out = "ctl: no register '" + terminal_safe(a.words[0]) + "' on this variant" +
+            (near.empty() ? " (use the datasheet name, e.g. ABS_POS)" : "; did you mean " + near + "?") + "\n";
       return 1;
     }
   } else if (cmd == "dump") {
@@ -430,11 +437,22 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       return 2;
     }
   } else {
-    out = "ctl: unknown command '" + cmd + "'\n" + control_help();
+    out = "ctl: " + unknown_control_command(cmd) + " (ctl help lists them)\n";
     return 2;
   }
   out = o.str();
   return 0;
+}
+
+const std::vector<std::string>& control_commands() {
+  static const std::vector<std::string> commands{"status", "get",  "dump",    "sw",    "pin",     "fault", "adc",
+                                                 "axis",   "time", "advance", "chains", "trace", "clients", "help"};
+  return commands;
+}
+
+std::string unknown_control_command(const std::string& word) {
+  const std::string near = closest_names(word, control_commands());
+  return "unknown command '" + terminal_safe(word) + "'" + (near.empty() ? "" : "; did you mean " + near + "?");
 }
 
 }  // namespace l6470emu

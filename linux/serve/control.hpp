@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "linux/device_board.hpp"
 
@@ -27,5 +28,10 @@ std::string parse_advance_ms(const std::string& text, Tick& ticks);
 /// Text of `ctl help`: with `numbering`, the daemon's convention; without, a client that has
 /// not asked the daemon (which numbers as its numbering= says).
 std::string control_help(std::optional<NumberFrom> numbering = std::nullopt);
+
+/// The commands `ctl` takes (its first word), as control_help lists them.
+const std::vector<std::string>& control_commands();
+/// "unknown command 'statsu'; did you mean status?" (without the near miss when none is close).
+std::string unknown_control_command(const std::string& word);
 
 }  // namespace l6470emu

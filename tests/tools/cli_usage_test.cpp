@@ -44,6 +44,18 @@ TEST(UsageErrors, EverySubcommandNamesAMisspeltOption) {
   expect_usage_error("convert x -o y --expnd", "l6470emu convert: unknown option '--expnd'; did you mean '--expand'?");
   expect_usage_error("plot --chpis 1 x", "l6470emu plot: unknown option '--chpis'; did you mean '--chips'?");
   expect_usage_error("units --varaint L6480 ACC", "l6470emu units: unknown option '--varaint'; did you mean '--variant'?");
+  // run: the program after -- is no excuse to name something else than the misspelt option.
+  expect_usage_error("run --chain chips=L6470 --scenaro x -- /bin/true",
+                     "l6470emu run: unknown option '--scenaro'; did you mean '--scenario'?");
+  expect_usage_error("run --chian L6470 -- /bin/true", "l6470emu run: unknown option '--chian'; did you mean '--chain'?");
+}
+
+TEST(UsageErrors, AMisspeltCtlCommandIsNamedBeforeAnyDaemonIsAsked) {
+  // No daemon at that socket: the command is checked first, with the near miss.
+  expect_usage_error("ctl --socket /nonexistent/l6470emu.sock statsu",
+                     "l6470emu ctl: unknown command 'statsu'; did you mean status? (l6470emu ctl help)");
+  expect_usage_error("ctl --socket /nonexistent/l6470emu.sock frobnicate",
+                     "l6470emu ctl: unknown command 'frobnicate' (l6470emu ctl help)");
 }
 
 TEST(UsageErrors, AnOptionOfAnotherSubcommandSaysWhoseItIs) {
