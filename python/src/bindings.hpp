@@ -26,8 +26,9 @@ void bind_board(py::module_& m);
 py::dict axis_state(const Chip& chip);
 /// Attaches an axis from the board description's axis items (an attached axis's spec is the start).
 void attach_axis_text(Chip& chip, const std::string& text);
-/// Changes the load of the attached axis (load=, friction=, force=).
-void set_load_text(Chip& chip, const std::string& text);
+/// The attached axis's load with the items of `text` (load=, friction=, force=) changed;
+/// ValueError without an axis or for a bad item. The caller applies it (recorded where it records).
+LoadSpec load_from_text(const Chip& chip, const std::string& text);
 /// The private functions l6470emu.units is written over (register values <-> physical units).
 void bind_units(py::module_& m);
 

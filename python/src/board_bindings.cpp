@@ -80,12 +80,12 @@ void attach_axis_text(Chip& chip, const std::string& text) {
   chip.attach_axis(spec);
 }
 
-void set_load_text(Chip& chip, const std::string& text) {
+LoadSpec load_from_text(const Chip& chip, const std::string& text) {
   const Axis* a = chip.axis();
   if (!a) throw py::value_error("no axis is attached to this chip (attach_axis first)");
   LoadSpec load = a->spec().load;
   if (std::string err = parse_axis_load(text, load); !err.empty()) throw py::value_error("load: " + err);
-  chip.set_axis_load(load);
+  return load;
 }
 
 void bind_board(py::module_& m) {
@@ -222,7 +222,9 @@ void bind_board(py::module_& m) {
   b.def("set_load", [](PyBoard& s, long long c, long long k, const std::string& text) {
     const std::size_t chain = chain_arg(s, c);
     const std::size_t chip = chip_arg(s, chain, k);
-    s.board().with_chain(chain, [&](Chain& ch) { set_load_text(ch.chip(chip), text); });
+    LoadSpec load;
+    s.board().with_chain(chain, [&](Chain& ch) { load = load_from_text(ch.chip(chip), text); });
+    s.board().set_axis_load(chain, chip, load);  // a load event in the board's recordings
   });
   b.def("axis", [](PyBoard& s, long long c, long long k) {
     const std::size_t chain = chain_arg(s, c);

@@ -401,7 +401,8 @@ Time does not advance by itself: call advance() between frames as a bus would ta
         "The axis now: position (true, 1/128 step), lost_steps, synchronised, at_stop, switches\n"
         "(name: actuated), sw_level, stall, overcurrent, phase_current_mA, spec.");
   c.def("set_load", [](PyChain& p, py::handle chip, const std::string& load) {
-        set_load_text(p.chain().chip(chip_arg(p, chip)), load);
+        const std::size_t k = chip_arg(p, chip);
+        p.set_axis_load(k, load_from_text(p.chain().chip(k), load));
       }, py::arg("chip"), py::arg("load"), "Changes the axis's load now: \"load=G_CM2,friction=NM,force=NM\".");
   c.def("set_sw_pin", [](PyChain& p, py::handle chip, py::handle level) { p.set_sw_pin(chip_arg(p, chip), level_arg(level, "level")); },
         py::arg("chip"), py::arg("level"), "SW input level: False/0 = switch closed (pulled to ground).")

@@ -96,6 +96,13 @@ void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
   }
 }
 
+void PyChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
+  if (rec_)
+    rec_->set_axis_load(chip, load);
+  else
+    chain_->chip(chip).set_axis_load(load);
+}
+
 void PyChain::close() {
   if (!rec_) return;
   rec_->observe_outputs();

@@ -66,6 +66,8 @@ class PyChain {
   void set_adc_input(std::size_t chip, std::uint8_t code);
   /// A backdoor event as in a trace: UVLO/UVLO_ADC/OCD/STALL_A/STALL_B 0 or 1, THERMAL 0..3, ADCIN 0..31.
   void fault(std::size_t chip, TraceFault fault, std::uint8_t value);
+  /// The load on `chip`'s axis changes (a load event when recording).
+  void set_axis_load(std::size_t chip, const LoadSpec& load);
 
   bool recording() const { return rec_ != nullptr; }
   /// The file being (or last) recorded into; empty for none or memory.

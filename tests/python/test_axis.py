@@ -2,6 +2,7 @@
 an axis, read its true position, change its load and place switches."""
 import pytest
 
+import l6470emu
 from l6470emu import Reg
 
 
@@ -48,3 +49,28 @@ def test_a_board_attaches_an_axis_whose_switch_stops_the_motor(l6470_board):
     # SW_MODE 0: the closing switch stops the motor hard, on the switch
     axis = l6470_board.axis(0)
     assert -4 <= axis["position"] <= 0 and axis["switches"]["home"]
+
+
+def test_a_load_change_is_a_load_event_of_the_recording_and_replays(tmp_path):
+    # The replay is checked on a Board, whose description (axis included) heads the recording; a
+    # Chain's recording has no board lines (docs/trace-format.md), but its load change is an event.
+    board = l6470emu.Board("L6470", options="axis.0=stops=-100000..100000", trace_path=tmp_path / "load.trace")
+    spi = board.spidev(0, 0)
+    spi.mode = 3
+    for byte in (0x51, 0x00, 0x20, 0x00):  # Run forward at 0x2000
+        spi.xfer2([byte])
+    board.advance(0.05)
+    board.set_load(0, "load=2000,friction=0.05")
+    board.advance(0.05)
+    [spi.xfer2([b]) for b in (0xD0, 0, 0)]
+    board.close()
+    text = (tmp_path / "load.trace").read_text()
+    assert " load 0 " in text, text
+    result = l6470emu.replay(tmp_path / "load.trace")
+    assert result.matched and result.pin_mismatches == 0, result
+
+    chain = l6470emu.Chain("L6470", record=tmp_path / "chain.trace")
+    chain.attach_axis(0, "stops=-100000..100000")
+    chain.set_load(0, "load=2000")
+    chain.close()
+    assert " load 0 " in (tmp_path / "chain.trace").read_text()

@@ -2,7 +2,9 @@
  * SystemClock_Config, MX_GPIO_Init (CS on PA4, FLAG on PA10 as a falling-edge EXTI line, BUSY
  * on PB5, STBY_RST on PB10), MX_SPI1_Init (mode 3: CPOL high, second edge; MSB first; APB/32),
  * the EXTI handler in the program, HAL_GPIO_EXTI_Callback, and a driver on
- * HAL_SPI_TransmitReceive. It checks itself and prints PASS. */
+ * HAL_SPI_TransmitReceive; then HAL_SPI_Transmit/Receive with CS by TogglePin, and the handle
+ * re-initialised LSB first and in mode 0, whose bits come back as silicon gives them. It checks
+ * itself and prints PASS. */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -187,6 +189,59 @@ int main(void) {
   SPI_HandleTypeDef never_initialised = {0};
   never_initialised.Instance = SPI1;
   check(HAL_SPI_Transmit(&never_initialised, word, 1, 10) == HAL_BUSY, "a handle never initialised is busy");
+
+  /* HAL_SPI_Transmit and HAL_SPI_Receive, CS by TogglePin: SetParam(MAX_SPEED) of both chips,
+   * then GetParam(MAX_SPEED) and its answer received (Receive sends its buffer: NOPs). */
+  const uint8_t set[3][CHIPS] = {{0x07, 0x07}, {0x01, 0x02}, {0x23, 0x45}}, get[CHIPS] = {0x27, 0x27};
+  for (int i = 0; i < 3; ++i) {
+    HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+    check(HAL_SPI_Transmit(&hspi1, set[i], CHIPS, 10) == HAL_OK, "HAL_SPI_Transmit");
+    HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  }
+  check(HAL_GPIO_ReadPin(CS_PORT, CS_PIN) == GPIO_PIN_SET, "TogglePin twice a frame leaves CS high");
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  HAL_SPI_Transmit(&hspi1, get, CHIPS, 10);
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  uint8_t hi[CHIPS] = {0}, lo[CHIPS] = {0};
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  check(HAL_SPI_Receive(&hspi1, hi, CHIPS, 10) == HAL_OK, "HAL_SPI_Receive");
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  HAL_SPI_Receive(&hspi1, lo, CHIPS, 10);
+  HAL_GPIO_TogglePin(CS_PORT, CS_PIN);
+  char line[96];
+  snprintf(line, sizeof line, "Transmit/Receive: MAX_SPEED 0x%03X and 0x%03X", hi[0] << 8 | lo[0], hi[1] << 8 | lo[1]);
+  check((hi[0] << 8 | lo[0]) == 0x123 && (hi[1] << 8 | lo[1]) == 0x245, line);
+
+  /* FirstBit LSB: each byte goes out and comes in bit-reversed, so a driver that reverses what
+   * it sends reads the chip's answer reversed: CONFIG 0x2E88 as 0x74 0x11. */
+  hspi1.Init.FirstBit = SPI_FIRSTBIT_LSB;
+  if (HAL_SPI_Init(&hspi1) != HAL_OK) Error_Handler();
+  const uint8_t get_config_lsb[CHIPS] = {0x1C, 0x1C}; /* 0x38 with its bits reversed */
+  const uint8_t nop[CHIPS] = {0, 0};
+  uint8_t a[CHIPS], b[CHIPS];
+  frame(get_config_lsb, NULL);
+  HAL_GPIO_WritePin(CS_PORT, CS_PIN, GPIO_PIN_RESET);
+  HAL_SPI_TransmitReceive(&hspi1, nop, a, CHIPS, 10);
+  HAL_GPIO_WritePin(CS_PORT, CS_PIN, GPIO_PIN_SET);
+  HAL_GPIO_WritePin(CS_PORT, CS_PIN, GPIO_PIN_RESET);
+  HAL_SPI_TransmitReceive(&hspi1, nop, b, CHIPS, 10);
+  HAL_GPIO_WritePin(CS_PORT, CS_PIN, GPIO_PIN_SET);
+  snprintf(line, sizeof line, "FirstBit LSB: CONFIG bytes 0x%02X 0x%02X and 0x%02X 0x%02X", a[0], b[0], a[1], b[1]);
+  check(a[0] == 0x74 && b[0] == 0x11 && a[1] == 0x74 && b[1] == 0x11, line);
+
+  /* CLKPolarity LOW, CLKPhase 1EDGE (mode 0), MSB first: the first rising edge comes before a
+   * chip's first falling edge has put bit 7 of its answer on SDO, so each chip sends its stale SDO
+   * latch for it (docs/spi-interface.md); chip 1's answer passes through chip 0 with that bit
+   * already lost. CONFIG 0x2E88 reads 0x2E08 from both. */
+  hspi1.Init.FirstBit = SPI_FIRSTBIT_MSB;
+  hspi1.Init.CLKPolarity = SPI_POLARITY_LOW;
+  hspi1.Init.CLKPhase = SPI_PHASE_1EDGE;
+  if (HAL_SPI_Init(&hspi1) != HAL_OK) Error_Handler();
+  const uint32_t config0 = command(0, 0x38, 0, 0, 2), config1 = command(1, 0x38, 0, 0, 2);
+  snprintf(line, sizeof line, "mode 0: chip 0 reads CONFIG as 0x%04X, chip 1 as 0x%04X", (unsigned)config0,
+           (unsigned)config1);
+  check(config0 == 0x2E08 && config1 == 0x2E08, line);
 
   printf("%s\n", failures == 0 ? "PASS" : "FAIL");
   return failures == 0 ? 0 : 1;
