@@ -47,7 +47,7 @@ case "$what" in
     stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer" env \
       ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       ctest --test-dir build-asan --output-on-failure -j"$(nproc)"
-    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, 10 harnesses x 45 s)" scripts/fuzz.sh 45
+    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, 11 harnesses x 45 s)" scripts/fuzz.sh 45
     ;;
   *)
     echo "usage: scripts/quickstart.sh demo|test" >&2
