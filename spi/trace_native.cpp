@@ -652,7 +652,18 @@ void NativeTraceWriter::finish() {
 }
 
 void NativeTraceWriter::flush_if_due() {
-  if (!finished_ && !abandoned_) out_->flush_if_due();
+  if (finished_ || abandoned_) return;
+  // A quiet moment in a run: its repeat line goes with the flush the output is due for.
+  if (in_run_ && !open_runs() && line_count_ > 0 && out_->flush_due().value_or(false)) write_repeat_line();
+  out_->flush_if_due();
+}
+
+/// Closed lines: whether a run in progress is written now. An output with a flush policy says
+/// when it will flush (a line written between flushes would only cost size); others get one
+/// every kCheckpointRepetitions repetitions or kCheckpointTicks of trace time.
+bool NativeTraceWriter::checkpoint_due() const {
+  if (const std::optional<bool> due = out_->flush_due()) return *due;
+  return line_count_ >= kCheckpointRepetitions || run_.back().tick - checkpoint_tick_ >= kCheckpointTicks;
 }
 
 void NativeTraceWriter::abandon() {
@@ -773,8 +784,7 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
         char field[7];
         out_->replace_tail(count_offset_, open_count_field(line_count_, field));
         if (line_count_ == kMaxOpenRepeatCount) end_run();
-      } else if (options_.flush_each_event &&
-                 (line_count_ >= kCheckpointRepetitions || run_.back().tick - checkpoint_tick_ >= kCheckpointTicks)) {
+      } else if (options_.flush_each_event && checkpoint_due()) {
         write_repeat_line();
       }
       return;

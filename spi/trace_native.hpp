@@ -183,6 +183,7 @@ class NativeTraceWriter final : public TraceSink {
   void end_run();
   void write_repeat_line();
   void write_open_repeat_line();
+  bool checkpoint_due() const;
   bool open_runs() const;
   const std::string& name() const;
 

@@ -37,6 +37,10 @@ class FileOutput final : public TraceOutput {
   void flush_if_due() override {
     if (unflushed_ != 0 && (!file_.gzip() || interval_passed())) flush();
   }
+  std::optional<bool> flush_due() const override {
+    if (!file_.gzip() || !policy_.clock) return std::nullopt;
+    return !flushed_once_ || unflushed_ >= policy_.gzip_bytes || interval_passed();
+  }
   std::uint64_t size() const override { return file_.end_offset(); }
   bool rewritable() const override { return !file_.gzip(); }
   void replace_tail(std::uint64_t offset, std::string_view text) override {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -36,6 +37,11 @@ class TraceOutput {
   virtual void event_end() {}
   /// Hands what is held to the OS if the policy's time has come (a quiet recording).
   virtual void flush_if_due() {}
+  /// Whether what is held would go to the OS now, by the output's own flush policy (a gzip
+  /// recording's size and time): a writer holding back a run's repeat line writes it only then,
+  /// so that no flush leaves it out and no line is written that no flush needs. nullopt: the
+  /// output has no such policy (the writer keeps its own checkpoints).
+  virtual std::optional<bool> flush_due() const { return std::nullopt; }
   /// Bytes appended so far, after replacements (where the next append goes).
   virtual std::uint64_t size() const = 0;
   /// Whether replace_tail works (plain files; not gzip or streams).

@@ -11,6 +11,7 @@
 
 #include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
+#include "spi/trace_output.hpp"
 #include "support/trace_test_support.hpp"
 
 namespace l6470emu {
@@ -310,6 +311,44 @@ TEST(TraceCompaction, AKilledGzipRecordingKeepsEverythingUpToItsLastCheckpoint) 
   ASSERT_GE(back.size(), 3u * (2 + 2000));
   for (std::size_t i = 0; i < back.size(); ++i)
     ASSERT_EQ(NativeTraceWriter::format_event(back[i]), NativeTraceWriter::format_event(t[i])) << i;
+}
+
+TEST(TraceCompaction, AGzipRecordingWritesARunsRepeatLineWhenItFlushesNotBefore) {
+  // A gzip recording flushes by size and host time; a run's repeat line is only worth writing
+  // when a flush takes it. A fast host (1 us between looks at the clock) polling for 100 s of
+  // trace time: one flush interval (200 ms) never passes, so the run is one line, not one per
+  // 1024 repetitions (which made a .gz recording 28 times gzip -6 of the plain one).
+  TempDir dir;
+  const std::string path = dir.file("fast.trace.gz");
+  std::int64_t now = 0;
+  TraceFlushPolicy policy;
+  policy.clock = [&now] { return now += 1000; };
+  const Trace t = polling(100000, 4000);
+  {
+    NativeTraceWriter w(open_trace_file_output(path, policy));
+    w.write_header(t.header);
+    for (std::size_t i = 0; i < t.size(); ++i) w.write(t[i]);
+    w.finish();
+  }
+  const std::string text = read_trace_file(path);
+  std::size_t repeats = 0;
+  for (std::size_t at = text.find(" repeat "); at != std::string::npos; at = text.find(" repeat ", at + 1)) ++repeats;
+  EXPECT_EQ(repeats, 1u) << text;
+  expect_same_events(t, read_native_trace(text, "fast.trace"));
+  // A slow host (10 ms a look): a flush is due at every 20th look or so, and each takes the
+  // run's line with it; what a kill would leave is never more than a flush interval behind.
+  now = 0;
+  policy.clock = [&now] { return now += 10'000'000; };
+  {
+    NativeTraceWriter w(open_trace_file_output(path, policy));
+    w.write_header(t.header);
+    for (std::size_t i = 0; i < 3000; ++i) w.write(t[i]);
+    w.finish();
+  }
+  const std::string slow = read_trace_file(path);
+  repeats = 0;
+  for (std::size_t at = slow.find(" repeat "); at != std::string::npos; at = slow.find(" repeat ", at + 1)) ++repeats;
+  EXPECT_GT(repeats, 20u) << slow.substr(0, 2000);
 }
 
 TEST(TraceCompaction, GzipFilesRoundTripAndAreRecognisedByTheirBytes) {
