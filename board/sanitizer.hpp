@@ -64,11 +64,17 @@ class Sanitizer {
   std::optional<std::string> take_failure();
   /// The failure, without taking it.
   const std::optional<Violation>& failure() const { return failure_; }
+  /// Broken rules reported so far at warn or error (allowed ones and check=off: none), and the
+  /// first of them (a scenario's `expect: {sanitizer: clean}`).
+  std::uint64_t broken() const { return broken_; }
+  const std::optional<Violation>& first_broken() const { return first_broken_; }
 
  private:
   CheckConfig config_;
   LineSink log_;
   std::optional<Violation> failure_;
+  std::uint64_t broken_ = 0;
+  std::optional<Violation> first_broken_;
   std::unordered_map<std::string, std::uint64_t> seen_;  // chain/chip/rule -> times reported
 };
 

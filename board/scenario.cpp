@@ -131,7 +131,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
       if (js.contains("expect")) {
         const json& e = js.at("expect");
         ScenarioExpectation x;
-        x.kind = enum_at<ScenarioExpectation::Kind>(e, "kind", 6);
+        x.kind = enum_at<ScenarioExpectation::Kind>(e, "kind", 7);
         x.chip = chip_of(e.at("chip"));
         x.name = unhex(e.at("name"));
         x.value = e.at("value").get<std::int64_t>();

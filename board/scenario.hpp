@@ -74,6 +74,7 @@ struct ScenarioExpectation {
     busy_pulse,     ///< BUSY pulses of `chip` (the `pulse`th, 0 = every one) last min..max ticks
     command,        ///< `chip` decoded command `name` `count` times (sent: count ≥ 1; not sent: 0)
     frames,         ///< the chain of `chip` saw min..max CS frames
+    sanitizer,      ///< no rule of the driver sanitizer fired on the board (allowed rules and check=off: none fire)
   };
   Kind kind = Kind::reg;
   ScenarioChip chip;

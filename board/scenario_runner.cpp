@@ -491,6 +491,17 @@ void ScenarioRunner::judge(const ScenarioExpectation& e, const Resolved& r, cons
         pass(where, "command " + e.name + " " + expected);
       return;
     }
+    case ScenarioExpectation::Kind::sanitizer: {
+      const Sanitizer& s = board_.sanitizer();
+      Resolved board_wide = r;
+      board_wide.label = "the board";
+      if (s.broken() == 0)
+        pass(where, "sanitizer clean (check=" + std::string(to_string(s.level())) + ")");
+      else
+        fail(where, "driver sanitizer", tick, board_wide, "no rule broken",
+             std::to_string(s.broken()) + " broken, the first " + violation_line(*s.first_broken()));
+      return;
+    }
     case ScenarioExpectation::Kind::frames: {
       const std::uint64_t n = board_.chain(r.chain).frames();
       auto text = [](std::uint64_t v) { return v == UINT64_MAX ? std::string("any") : std::to_string(v); };

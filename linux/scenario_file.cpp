@@ -278,7 +278,7 @@ class Reader {
 
   ScenarioExpectation expectation(const YAML::Node& m, const ScenarioChip& dflt) {
     if (!m.IsMap()) fail(m, "expect", "expects a map such as {register: ABS_POS, value: 0}");
-    const std::vector<std::string> kinds{"register", "true_position", "status", "busy_pulse", "command", "frames"};
+    const std::vector<std::string> kinds{"register", "true_position", "status", "busy_pulse", "command", "frames", "sanitizer"};
     std::vector<std::string> keys = kinds;
     keys.insert(keys.end(), {"value", "tolerance", "sent", "count", "chip", "chain"});
     check_keys(m, "expect:", keys);
@@ -286,7 +286,7 @@ class Reader {
     e.chip = chip_of(m, dflt);
     int n = 0;
     for (const auto& k : kinds) n += m[k] ? 1 : 0;
-    if (n != 1) fail(m, "expect", "names exactly one of register, true_position, status, busy_pulse, command, frames");
+    if (n != 1) fail(m, "expect", "names exactly one of register, true_position, status, busy_pulse, command, frames, sanitizer");
     auto only = [&](std::initializer_list<const char*> allowed, const char* what) {
       for (const char* k : {"value", "tolerance", "sent", "count"}) {
         if (!m[k]) continue;
@@ -334,6 +334,10 @@ class Reader {
       if (m["sent"] && m["count"]) fail(m["count"], "count", "give sent: or count:, not both");
       if (const YAML::Node s = m["sent"]) e.count = flag(s, "sent") ? ScenarioExpectation::kAtLeastOnce : 0;
       if (const YAML::Node c = m["count"]) e.count = static_cast<std::uint64_t>(integer(c, "count", 0, std::int64_t{1} << 53));
+    } else if (const YAML::Node v = m["sanitizer"]) {
+      only({}, "sanitizer");
+      e.kind = ScenarioExpectation::Kind::sanitizer;
+      if (scalar(v, "sanitizer") != "clean") fail(v, "sanitizer", "takes clean (no rule of the chip broken)");
     } else if (const YAML::Node v = m["frames"]) {
       only({}, "frames");
       e.kind = ScenarioExpectation::Kind::frames;

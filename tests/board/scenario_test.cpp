@@ -161,6 +161,97 @@ TEST(ScenarioRunner, BusyPulsesCommandsAndFramesAreCountedAndJudgedAtTheEnd) {
   EXPECT_EQ(runner.judged(), 4u);
 }
 
+ScenarioExpectation status_is(std::vector<std::pair<std::string, bool>> flags) {
+  ScenarioExpectation e;
+  e.kind = ScenarioExpectation::Kind::status;
+  e.flags = std::move(flags);
+  return e;
+}
+
+ScenarioTrigger at(Tick tick) {
+  ScenarioTrigger t;
+  t.kind = ScenarioTrigger::Kind::time;
+  t.tick = tick;
+  return t;
+}
+
+TEST(ScenarioRunner, TheTemperatureTheAdcTheSupplyAndStandbyReachTheChipAtTheirTicks) {
+  VirtualBoard v("chips=L6470 axis.0=stops=-1000000..1000000; time=virtual");
+  Scenario s;
+  ScenarioAction hot;
+  hot.kind = ScenarioAction::Kind::fault;
+  hot.fault = TraceFault::THERMAL;
+  hot.value = static_cast<std::uint8_t>(Thermal::warning);
+  s.steps.push_back(at_time(ticks_from_ms(1), hot, "s.yaml:1"));
+  s.steps.push_back(expect_at(at(ticks_from_ms(2)), status_is({{"TH_WRN", false}}), "s.yaml:2"));
+  ScenarioAction adc;
+  adc.kind = ScenarioAction::Kind::fault;
+  adc.fault = TraceFault::ADCIN;
+  adc.value = 17;
+  s.steps.push_back(at_time(ticks_from_ms(3), adc, "s.yaml:3"));
+  s.steps.push_back(expect_at(at(ticks_from_ms(4)), reg("ADC_OUT", 17), "s.yaml:4"));
+  ScenarioAction low_supply;
+  low_supply.kind = ScenarioAction::Kind::supply;
+  low_supply.supply_mV = 6000;  // below the 7.2 V UVLO threshold
+  s.steps.push_back(at_time(ticks_from_ms(5), low_supply, "s.yaml:5"));
+  s.steps.push_back(expect_at(at(ticks_from_ms(6)), status_is({{"UVLO", false}}), "s.yaml:6"));
+  ScenarioAction standby;
+  standby.kind = ScenarioAction::Kind::stby_rst;
+  standby.level = false;
+  s.steps.push_back(at_time(ticks_from_ms(7), standby, "s.yaml:7"));
+  ScenarioAction wake = standby;
+  wake.level = true;
+  s.steps.push_back(at_time(ticks_from_ms(8), wake, "s.yaml:8"));
+  // The reset put MAX_SPEED back to its power-up value, 0x041, after the host wrote 0x020.
+  s.steps.push_back(expect_at(at(ticks_from_ms(9)), reg("MAX_SPEED", 0x041), "s.yaml:9"));
+  ScenarioRunner runner(v.board, s);
+  send(v.board, {0x07, 0x00, 0x20});  // SetParam(MAX_SPEED, 0x020)
+  runner.after_transfer();
+  runner.advance_to(ticks_from_ms(10));
+  runner.finish();
+  for (const ScenarioFailure& f : runner.failures())
+    ADD_FAILURE() << f.where << ": " << f.what << ": expected " << f.expected << ", seen " << f.seen;
+  EXPECT_EQ(runner.judged(), 4u);
+  EXPECT_EQ(runner.log().size(), 5u);
+}
+
+TEST(ScenarioRunner, BusyFallTruePositionTriggersAndAHardStopActAtTheirTicks) {
+  VirtualBoard v("chips=L6470 axis.0=stops=-1000000..1000000; time=virtual");
+  Scenario s;
+  ScenarioTrigger fall;
+  fall.kind = ScenarioTrigger::Kind::busy_fall;
+  s.steps.push_back(expect_at(fall, status_is({{"BUSY", false}}), "s.yaml:1"));
+  // When the rotor reaches 20 full steps, a block appears 10 full steps further on.
+  ScenarioTrigger rotor;
+  rotor.kind = ScenarioTrigger::Kind::true_position;
+  rotor.position = 20 * 128;
+  s.steps.push_back(expect_at(rotor, reg("ABS_POS", 20 * 128, 1), "s.yaml:2"));
+  ScenarioStep block;
+  block.where = "s.yaml:3";
+  block.when = rotor;
+  block.action = ScenarioAction{};
+  block.action->kind = ScenarioAction::Kind::block;
+  block.action->position = 30 * 128;
+  s.steps.push_back(block);
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation rotor_at;
+  rotor_at.kind = ScenarioExpectation::Kind::true_position;
+  rotor_at.value = 30 * 128;
+  rotor_at.tolerance = 4 * 128;  // it stalls at the stop, within the rotor's pull-out of a few steps
+  s.steps.push_back(expect_at(end, rotor_at, "s.yaml:4"));
+  ScenarioRunner runner(v.board, s);
+  const Tick t = send(v.board, {0x41, 0x00, 0x64, 0x00});  // Move(forward, 200 full steps)
+  runner.after_transfer();
+  runner.advance_to(t + ticks_from_ms(3000));
+  runner.finish();
+  for (const ScenarioFailure& f : runner.failures())
+    ADD_FAILURE() << f.where << ": " << f.what << ": expected " << f.expected << ", seen " << f.seen;
+  EXPECT_EQ(runner.judged(), 3u);
+  // ABS_POS counted the whole move: the rotor did not follow past the stop.
+  EXPECT_EQ(v.board.chain(0).chip(0).position(), 200 * 128);
+}
+
 TEST(ScenarioRunner, AnActionOnACommandSeenIsAppliedWhenTheBusUseEnds) {
   VirtualBoard v("chips=L6470; time=virtual");
   Scenario s;

@@ -186,6 +186,17 @@ TEST_F(RunCommand, AMode0DriverIsStoppedByTheSanitizerWithStatusFiveUnlessTheDes
   r = run({"--chain", "chips=L6470 check=warn"}, program);
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out, "[0, 46, 8]\n") << r.err;  // CONFIG 0x2E88 read in mode 0: the stale latch's 0 for bit 7
+  // At check=warn the program runs on; a scenario can still require that no rule was broken.
+  const std::string clean = file("clean.yaml", "steps:\n  - at: end\n    expect: {sanitizer: clean}\n");
+  r = run({"--chain", "chips=L6470 check=warn", "--scenario", clean}, program);
+  EXPECT_EQ(r.status, kRunExpectationFailed) << r.err;
+  EXPECT_NE(r.err.find("FAILED " + clean + ":2: the board: driver sanitizer at "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("expected no rule broken, seen 1 broken, the first spidev0.0: chip 0: SPI_MODE"),
+            std::string::npos)
+      << r.err;
+  r = run({"--chain", "chips=L6470 check=warn", "--scenario", clean},
+          python("print(hex(status()))\n"));  // mode 3, byte frames: nothing broken
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
 }
 
 TEST_F(RunCommand, UsageAndScenarioErrorsAreStatusTwoAndTheProgramNeverStarts) {

@@ -85,6 +85,8 @@ TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
   EXPECT_EQ(error_of("steps:\n  - at: [1s\n"), "l6470emu: scenario s.yaml:3: not YAML: end of sequence flow not found");
   EXPECT_EQ(error_of(""), "l6470emu: scenario s.yaml: the file is empty: a scenario needs steps:");
   EXPECT_EQ(error_of(std::string(100, '[')), "l6470emu: scenario s.yaml:1: nested deeper than a scenario can be");
+  EXPECT_EQ(error_of("steps:\n  - at: end\n    expect: {sanitizer: dirty}\n"),
+            "l6470emu: scenario s.yaml:3: key 'sanitizer': takes clean (no rule of the chip broken)");
 }
 
 TEST(ScenarioFile, DurationsAreWholeTicksOfTheChip) {
