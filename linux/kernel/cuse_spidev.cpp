@@ -176,6 +176,7 @@ std::string CuseSpidev::start() {
   const char* argv[] = {"l6470emu", nullptr};
   fuse_args args = FUSE_ARGS_INIT(1, const_cast<char**>(argv));
   impl.session = cuse_lowlevel_new(&args, &ci, &kOps, &impl);
+  fuse_opt_free_args(&args);  // the session parsed them into a copy of its own (libfuse allocated it)
   if (!impl.session) return node.path + ": cannot create a CUSE session";
   const int fd = ::open("/dev/cuse", O_RDWR | O_CLOEXEC);
   if (fd < 0) {
