@@ -98,22 +98,9 @@ int usage_error(const CLI::App& app, const CLI::ParseError& e, std::ostream& err
   if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
     // "The following argument(s) was/were not expected: B A": CLI11 lists them last first, so
     // the last one is the first mistake.
-    // An option among them is named first (a misspelt option makes its value and the program's
-    // words extras too: `run --scenaro x -- prog`).
     const auto colon = message.rfind(": ");
-    const std::string list = colon == std::string::npos ? message : message.substr(colon + 2);
-    std::string extra = list.substr(list.rfind(' ') + 1);
-    for (std::size_t end = list.size(); end > 0;) {
-      const std::size_t start = list.rfind(' ', end - 1);
-      const std::size_t from = start == std::string::npos ? 0 : start + 1;
-      const std::string word = list.substr(from, end - from);
-      if (word.size() > 1 && word[0] == '-') {
-        extra = word;
-        break;
-      }
-      if (start == std::string::npos) break;
-      end = start;
-    }
+    std::string extra = colon == std::string::npos ? message : message.substr(colon + 2);
+    extra = extra.substr(extra.rfind(' ') + 1);
     if (extra.size() > 1 && extra[0] == '-') {
       const std::string name = extra.substr(0, extra.find('='));
       const std::string near = option_suggestion(name, option_names(where));
