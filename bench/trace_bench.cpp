@@ -30,7 +30,7 @@ constexpr std::size_t kChips = 3;
 void record_trace(const std::string& path, std::uint64_t frames) {
   Chain chain(kChips);
   NativeTraceWriter writer(path, NativeWriteOptions{/*flush_each_event=*/false, /*compact=*/false});
-  RecordingChain rec(chain, writer, RecordOptions{.observe_outputs = false});
+  RecordingChain rec(chain, writer, RecordOptions{.observe_outputs = false, .board = {}});
   std::mt19937 rng(6470);
   std::vector<std::uint8_t> tx(kChips), rx(kChips);
   auto frame = [&](std::uint8_t b0, std::uint8_t b1, std::uint8_t b2) {

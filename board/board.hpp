@@ -28,6 +28,8 @@
 namespace l6470emu {
 
 /// A level change of a watched pin, at the tick it happened.
+class RecordingChain;
+
 struct PinEdge {
   std::size_t chain = 0;  ///< index of the chain in the board description
   std::size_t chip = 0;   ///< chain index of the chip (0 drives MISO)
@@ -212,6 +214,19 @@ class Board {
   /// the chain is being recorded; edges reported. A recording started later carries the new load
   /// in its board description. False for a bad index or a chip without an axis.
   bool set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& load);
+  /// Attaches an axis to chip `chip` now (replacing one it has; Python's `attach_axis`),
+  /// recorded as an `axis` event; a recording started later has it in its board description.
+  /// False for a bad index.
+  bool attach_axis(std::size_t chain, std::size_t chip, const AxisSpec& spec);
+  /// Removes chip `chip`'s axis now, recorded. False for a bad index or a chip without one.
+  bool detach_axis(std::size_t chain, std::size_t chip);
+  /// Moves the hard stops of chip `chip`'s axis now (a scenario's `block:`), recorded. False
+  /// for a bad index or a chip without an axis.
+  bool set_axis_stops(std::size_t chain, std::size_t chip, bool has_lower, std::int64_t lower, bool has_upper,
+                      std::int64_t upper);
+  /// Changes the motor supply chip `chip`'s axis sees now (a scenario's `supply_mV:`; the UVLO
+  /// flag is inject_fault's business), recorded. False for a bad index or a chip without an axis.
+  bool set_axis_supply(std::size_t chain, std::size_t chip, std::uint32_t supply_mV);
   /// Opens the output of a recording at `path` (throws std::runtime_error with one line when it
   /// cannot). A front brings its own (linux/: a memory-mapped file); the default writes through
   /// stdio and zlib (spi/trace_output.hpp).
@@ -248,6 +263,9 @@ class Board {
   SpiDevice& spi_of(ChainState& c);
   void apply_input(ChainState& c, std::size_t chip, Pin pin, bool level);
   void record_outputs(ChainState& c);
+  bool change_axis(std::size_t chain, std::size_t chip, bool needs_axis,
+                   const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
+                   const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);
   void catch_up(ChainState& c);
   void advance_chain(ChainState& c, Tick target);
   Tick first_change(ChainState& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);

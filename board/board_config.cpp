@@ -2,7 +2,7 @@
 // checked against its range, one error line that says where, what and how to write it instead.
 #include "board/board_config.hpp"
 
-#include "board/axis_config.hpp"
+#include "core/axis_text.hpp"
 #include "core/near_miss.hpp"
 
 #include <algorithm>

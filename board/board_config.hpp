@@ -39,7 +39,7 @@ struct ChainConfig {
   std::uint32_t max_speed_hz = 5'000'000;  ///< the device's spi-max-frequency (RD_MAX_SPEED_HZ at open)
   std::uint8_t mode = 0;                   ///< SPI mode the device starts in (as a device tree sets it)
   std::uint32_t bufsiz = 4096;             ///< spidev's bufsiz module parameter
-  /// axis.K=...: the mechanics behind chip K (board/axis_config.hpp), ascending K.
+  /// axis.K=...: the mechanics behind chip K (core/axis_text.hpp), ascending K.
   std::vector<std::pair<std::size_t, AxisSpec>> axes;
   /// cs_pin=, busy_pin=, ..., spi=: the microcontroller pins of a firmware run (board/pin_map.hpp).
   ChainPins pins;

@@ -3,6 +3,8 @@
 #include "board/board_chain.hpp"
 #include "board/board_internal.hpp"
 
+#include <algorithm>
+
 namespace l6470emu {
 
 SpiDevice& Board::spi_of(ChainState& c) {
@@ -65,6 +67,83 @@ bool Board::set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& l
     if (k == number) spec.load = load;
   emit_changes(c, c.chain.now());
   return true;
+}
+
+/// Applies a change to chip `chip`'s axis through the recorder when there is one (`recorded`)
+/// or to the chip (`direct`), and keeps the chain's description in step with `describe` (what
+/// a recording started later says of the axis). False for a bad index, or for a chip without
+/// an axis unless `needs_axis` is false.
+bool Board::change_axis(std::size_t chain, std::size_t chip, bool needs_axis,
+                        const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
+                        const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe) {
+  if (chain >= chains_.size()) return false;
+  ChainState& c = *chains_[chain];
+  if (chip >= c.chain.size() || (needs_axis && !c.chain.chip(chip).has_axis())) return false;
+  catch_up(c);
+  c.touched = true;
+  c.prediction_valid = false;
+  if (c.recorder)
+    recorded(c.recorder->recording());
+  else
+    direct(c.chain.chip(chip));
+  describe(c.config.axes, ChipNumbering(numbering_, c.chain.size()).number_of(chip));
+  emit_changes(c, c.chain.now());
+  return true;
+}
+
+namespace {
+
+AxisSpec* described_axis(std::vector<std::pair<std::size_t, AxisSpec>>& axes, std::size_t number) {
+  for (auto& [k, spec] : axes)
+    if (k == number) return &spec;
+  return nullptr;
+}
+
+}  // namespace
+
+bool Board::attach_axis(std::size_t chain, std::size_t chip, const AxisSpec& spec) {
+  return change_axis(
+      chain, chip, false, [&](RecordingChain& r) { r.attach_axis(chip, spec); }, [&](Chip& ch) { ch.attach_axis(spec); },
+      [&](auto& axes, std::size_t number) {
+        if (AxisSpec* a = described_axis(axes, number)) {
+          *a = spec;
+          return;
+        }
+        axes.emplace_back(number, spec);
+        std::sort(axes.begin(), axes.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      });
+}
+
+bool Board::detach_axis(std::size_t chain, std::size_t chip) {
+  return change_axis(
+      chain, chip, true, [&](RecordingChain& r) { r.detach_axis(chip); }, [](Chip& ch) { ch.detach_axis(); },
+      [](auto& axes, std::size_t number) {
+        std::erase_if(axes, [number](const auto& a) { return a.first == number; });
+      });
+}
+
+bool Board::set_axis_stops(std::size_t chain, std::size_t chip, bool has_lower, std::int64_t lower, bool has_upper,
+                           std::int64_t upper) {
+  return change_axis(
+      chain, chip, true, [&](RecordingChain& r) { r.set_axis_stops(chip, has_lower, lower, has_upper, upper); },
+      [&](Chip& ch) { ch.set_axis_stops(has_lower, lower, has_upper, upper); },
+      [&](auto& axes, std::size_t number) {
+        if (AxisSpec* a = described_axis(axes, number)) {
+          a->has_lower_stop = has_lower;
+          a->lower_stop = has_lower ? lower : 0;
+          a->has_upper_stop = has_upper;
+          a->upper_stop = has_upper ? upper : 0;
+        }
+      });
+}
+
+bool Board::set_axis_supply(std::size_t chain, std::size_t chip, std::uint32_t supply_mV) {
+  return change_axis(
+      chain, chip, true, [&](RecordingChain& r) { r.set_axis_supply(chip, supply_mV); },
+      [&](Chip& ch) { ch.set_axis_supply(supply_mV); },
+      [&](auto& axes, std::size_t number) {
+        if (AxisSpec* a = described_axis(axes, number)) a->supply.supply_mV = supply_mV;
+      });
 }
 
 std::string Board::start_recording(std::size_t chain, const std::string& path) {

@@ -374,20 +374,26 @@ void ScenarioRunner::apply(const ScenarioAction& a, const Resolved& r, const std
     case ScenarioAction::Kind::load:
       board_.set_axis_load(r.chain, r.chip, a.load);  // recorded as a load event: replays with it
       return;
-    case ScenarioAction::Kind::block:
+    case ScenarioAction::Kind::block: {
+      // A stop on the side of the rotor the position is on; recorded as a stops event.
+      bool has_axis = false, above = false;
+      AxisSpec spec;
       board_.with_chain(r.chain, [&](Chain& c) {
-        Chip& chip = c.chip(r.chip);
-        const Axis* axis = chip.axis();
+        const Axis* axis = c.chip(r.chip).axis();
         if (!axis) return;
-        const AxisSpec& spec = axis->spec();
-        if (axis->true_position() <= a.position)
-          chip.set_axis_stops(spec.has_lower_stop, spec.lower_stop, true, a.position);
-        else
-          chip.set_axis_stops(true, a.position, spec.has_upper_stop, spec.upper_stop);
+        has_axis = true;
+        spec = axis->spec();
+        above = axis->true_position() <= a.position;
       });
+      if (!has_axis) return;
+      if (above)
+        board_.set_axis_stops(r.chain, r.chip, spec.has_lower_stop, spec.lower_stop, true, a.position);
+      else
+        board_.set_axis_stops(r.chain, r.chip, true, a.position, spec.has_upper_stop, spec.upper_stop);
       return;
+    }
     case ScenarioAction::Kind::supply: {
-      board_.with_chain(r.chain, [&](Chain& c) { c.chip(r.chip).set_axis_supply(a.supply_mV); });
+      board_.set_axis_supply(r.chain, r.chip, a.supply_mV);  // recorded; no effect without an axis
       auto uvlo = uvlo_by_supply_[r.chain][r.chip];
       if (a.supply_mV < kUvloOff_mV && !uvlo) {
         board_.inject_fault(r.chain, r.chip, TraceFault::UVLO, 1);

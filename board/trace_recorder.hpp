@@ -40,6 +40,9 @@ class ChainTraceRecorder {
   void set_axis_load(std::size_t chip, const LoadSpec& load);
   /// Records that time was moved on to the chain's tick (`ctl advance`).
   void mark_advance();
+  /// The recording chain itself, for the rarer stimuli (an axis attached or removed, its stops
+  /// or supply changed): applied to the chip and recorded. Write errors end up in error().
+  RecordingChain& recording() { return recording_; }
   /// Records BUSY/FLAG levels that changed since they were last seen.
   void observe_outputs() { recording_.observe_outputs(); }
   /// The chain was changed behind the recorder's back: the next look sees it.

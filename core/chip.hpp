@@ -161,6 +161,8 @@ class alignas(64) Chip {
   void detach_axis();
   /// The axis brought up to now() (true position, lost steps, switches), or nullptr.
   const Axis* axis() const;
+  /// Whether an axis is attached (without bringing it up to now()).
+  bool has_axis() const { return static_cast<bool>(axis_); }
   /// Changes the axis's load at runtime (no effect without an axis).
   void set_axis_load(const LoadSpec& load);
   /// Changes the axis's hard stops at runtime (no effect without an axis): a stop put where the

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "daisychain/divergence.hpp"
 #include "daisychain/explain.hpp"
 #include "daisychain/protocol_tracker.hpp"
 
@@ -110,11 +111,12 @@ class Decoder {
         case TracePin::STBY: what = level ? "STBY\\RST high (out of standby: power-up state)" : "STBY\\RST low (standby)"; break;
         case TracePin::BUSY: what = level ? "BUSY output high (released)" : "BUSY output low (busy)"; break;
         case TracePin::FLAG: what = level ? "FLAG output high (no alarm)" : "FLAG output low (alarm)"; break;
+        case TracePin::SW_AXIS: what = level ? "SW high: the axis's switch opened" : "SW low: the axis's switch closed"; break;
       }
       // STCK edges are as frequent as the steps: show them only with --nops.
       if (e.pin == TracePin::STCK && !options_.show_nops) return;
       // An output level in a trace is an observation: when it was looked at, not when it changed.
-      if (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG) {
+      if (is_observed_pin(e.pin)) {
         const bool first = seen_outputs_.insert({e.chip, static_cast<int>(e.pin)}).second;
         if (first) {
           what += ", seen at (its level when watching began)";
@@ -132,6 +134,13 @@ class Decoder {
           }
         }
       }
+    } else if (e.kind == TraceEventKind::axis) {
+      what = e.text == "none" ? std::string("axis removed") : "axis attached: " + std::string(e.text);
+    } else if (e.kind == TraceEventKind::stops) {
+      what = "axis hard stops: " + (e.has_lower_stop ? std::to_string(e.lower_stop) : std::string()) + ".." +
+             (e.has_upper_stop ? std::to_string(e.upper_stop) : std::string()) + " (1/128 step)";
+    } else if (e.kind == TraceEventKind::supply) {
+      what = "axis motor supply: " + std::to_string(e.supply_mV) + " mV";
     } else if (e.kind == TraceEventKind::load) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "axis load: %.2f g·cm² load inertia, %.6f N·m friction, %.6f N·m force",
@@ -250,7 +259,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
     }
     if (e.chip >= chain.size())
       throw TraceError(name, e.line, trace_chip_outside_chain(e.chip, chain.size()));
-    const bool output = e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG);
+    const bool output = e.is_observation();
     // Where the emulated output took the observed level: a copy of the chip before the event,
     // searched up to the observation's tick.
     Tick edge = kNever;
@@ -260,7 +269,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       const auto level_at = [&](Tick tick) {
         Chip c = probe;
         c.advance_to(tick);
-        return (e.pin == TracePin::BUSY ? c.busy_sync_pin() : c.flag_pin()) == (e.value != 0);
+        return observed_level(c, e.pin) == (e.value != 0);
       };
       if (level_at(probe.now())) {
         edge = probe.now();  // it changed with the event before (a frame's CS rising edge)
@@ -276,9 +285,9 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
     tracker.apply(e);
     const double t = display_seconds(e.tick, e.source_time);
     if (e.kind == TraceEventKind::advance) continue;  // time only
-    if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+    if (e.is_observation()) {
       const Chip& chip = chain.chip(e.chip);
-      watch.observation(e, e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin());
+      watch.observation(e, observed_level(chip, e.pin));
       check(diverged);
     }
     if (output && edge != kNever) {
@@ -288,7 +297,7 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
       decoder.pin(e, t, previous);
     }
     // Outputs looked at together share one bound; an input or fault is an event of its own.
-    if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) previous = t;
+    if (!e.is_observation()) previous = t;
     decoder.flush(std::min(tracker.pending_answer_seconds(), t));
   }
   tracker.finish();

@@ -30,13 +30,21 @@ void DivergenceWatch::frame(const TraceEvent& e, std::span<const std::uint8_t> e
   found(e, first_bad < numbering_.chips() ? first_bad : FirstDivergence::kNoChip, std::move(what));
 }
 
+bool observed_level(const Chip& chip, TracePin pin) {
+  switch (pin) {
+    case TracePin::BUSY: return chip.busy_sync_pin();
+    case TracePin::FLAG: return chip.flag_pin();
+    default: return chip.sw_pin();
+  }
+}
+
 void DivergenceWatch::observation(const TraceEvent& e, bool emulated) {
-  if (e.kind != TraceEventKind::pin || (e.pin != TracePin::BUSY && e.pin != TracePin::FLAG)) return;
+  if (!e.is_observation()) return;
   if ((e.value != 0) == emulated) return;
   ++pins_diverged_;
   if (first_.found) return;
   auto level = [](bool l) { return std::string(l ? "high" : "low"); };
-  found(e, e.chip, std::string(to_string(e.pin)) + " expected " + level(e.value != 0) + ", emulated " + level(emulated));
+  found(e, e.chip, std::string(to_string(e.pin)) + (e.pin == TracePin::SW_AXIS ? " (driven by its axis)" : "") + " expected " + level(e.value != 0) + ", emulated " + level(emulated));
 }
 
 void DivergenceWatch::found(const TraceEvent& e, std::size_t chip, std::string what) {

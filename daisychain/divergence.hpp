@@ -8,10 +8,15 @@
 #include <span>
 #include <string>
 
+#include "core/chip.hpp"
 #include "daisychain/chip_numbering.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
+
+/// The level of `chip`'s pin that an observation (TraceEvent::is_observation: BUSY, FLAG, or
+/// SW as the axis drove it) is compared with.
+bool observed_level(const Chip& chip, TracePin pin);
 
 /// Where a trace and the emulator first disagree.
 struct FirstDivergence {
@@ -36,7 +41,7 @@ class DivergenceWatch {
 
   /// A frame's bytes were clocked: its captured MISO (where known) against `emulated`.
   void frame(const TraceEvent& e, std::span<const std::uint8_t> emulated);
-  /// A BUSY or FLAG observation against the level the emulated chip has at its tick.
+  /// A BUSY, FLAG or SW (axis) observation against the level the emulated chip has at its tick.
   void observation(const TraceEvent& e, bool emulated);
 
   const FirstDivergence& first() const { return first_; }

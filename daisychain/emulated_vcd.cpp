@@ -79,7 +79,7 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
     tracker.apply(e);
     const std::uint64_t ns = ns_from_ticks(e.tick);
     if (e.kind == TraceEventKind::pin) {
-      if (e.pin == TracePin::SW) w.change(ns, wires[e.chip].sw, e.value);
+      if (e.pin == TracePin::SW || e.pin == TracePin::SW_AXIS) w.change(ns, wires[e.chip].sw, e.value);
       if (e.pin == TracePin::STCK) w.change(ns, wires[e.chip].stck, e.value);
       if (e.pin == TracePin::STBY) w.change(ns, wires[e.chip].stby, e.value);
     }

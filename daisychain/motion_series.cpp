@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/fast_motion.hpp"
+#include "daisychain/divergence.hpp"
 #include "daisychain/explain.hpp"
 #include "daisychain/protocol_tracker.hpp"
 
@@ -321,9 +322,9 @@ MotionSeries sample_motion(TraceReader& in, Chain& chain, Tick trace_end, const 
     } else {
       tracker.apply(e);
       // Pin observations (BUSY, FLAG) change nothing, but are checked; inputs, faults and loads may.
-      if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+      if (e.is_observation()) {
         const Chip& chip = chain.chip(e.chip);
-        watch.observation(e, e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin());
+        watch.observation(e, observed_level(chip, e.pin));
       } else if (e.kind != TraceEventKind::advance) {
         sampler.sample(e.chip, at);
       }

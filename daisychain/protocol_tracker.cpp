@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "core/axis_text.hpp"
 #include "core/counted.hpp"
 #include "daisychain/explain.hpp"
 
@@ -288,6 +289,23 @@ void ProtocolTracker::apply(const TraceEvent& e) {
     chip.set_axis_load(e.load);
     return;
   }
+  if (e.kind == TraceEventKind::axis) {
+    if (e.text == "none") {
+      chip.detach_axis();
+      return;
+    }
+    AxisSpec spec;
+    if (parse_axis_spec(e.text, spec).empty()) chip.attach_axis(spec);  // readers check the text
+    return;
+  }
+  if (e.kind == TraceEventKind::stops) {
+    chip.set_axis_stops(e.has_lower_stop, e.lower_stop, e.has_upper_stop, e.upper_stop);
+    return;
+  }
+  if (e.kind == TraceEventKind::supply) {
+    chip.set_axis_supply(e.supply_mV);
+    return;
+  }
   if (e.kind == TraceEventKind::pin) {
     switch (e.pin) {
       case TracePin::SW: chip.set_sw_pin(e.value != 0); break;
@@ -301,7 +319,8 @@ void ProtocolTracker::apply(const TraceEvent& e) {
         }
         break;
       case TracePin::BUSY:
-      case TracePin::FLAG: break;  // outputs: observations, compared by replay
+      case TracePin::FLAG:
+      case TracePin::SW_AXIS: break;  // observations, compared by replay
     }
     return;
   }

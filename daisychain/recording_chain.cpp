@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "core/axis_text.hpp"
 #include "daisychain/chain_spec.hpp"
 
 namespace l6470emu {
@@ -17,6 +18,7 @@ RecordingChain::RecordingChain(Chain& chain, TraceSink& sink, RecordOptions opti
   if (options_.observe_outputs) {
     busy_.assign(chain_.size(), 2);  // 2 = not seen yet: the first look records the level
     flag_.assign(chain_.size(), 2);
+    sw_.assign(chain_.size(), 2);
     observe_outputs();
   }
 }
@@ -32,7 +34,7 @@ constexpr Tick kLookAheadTicks = ticks_from_ms(64);
 
 }  // namespace
 
-/// The first tick in (now, to] at which `chip`'s BUSY or FLAG differs from its level now
+/// The first tick in (now, to] at which `chip`'s BUSY, FLAG or axis-driven SW differs from its level now
 /// (kNever: neither changes by then), found on copies of the chip moved on (cheap: a copy
 /// keeps the chip's knowledge of the motion's uniform runs). `unsure` is set when a BUSY that
 /// is the SYNC clock was left out.
@@ -43,11 +45,12 @@ Tick RecordingChain::first_output_change(std::size_t k, Tick to, bool& unsure) c
   const bool sync = (chip.peek(Reg::STEP_MODE) & kStepModeSyncEn) != 0;
   unsure = unsure || sync;
   const bool busy0 = chip.busy_sync_pin(), flag0 = chip.flag_pin();
+  const bool axis = chip.has_axis(), sw0 = chip.sw_pin();
   auto differs_at = [&](Tick t) {
     Chip probe = chip;
     probe.set_diagnostic_sink({});
     probe.advance_to(t);
-    return (!sync && probe.busy_sync_pin() != busy0) || probe.flag_pin() != flag0;
+    return (!sync && probe.busy_sync_pin() != busy0) || probe.flag_pin() != flag0 || (axis && probe.sw_pin() != sw0);
   };
   if (!differs_at(to)) return kNever;
   Tick lo = from, hi = to;  // the same at lo, different at hi
@@ -96,13 +99,14 @@ void RecordingChain::advance_to(Tick tick) {
 }
 
 void RecordingChain::select() {
-  observed_at_ = kNever;
+  touched();
   if (chain_.selected()) return;
   start_frame();
   chain_.select();
 }
 
 void RecordingChain::select_wire() {
+  touched();
   if (chain_.selected()) return;
   start_frame();
   chain_.select_wire();
@@ -115,7 +119,7 @@ void RecordingChain::start_frame() {
 }
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
-  observed_at_ = kNever;
+  touched();
   const std::uint8_t miso = chain_.exchange(mosi);
   if (chain_.selected()) {
     tx_.push_back(mosi);
@@ -125,7 +129,7 @@ std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
 }
 
 void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  observed_at_ = kNever;
+  touched();
   chain_.exchange(tx, rx);
   if (chain_.selected()) {
     tx_.insert(tx_.end(), tx.begin(), tx.end());
@@ -135,6 +139,7 @@ void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::u
 
 void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                                    const WireSettings& wire) {
+  touched();
   chain_.exchange_wire(tx, rx, wire);
   if (chain_.selected()) {
     tx_.insert(tx_.end(), tx.begin(), tx.end());
@@ -143,7 +148,7 @@ void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<s
 }
 
 void RecordingChain::deselect() {
-  observed_at_ = kNever;
+  touched();
   quiet_until_ = 0;
   if (!chain_.selected()) return;
   chain_.deselect();
@@ -151,6 +156,8 @@ void RecordingChain::deselect() {
 }
 
 void RecordingChain::deselect_wire() {
+  touched();
+  quiet_until_ = 0;
   if (!chain_.selected()) return;
   chain_.deselect_wire();
   finish_frame();
@@ -182,7 +189,7 @@ void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_
     e.pin = static_cast<TracePin>(what);
   else
     e.fault = static_cast<TraceFault>(what);
-  if (kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+  if (e.is_observation()) {
     emit(e);  // an observation, made between frames
     return;
   }
@@ -190,7 +197,7 @@ void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_
 }
 
 void RecordingChain::stimulus(const TraceEvent& e) {
-  observed_at_ = kNever;
+  touched();
   quiet_until_ = 0;
   if (chain_.selected()) {
     deferred_.push_back(e);
@@ -210,6 +217,50 @@ void RecordingChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
   stimulus(e);
 }
 
+void RecordingChain::axis_event(std::size_t chip, TraceEvent& e) {
+  e.tick = chain_.now();
+  e.chip = static_cast<std::uint16_t>(chip);
+  stimulus(e);
+}
+
+void RecordingChain::attach_axis(std::size_t chip, const AxisSpec& spec) {
+  chain_.chip(chip).attach_axis(spec);
+  const std::string text = describe_axis_spec(spec);
+  TraceEvent e;
+  e.kind = TraceEventKind::axis;
+  e.text = text.empty() ? std::string_view("default") : std::string_view(text);
+  axis_event(chip, e);
+}
+
+void RecordingChain::detach_axis(std::size_t chip) {
+  chain_.chip(chip).detach_axis();
+  if (!sw_.empty()) sw_[chip] = 2;  // no axis drives it now
+  TraceEvent e;
+  e.kind = TraceEventKind::axis;
+  e.text = "none";
+  axis_event(chip, e);
+}
+
+void RecordingChain::set_axis_stops(std::size_t chip, bool has_lower, std::int64_t lower, bool has_upper,
+                                    std::int64_t upper) {
+  chain_.chip(chip).set_axis_stops(has_lower, lower, has_upper, upper);
+  TraceEvent e;
+  e.kind = TraceEventKind::stops;
+  e.has_lower_stop = has_lower;
+  e.lower_stop = has_lower ? lower : 0;
+  e.has_upper_stop = has_upper;
+  e.upper_stop = has_upper ? upper : 0;
+  axis_event(chip, e);
+}
+
+void RecordingChain::set_axis_supply(std::size_t chip, std::uint32_t supply_mV) {
+  chain_.chip(chip).set_axis_supply(supply_mV);
+  TraceEvent e;
+  e.kind = TraceEventKind::supply;
+  e.supply_mV = supply_mV;
+  axis_event(chip, e);
+}
+
 void RecordingChain::mark_advance() {
   TraceEvent e;
   e.kind = TraceEventKind::advance;
@@ -218,7 +269,10 @@ void RecordingChain::mark_advance() {
 }
 
 void RecordingChain::set_sw_pin(std::size_t chip, bool level) {
-  chain_.chip(chip).set_sw_pin(level);
+  Chip& c = chain_.chip(chip);
+  c.set_sw_pin(level);
+  // The host drove it: not an observation of what the axis does.
+  if (c.has_axis() && !sw_.empty() && sw_[chip] != 2) sw_[chip] = c.sw_pin();
   backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW), level);
 }
 void RecordingChain::set_stck_pin(std::size_t chip, bool level) {
@@ -257,9 +311,20 @@ void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
 
 void RecordingChain::observe_outputs() {
   if (!options_.observe_outputs || chain_.selected() || chain_.now() == observed_at_) return;
+  // Untouched since a look that found every chip with nothing to do on its own: still the same.
+  if (idle_ && observed_at_ != kNever) return;
   observed_at_ = chain_.now();
+  bool idle = true;
   for (std::size_t k = 0; k < chain_.size(); ++k) {
     const Chip& c = chain_.chip(k);
+    if (idle && c.next_event_tick() != kNever) idle = false;
+    if (c.has_axis()) {
+      const std::uint8_t sw = c.sw_pin();
+      if (sw != sw_[k]) {
+        sw_[k] = sw;
+        backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), sw);
+      }
+    }
     const std::uint8_t busy = c.busy_sync_pin(), flag = c.flag_pin();
     if (busy != busy_[k]) {
       busy_[k] = busy;
@@ -270,6 +335,7 @@ void RecordingChain::observe_outputs() {
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::FLAG), flag);
     }
   }
+  idle_ = idle;
 }
 
 }  // namespace l6470emu

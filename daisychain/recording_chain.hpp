@@ -62,19 +62,31 @@ class RecordingChain final : public SpiDevice {
   void set_stall(std::size_t chip, Bridge bridge, bool active);
   /// The load on chip `chip`'s axis changes (no effect on the chip without an axis, but recorded).
   void set_axis_load(std::size_t chip, const LoadSpec& load);
+  /// An axis is attached to chip `chip` (replacing one it had), recorded as an `axis` event
+  /// with the whole spec.
+  void attach_axis(std::size_t chip, const AxisSpec& spec);
+  /// Chip `chip`'s axis is removed (recorded as `axis K none`).
+  void detach_axis(std::size_t chip);
+  /// The hard stops of chip `chip`'s axis change (a scenario's `block:`).
+  void set_axis_stops(std::size_t chip, bool has_lower, std::int64_t lower, bool has_upper, std::int64_t upper);
+  /// The motor supply chip `chip`'s axis sees changes (its torque and current follow).
+  void set_axis_supply(std::size_t chip, std::uint32_t supply_mV);
   /// Records that time was moved on to now() with nothing else happening (`ctl advance`), so
   /// that a replay lets the chips run as far.
   void mark_advance();
 
-  /// Records BUSY/FLAG levels that changed since they were last seen (done after every
-  /// frame and event; call it to catch a change between frames, e.g. a move ending). Looking
-  /// again at the same tick with nothing done to the chain through the recorder in between is free.
+  /// Records BUSY/FLAG levels, and the SW level of chips with an axis, that changed since they
+  /// were last seen (done after every frame and event; call it to catch a change between
+  /// frames, e.g. a move ending). Looking again with nothing done to the chain through the
+  /// recorder in between is free at the same tick, and at any later one while no chip has
+  /// anything to do on its own.
   void observe_outputs();
   /// The chain was changed behind the recorder's back (through chain()): the next
   /// observe_outputs() looks even at the same tick.
   void outputs_may_have_changed() {
     observed_at_ = kNever;
     quiet_until_ = 0;
+    idle_ = false;
   }
 
   Chain& chain() { return chain_; }
@@ -94,8 +106,15 @@ class RecordingChain final : public SpiDevice {
   Tick frame_start_ = 0;
   std::vector<std::uint8_t> tx_, rx_;
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
-  std::vector<std::uint8_t> busy_, flag_;
+  void touched() {
+    observed_at_ = kNever;
+    idle_ = false;
+  }
+  void axis_event(std::size_t chip, TraceEvent& e);
+
+  std::vector<std::uint8_t> busy_, flag_, sw_;
   Tick observed_at_ = kNever;  // tick of the last look at the outputs; kNever after any change
+  bool idle_ = false;          // at that look no chip had anything to do on its own
   Tick quiet_until_ = 0;       // no output changes by itself up to here (until the chain is touched)
   std::uint64_t frames_ = 0;
 };

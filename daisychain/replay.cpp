@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "daisychain/divergence.hpp"
 #include "daisychain/explain.hpp"
 #include "daisychain/protocol_tracker.hpp"
 
@@ -82,11 +83,11 @@ class Replayer {
       }
       if (e.chip >= n)
         throw TraceError(name_, e.line, trace_chip_outside_chain(e.chip, n));
-      if (e.kind == TraceEventKind::pin && (e.pin == TracePin::BUSY || e.pin == TracePin::FLAG)) {
+      if (e.is_observation()) {
         if (!options_.compare_pins) continue;
         chain_.advance_to(e.tick);
         const Chip& chip = chain_.chip(e.chip);
-        const bool level = e.pin == TracePin::BUSY ? chip.busy_sync_pin() : chip.flag_pin();
+        const bool level = observed_level(chip, e.pin);
         ++result_.pin_checks;
         if (level != (e.value != 0)) {
           ++result_.pin_mismatches;
@@ -168,13 +169,16 @@ class Replayer {
     d.line = e.line;
     d.tick = e.tick;
     d.source_time = display_seconds(e.tick, e.source_time);
-    const bool busy = e.pin == TracePin::BUSY;
-    auto level = [busy](bool l) {
-      return std::string(l ? "high" : "low") + (busy ? (l ? " (released)" : " (busy)") : (l ? " (no alarm)" : " (alarm)"));
+    const TracePin pin = e.pin;
+    auto level = [pin](bool l) {
+      const char* meaning = pin == TracePin::BUSY ? (l ? " (released)" : " (busy)")
+                            : pin == TracePin::FLAG ? (l ? " (no alarm)" : " (alarm)")
+                                                    : (l ? " (switch open)" : " (switch closed)");
+      return std::string(l ? "high" : "low") + meaning;
     };
     d.summary = where(name_, e) + ": " + time_text(e.tick, e.source_time) + " (after frame " +
                 std::to_string(d.frame) + "): " + tracker_.numbering().label(e.chip) + " " + std::string(to_string(e.pin)) +
-                " expected " + level(e.value != 0) + ", emulated " + level(emulated);
+                (pin == TracePin::SW_AXIS ? " (driven by its axis)" : "") + " expected " + level(e.value != 0) + ", emulated " + level(emulated);
     d.report = d.summary + "\n  " + tracker_.numbering().label(e.chip) + " state (emulated):\n" +
                indent(chain_.chip(e.chip).dump(), "    ");
     return d;

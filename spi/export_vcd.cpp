@@ -166,6 +166,13 @@ std::uint64_t SpiVcdWaveform::draw(const TraceEvent& frame, std::uint64_t limit_
 
 // ---------------------------------------------------------------- export
 
+namespace {
+
+/// The wire a pin event is drawn on: SW whether the host or the axis drove it.
+TracePin vcd_pin(TracePin pin) { return pin == TracePin::SW_AXIS ? TracePin::SW : pin; }
+
+}  // namespace
+
 void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options) {
   VcdWriter w(out, options.timescale_ns);
   SpiVcdWaveform spi(w);
@@ -174,7 +181,7 @@ void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options
   for (std::size_t i = 0; i < trace.size(); ++i) {
     const TraceEvent e = trace[i];
     if (e.kind != TraceEventKind::pin) continue;
-    const auto key = std::make_pair(e.chip, e.pin);
+    const auto key = std::make_pair(e.chip, vcd_pin(e.pin));
     if (!pins.count(key)) pins[key] = -1;
   }
   for (auto& [key, id] : pins) {
@@ -194,7 +201,7 @@ void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options
       end = std::max(end, spi.draw(e, limit));
     } else if (e.kind == TraceEventKind::pin) {
       const std::uint64_t t = ns_from_ticks(e.tick);
-      w.change(t, pins[{e.chip, e.pin}], e.value);
+      w.change(t, pins[{e.chip, vcd_pin(e.pin)}], e.value);
       end = std::max(end, t);
     }
   }

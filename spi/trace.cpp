@@ -13,6 +13,7 @@ std::string_view to_string(TracePin pin) {
     case TracePin::STBY: return "STBY";
     case TracePin::BUSY: return "BUSY";
     case TracePin::FLAG: return "FLAG";
+    case TracePin::SW_AXIS: return "SW";
   }
   return "?";
 }
@@ -54,12 +55,30 @@ void Trace::write(const TraceEvent& e) {
   s.kind = e.kind;
   s.value = e.value;
   s.what = e.kind == TraceEventKind::pin ? static_cast<std::uint8_t>(e.pin) : static_cast<std::uint8_t>(e.fault);
+  // The numbers and text of the rare events go to the byte pool (Stored stays small).
+  auto put = [this](std::uint64_t w, int n) {
+    for (int b = 0; b < n; ++b) bytes_.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+  };
   if (e.kind == TraceEventKind::load) {
-    // The load's three numbers go to the byte pool (rare events: Stored stays small).
     s.offset = bytes_.size();
-    const std::uint32_t words[3] = {e.load.inertia_g_mm2, e.load.friction_uNm, static_cast<std::uint32_t>(e.load.force_uNm)};
-    for (std::uint32_t w : words)
-      for (int b = 0; b < 4; ++b) bytes_.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+    put(e.load.inertia_g_mm2, 4);
+    put(e.load.friction_uNm, 4);
+    put(static_cast<std::uint32_t>(e.load.force_uNm), 4);
+  }
+  if (e.kind == TraceEventKind::axis) {
+    s.offset = bytes_.size();
+    s.length = static_cast<std::uint32_t>(e.text.size());
+    bytes_.insert(bytes_.end(), e.text.begin(), e.text.end());
+  }
+  if (e.kind == TraceEventKind::stops) {
+    s.offset = bytes_.size();
+    s.value = static_cast<std::uint8_t>((e.has_lower_stop ? 1 : 0) | (e.has_upper_stop ? 2 : 0));
+    put(static_cast<std::uint64_t>(e.lower_stop), 8);
+    put(static_cast<std::uint64_t>(e.upper_stop), 8);
+  }
+  if (e.kind == TraceEventKind::supply) {
+    s.offset = bytes_.size();
+    put(e.supply_mV, 4);
   }
   if (e.kind == TraceEventKind::frame) {
     if ((!e.miso.empty() && e.miso.size() != e.mosi.size()) ||
@@ -94,14 +113,26 @@ TraceEvent Trace::operator[](std::size_t i) const {
   e.value = s.value;
   if (s.kind == TraceEventKind::pin) e.pin = static_cast<TracePin>(s.what);
   if (s.kind == TraceEventKind::fault) e.fault = static_cast<TraceFault>(s.what);
+  auto get = [this, &s](std::size_t at, int n) {
+    std::uint64_t w = 0;
+    for (int b = 0; b < n; ++b) w |= std::uint64_t{bytes_[s.offset + at + static_cast<std::size_t>(b)]} << (8 * b);
+    return w;
+  };
   if (s.kind == TraceEventKind::load) {
-    std::uint32_t words[3] = {};
-    for (int w = 0; w < 3; ++w)
-      for (int b = 0; b < 4; ++b) words[w] |= std::uint32_t{bytes_[s.offset + 4 * w + b]} << (8 * b);
-    e.load.inertia_g_mm2 = words[0];
-    e.load.friction_uNm = words[1];
-    e.load.force_uNm = static_cast<std::int32_t>(words[2]);
+    e.load.inertia_g_mm2 = static_cast<std::uint32_t>(get(0, 4));
+    e.load.friction_uNm = static_cast<std::uint32_t>(get(4, 4));
+    e.load.force_uNm = static_cast<std::int32_t>(static_cast<std::uint32_t>(get(8, 4)));
   }
+  if (s.kind == TraceEventKind::axis)
+    e.text = {reinterpret_cast<const char*>(bytes_.data() + s.offset), s.length};
+  if (s.kind == TraceEventKind::stops) {
+    e.value = 0;
+    e.has_lower_stop = (s.value & 1) != 0;
+    e.has_upper_stop = (s.value & 2) != 0;
+    e.lower_stop = static_cast<std::int64_t>(get(0, 8));
+    e.upper_stop = static_cast<std::int64_t>(get(8, 8));
+  }
+  if (s.kind == TraceEventKind::supply) e.supply_mV = static_cast<std::uint32_t>(get(0, 4));
   if (s.kind == TraceEventKind::frame) {
     const std::uint8_t* p = bytes_.data() + s.offset;
     e.mosi = {p, s.length};

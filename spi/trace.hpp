@@ -45,6 +45,9 @@ enum class TraceEventKind : std::uint8_t {
   fault,  ///< a backdoor event: a fault condition starts or ends, or the ADCIN level changes
   load,   ///< the load on a chip's mechanical axis changes (inertia, friction, force: TraceEvent::load)
   advance,  ///< time was moved on with nothing else happening (`ctl advance`): the chips run up to here
+  axis,     ///< an axis is attached to a chip (TraceEvent::text: its AxisSpec text) or removed ("none")
+  stops,    ///< the hard stops of a chip's axis change (a scenario's `block:`)
+  supply,   ///< the motor supply a chip's axis sees changes (TraceEvent::supply_mV)
 };
 
 /// The chip pins a trace can carry, by datasheet name.
@@ -54,7 +57,16 @@ enum class TracePin : std::uint8_t {
   STBY,  ///< STBY\RST input; low = logic held in reset
   BUSY,  ///< BUSY\SYNC output (observed); low = busy
   FLAG,  ///< FLAG output (observed); low = alarm
+  /// SW as the chip's mechanical axis drove it (observed, like BUSY and FLAG: replay checks it
+  /// and does not drive it); written `pin K SW LEVEL axis`.
+  SW_AXIS,
 };
+
+/// Whether a pin event is an observation of the chip (BUSY, FLAG, SW_AXIS), which replay
+/// checks, rather than an input the host or the test bench drove.
+constexpr bool is_observed_pin(TracePin pin) {
+  return pin == TracePin::BUSY || pin == TracePin::FLAG || pin == TracePin::SW_AXIS;
+}
 
 /// Backdoor (physical world) events a trace can carry.
 enum class TraceFault : std::uint8_t {
@@ -86,6 +98,14 @@ struct TraceEvent {
   TraceFault fault = TraceFault::UVLO;       ///< fault events
   std::uint8_t value = 0;                    ///< pin: level 0/1; fault: see TraceFault
   LoadSpec load;                             ///< load events: the axis's new load
+  /// axis events: the AxisSpec as core/axis_text.hpp writes it ("default" for the default
+  /// axis), or "none" when the axis is removed. Valid as long as the byte spans.
+  std::string_view text;
+  bool has_lower_stop = false;               ///< stops events: the axis's new hard stops (1/128 step)
+  bool has_upper_stop = false;
+  std::int64_t lower_stop = 0;
+  std::int64_t upper_stop = 0;
+  std::uint32_t supply_mV = 0;               ///< supply events: the new motor supply, mV
   std::uint64_t line = 0;                    ///< line in the source file (0 = none)
   std::uint64_t repetition = 0;              ///< native `repeat` lines: which repetition (1..), else 0
   double source_time = std::numeric_limits<double>::quiet_NaN();  ///< seconds as in the source file
@@ -98,6 +118,8 @@ struct TraceEvent {
   }
   /// Whether the source file gave this event a time of its own.
   bool has_source_time() const { return source_time == source_time; }
+  /// Whether this is an observation of a chip's output (a pin event of BUSY, FLAG or SW_AXIS).
+  bool is_observation() const { return kind == TraceEventKind::pin && is_observed_pin(pin); }
 };
 
 /// Facts about a trace as a whole.

@@ -2,6 +2,7 @@
 // `repeat` lines, and writing with one flush per event and runs of repeated frames
 // collapsed. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
+#include "core/axis_text.hpp"
 #include "core/counted.hpp"
 
 #include "spi/import_support.hpp"
@@ -68,7 +69,7 @@ bool parse_native_us(std::string_view text, Tick& out) {
 std::string max_time_words() { return "10^" + std::to_string(std::to_string(kMaxNativeTraceSeconds).size() - 1) + " s"; }
 
 bool parse_uint(std::string_view s, unsigned long max, unsigned long& out) {
-  if (s.empty() || s.size() > 10) return false;
+  if (s.empty() || s.size() > 19) return false;  // 19 digits never overflow 64 bits
   unsigned long v = 0;
   for (char c : s) {
     if (c < '0' || c > '9') return false;
@@ -478,6 +479,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     unsigned long chip = 0;
     if (!parse_uint(chip_tok, 255, chip)) fail("chip " + quoted(chip_tok) + " is not a chip number (0..255)");
     e.chip = static_cast<std::uint16_t>(chip);
+    const std::string_view source = kind == "pin" ? next_token(rest) : std::string_view{};
     if (!next_token(rest).empty()) fail("too many fields in " + quoted(line));
     if (kind == "pin") {
       e.kind = TraceEventKind::pin;
@@ -490,6 +492,9 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
       if (!found) fail("unknown pin " + quoted(name) + " (SW, STCK, STBY, BUSY or FLAG)");
       if (value != "0" && value != "1") fail("pin level " + quoted(value) + " is not 0 or 1");
       e.value = value == "1";
+      // `pin K SW L axis`: the level the chip's axis drove SW to, an observation.
+      if (e.pin == TracePin::SW && source == "axis") e.pin = TracePin::SW_AXIS;
+      else if (!source.empty()) fail("too many fields in " + quoted(line) + (e.pin == TracePin::SW ? " (an SW the axis drove ends in 'axis')" : ""));
     } else {
       e.kind = TraceEventKind::fault;
       bool found = false;
@@ -546,10 +551,61 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
       }
       if (!next_token(rest).empty()) fail("too many fields in " + quoted(line) + form);
     }
+  } else if (kind == "axis" || kind == "stops" || kind == "supply") {
+    if (header_.version < 2) fail("'" + std::string(kind) + "' events need format version 2 (the first line says 1)");
+    kept_count_ = 0;
+    const std::string form = kind == "axis"    ? " (expected 'TIME axis CHIP SPEC' or 'TIME axis CHIP none')"
+                             : kind == "stops" ? " (expected 'TIME stops CHIP LOWER..UPPER', either side may be empty)"
+                                               : " (expected 'TIME supply CHIP MILLIVOLTS')";
+    const std::string_view chip_tok = next_token(rest);
+    unsigned long chip = 0;
+    if (!parse_uint(chip_tok, 255, chip)) fail("chip " + quoted(chip_tok) + " is not a chip number (0..255)" + form);
+    e.chip = static_cast<std::uint16_t>(chip);
+    if (kind == "axis") {
+      e.kind = TraceEventKind::axis;
+      std::string_view spec = rest;
+      while (!spec.empty() && (spec.front() == ' ' || spec.front() == '\t')) spec.remove_prefix(1);
+      while (!spec.empty() && (spec.back() == ' ' || spec.back() == '\t' || spec.back() == '\r')) spec.remove_suffix(1);
+      if (spec.empty()) fail("axis without a spec" + form);
+      if (spec != "none" && spec != "default") {
+        AxisSpec parsed;
+        const std::string why = parse_axis_spec(spec, parsed);
+        if (!why.empty()) fail("axis " + quoted(spec) + ": " + why);
+      }
+      axis_text_.assign(spec);
+      e.text = axis_text_;
+    } else if (kind == "stops") {
+      e.kind = TraceEventKind::stops;
+      const std::string_view range = next_token(rest);
+      const std::size_t dots = range.find("..");
+      if (dots == std::string_view::npos) fail("stops " + quoted(range) + " is not LOWER..UPPER" + form);
+      auto side = [&](std::string_view v, bool& has, std::int64_t& at) {
+        has = !v.empty();
+        if (!has) return;
+        const bool negative = v[0] == '-';
+        if (negative) v.remove_prefix(1);
+        unsigned long n = 0;
+        if (!parse_uint(v, 1'000'000'000'000ul, n))
+          fail("stops " + quoted(range) + ": a side is not a whole number from -10^12 to 10^12 (1/128 step)" + form);
+        at = negative ? -static_cast<std::int64_t>(n) : static_cast<std::int64_t>(n);
+      };
+      side(range.substr(0, dots), e.has_lower_stop, e.lower_stop);
+      side(range.substr(dots + 2), e.has_upper_stop, e.upper_stop);
+      if (e.has_lower_stop && e.has_upper_stop && e.lower_stop > e.upper_stop)
+        fail("stops " + quoted(range) + ": the lower stop is above the upper one" + form);
+      if (!next_token(rest).empty()) fail("too many fields in " + quoted(line) + form);
+    } else {
+      e.kind = TraceEventKind::supply;
+      const std::string_view mv = next_token(rest);
+      unsigned long v = 0;
+      if (!parse_uint(mv, 1'000'000, v)) fail("supply " + quoted(mv) + " is not a whole number of millivolts (0..1000000)" + form);
+      e.supply_mV = static_cast<std::uint32_t>(v);
+      if (!next_token(rest).empty()) fail("too many fields in " + quoted(line) + form);
+    }
   } else if (kind.empty()) {
     fail("time without an event");
   } else {
-    fail("unknown event " + quoted(kind) + " (frame, repeat, pin, fault, load or advance)");
+    fail("unknown event " + quoted(kind) + " (frame, repeat, pin, fault, load, advance, axis, stops or supply)");
   }
   any_event_ = true;
   last_tick_ = tick;
@@ -924,6 +980,7 @@ void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
       break;
     case TraceEventKind::pin:
       s += " pin " + std::to_string(e.chip) + " " + std::string(to_string(e.pin)) + (e.value ? " 1" : " 0");
+      if (e.pin == TracePin::SW_AXIS) s += " axis";
       break;
     case TraceEventKind::fault:
       s += " fault " + std::to_string(e.chip) + " " + std::string(to_string(e.fault)) + " ";
@@ -940,6 +997,19 @@ void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
       break;
     case TraceEventKind::advance:
       s += " advance";
+      break;
+    case TraceEventKind::axis:
+      s += " axis " + std::to_string(e.chip) + " ";
+      s += e.text.empty() ? std::string_view("default") : e.text;
+      break;
+    case TraceEventKind::stops:
+      s += " stops " + std::to_string(e.chip) + " ";
+      if (e.has_lower_stop) s += std::to_string(e.lower_stop);
+      s += "..";
+      if (e.has_upper_stop) s += std::to_string(e.upper_stop);
+      break;
+    case TraceEventKind::supply:
+      s += " supply " + std::to_string(e.chip) + " " + std::to_string(e.supply_mV);
       break;
   }
 }

@@ -90,6 +90,7 @@ class NativeTraceReader final : public TraceReader {
   Tick last_tick_ = 0;
   Tick last_frame_end_ = 0;
   std::vector<std::uint8_t> mosi_, miso_, known_;
+  std::string axis_text_;  // an axis event's spec
   // `repeat` lines: the last frames (a ring), and the repetition being handed out.
   std::vector<Kept> kept_;
   std::size_t kept_next_ = 0;   // ring slot the next frame goes to

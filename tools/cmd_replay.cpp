@@ -44,7 +44,7 @@ int run_replay(const ReplayArgs& args, std::ostream& out, std::ostream& err) {
 
     out << file.path() << ": " << counted(r.frames, "frame") << ", " << counted(r.bytes_compared, "MISO byte") << " compared";
     if (r.bytes_unknown) out << " (" << r.bytes_unknown << " not captured)";
-    if (r.pin_checks) out << ", " << r.pin_checks << " BUSY/FLAG levels checked";
+    if (r.pin_checks) out << ", " << r.pin_checks << " pin levels checked (BUSY, FLAG, SW the axis drove)";
     if (r.matched()) {
       out << ": matched\n";
       return kTraceOk;

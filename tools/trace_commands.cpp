@@ -101,7 +101,7 @@ void add_trace_commands(CLI::App& app) {
   add_trace_options(r, replay->trace);
   r->add_flag("--continue", replay->keep_going, "report every divergence, not only the first");
   r->add_option("--max-reports", replay->max_reports, "with --continue: full reports for this many (0 = all)");
-  r->add_flag("--no-pins", replay->no_pins, "do not compare the trace's BUSY/FLAG levels");
+  r->add_flag("--no-pins", replay->no_pins, "do not compare the trace's pin observations (BUSY, FLAG, SW the axis drove)");
   r->add_flag("--quiet", replay->quiet, "one line per divergence instead of the full report");
   add_number_from_option(r, replay->number_from);
   r->callback([replay] { finish(run_replay(*replay, std::cout, std::cerr)); });

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <vector>
 
-#include "board/axis_config.hpp"
+#include "core/axis_text.hpp"
 #include "core/near_miss.hpp"
 #include "core/status.hpp"
 #include "linux/terminal_text.hpp"

@@ -24,8 +24,10 @@ void bind_motion(py::module_& m);
 void bind_board(py::module_& m);
 /// The axis behind `chip` as a dict (true position, lost steps, switches, ...); ValueError without one.
 py::dict axis_state(const Chip& chip);
-/// Attaches an axis from the board description's axis items (an attached axis's spec is the start).
-void attach_axis_text(Chip& chip, const std::string& text);
+/// The axis spec the board description's axis items make for `chip` (an attached axis's spec,
+/// with its rotor where it is now, is the start); ValueError for a bad item. The caller attaches
+/// it (recorded where it records).
+AxisSpec axis_from_text(const Chip& chip, const std::string& text);
 /// The attached axis's load with the items of `text` (load=, friction=, force=) changed;
 /// ValueError without an axis or for a bad item. The caller applies it (recorded where it records).
 LoadSpec load_from_text(const Chip& chip, const std::string& text);

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <string>
 
-#include "board/axis_config.hpp"
+#include "core/axis_text.hpp"
 #include "board/board_config.hpp"
 #include "bindings.hpp"
 #include "convert.hpp"
@@ -70,14 +70,14 @@ py::dict axis_state(const Chip& chip) {
   return d;
 }
 
-void attach_axis_text(Chip& chip, const std::string& text) {
+AxisSpec axis_from_text(const Chip& chip, const std::string& text) {
   AxisSpec spec;
   if (const Axis* a = chip.axis()) {  // items given change the axis attached; the rotor stays where it is
     spec = a->spec();
     spec.start_position = a->true_position();
   }
   if (std::string err = parse_axis_spec(text, spec); !err.empty()) throw py::value_error("axis: " + err);
-  chip.attach_axis(spec);
+  return spec;
 }
 
 LoadSpec load_from_text(const Chip& chip, const std::string& text) {
@@ -217,7 +217,9 @@ void bind_board(py::module_& m) {
   b.def("attach_axis", [](PyBoard& s, long long c, long long k, const std::string& text) {
     const std::size_t chain = chain_arg(s, c);
     const std::size_t chip = chip_arg(s, chain, k);
-    s.board().with_chain(chain, [&](Chain& ch) { attach_axis_text(ch.chip(chip), text); });
+    AxisSpec spec;
+    s.board().with_chain(chain, [&](Chain& ch) { spec = axis_from_text(ch.chip(chip), text); });
+    s.board().attach_axis(chain, chip, spec);  // an axis event in the board's recordings
   });
   b.def("set_load", [](PyBoard& s, long long c, long long k, const std::string& text) {
     const std::size_t chain = chain_arg(s, c);

@@ -390,7 +390,8 @@ Time does not advance by itself: call advance() between frames as a bus would ta
 
   // ---- the physical world ------------------------------------------------------------
   c.def("attach_axis", [](PyChain& p, py::handle chip, const std::string& spec) {
-        attach_axis_text(p.chain().chip(chip_arg(p, chip)), spec == "default" ? std::string() : spec);
+        const std::size_t k = chip_arg(p, chip);
+        p.attach_axis(k, axis_from_text(p.chain().chip(k), spec == "default" ? std::string() : spec));
       }, py::arg("chip"), py::arg("spec") = "default",
       "Puts a motor, load, stops and switches behind chip `chip` (the board description's axis items:\n"
       "\"steps=200,load=120,stops=-2000..90000,switch=home@0\"; positions in 1/128 step). An axis already\n"

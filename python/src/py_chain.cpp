@@ -1,11 +1,31 @@
 // PyChain: a chain, its host and an optional recorder (see py_chain.hpp).
 #include "py_chain.hpp"
 
+#include "board/board_config.hpp"
 #include "board/trace_recorder.hpp"
 #include "daisychain/chain_spec.hpp"
 #include "spi/trace_native.hpp"
 
 namespace l6470emu::python {
+
+namespace {
+
+/// The board description of a Python Chain: its chips (runs of one variant as NxNAME) and the
+/// sanitizer's level and allowed rules.
+std::string describe_python_chain(const std::vector<const Variant*>& variants, const CheckConfig& check) {
+  BoardConfig config;
+  config.chains.emplace_back().chips = variants;
+  config.check = check;
+  const std::string text = describe_board_config(config);
+  // Only the chips and the checks: a spidev node, pins or a clock mean nothing to a Chain.
+  const std::size_t chips = text.find("chips=");
+  std::string out = text.substr(chips, text.find(' ', chips) - chips) + "\n";
+  for (std::size_t at = text.find("\ncheck"); at != std::string::npos; at = text.find("\ncheck", at + 1))
+    out += text.substr(at + 1, text.find('\n', at + 1) - at);
+  return out;
+}
+
+}  // namespace
 
 PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap,
                  const CheckConfig& check)
@@ -29,13 +49,15 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
       checker->chip_diagnostic(k, d);
     });
   }
+  // The header's board lines: the variants and the checks (axes come as events when attached).
+  const RecordOptions options{.board = describe_python_chain(variants, check)};
   if (!record.path.empty()) {
     file_ = std::make_unique<NativeTraceWriter>(record.path);  // throws std::runtime_error with the reason
     record_path_ = record.path;
-    rec_ = std::make_unique<RecordingChain>(*chain_, *file_);
+    rec_ = std::make_unique<RecordingChain>(*chain_, *file_, options);
   } else if (record.memory) {
     memory_ = std::make_shared<Trace>();
-    rec_ = std::make_unique<RecordingChain>(*chain_, *memory_);
+    rec_ = std::make_unique<RecordingChain>(*chain_, *memory_, options);
   }
   bus_ = std::make_unique<ChainBus>(rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_, *chain_, *checker_);
   bus_->set_untimed();  // time moves only when Python says so
@@ -101,6 +123,13 @@ void PyChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
     rec_->set_axis_load(chip, load);
   else
     chain_->chip(chip).set_axis_load(load);
+}
+
+void PyChain::attach_axis(std::size_t chip, const AxisSpec& spec) {
+  if (rec_)
+    rec_->attach_axis(chip, spec);
+  else
+    chain_->chip(chip).attach_axis(spec);
 }
 
 void PyChain::close() {

@@ -68,6 +68,8 @@ class PyChain {
   void fault(std::size_t chip, TraceFault fault, std::uint8_t value);
   /// The load on `chip`'s axis changes (a load event when recording).
   void set_axis_load(std::size_t chip, const LoadSpec& load);
+  /// Attaches an axis to `chip` (an axis event when recording).
+  void attach_axis(std::size_t chip, const AxisSpec& spec);
 
   bool recording() const { return rec_ != nullptr; }
   /// The file being (or last) recorded into; empty for none or memory.

@@ -40,7 +40,7 @@ struct PyTraceEvent {
 };
 
 PyTraceEvent event_of(const TraceEvent& e) {
-  static constexpr const char* kKinds[] = {"frame", "pin", "fault", "load", "advance"};
+  static constexpr const char* kKinds[] = {"frame", "pin", "fault", "load", "advance", "axis", "stops", "supply"};
   PyTraceEvent p;
   p.kind = kKinds[static_cast<int>(e.kind)];
   p.tick = e.tick;
@@ -49,7 +49,10 @@ PyTraceEvent event_of(const TraceEvent& e) {
   p.miso = e.miso.empty() ? py::object(py::none()) : py::object(py::bytes(reinterpret_cast<const char*>(e.miso.data()), e.miso.size()));
   for (std::size_t i = 0; i < e.miso.size(); ++i) p.miso_known.push_back(e.miso_byte_known(i));
   p.chip = e.chip;
-  p.pin = e.kind == TraceEventKind::pin ? py::object(py::str(std::string(to_string(e.pin)))) : py::object(py::none());
+  // An SW level the axis drove (an observation) is "SW_AXIS"; "SW" is the input the host drove.
+  p.pin = e.kind != TraceEventKind::pin          ? py::object(py::none())
+          : e.pin == TracePin::SW_AXIS ? py::object(py::str("SW_AXIS"))
+                                       : py::object(py::str(std::string(to_string(e.pin))));
   p.fault = e.kind == TraceEventKind::fault ? py::object(py::str(std::string(to_string(e.fault)))) : py::object(py::none());
   p.value = e.value;
   p.line = e.line;
@@ -98,7 +101,8 @@ void bind_trace(py::module_& m) {
 
   py::class_<PyTraceEvent>(m, "TraceEvent", "One event of a trace: a CS frame, a pin level or a backdoor fault.")
       .def_readonly("kind", &PyTraceEvent::kind,
-                    "\"frame\", \"pin\", \"fault\", \"load\" (an axis load change: see .text) or \"advance\" (time moved on)")
+                    "\"frame\", \"pin\", \"fault\", \"load\" (an axis load change: see .text), \"advance\" (time moved on),\n"
+                    "\"axis\" (an axis attached or removed), \"stops\" (its hard stops moved) or \"supply\" (its motor supply changed)")
       .def_readonly("tick", &PyTraceEvent::tick, "frame: CS falling edge; pin/fault: when (250 ns ticks)")
       .def_readonly("duration", &PyTraceEvent::duration, "frame: ticks from CS falling to rising edge")
       .def_property_readonly("end", [](const PyTraceEvent& e) { return e.tick + e.duration; }, "frame: the CS rising edge")
@@ -106,7 +110,7 @@ void bind_trace(py::module_& m) {
       .def_readonly("miso", &PyTraceEvent::miso, "frame: bytes received, or None when the trace has none")
       .def_readonly("miso_known", &PyTraceEvent::miso_known, "frame: for each MISO byte, whether the trace knows it")
       .def_readonly("chip", &PyTraceEvent::chip, "pin/fault: the chip (0 drives MISO)")
-      .def_readonly("pin", &PyTraceEvent::pin, "pin: SW, STCK, STBY, BUSY or FLAG")
+      .def_readonly("pin", &PyTraceEvent::pin, "pin: SW, STCK, STBY, BUSY, FLAG, or SW_AXIS (the SW level the axis drove, an observation)")
       .def_readonly("fault", &PyTraceEvent::fault, "fault: UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL or ADCIN")
       .def_readonly("value", &PyTraceEvent::value, "pin: level 0/1; fault: on/off, Thermal number or ADC code")
       .def_readonly("line", &PyTraceEvent::line, "line in the source file (0 = none)")

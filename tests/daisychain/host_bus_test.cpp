@@ -12,7 +12,7 @@ namespace {
 TEST(ChainHostOverABus, SendsEveryFrameThroughTheBusItWasGiven) {
   Chain chain(2);
   Trace trace;
-  RecordingChain rec(chain, trace, RecordOptions{.observe_outputs = false});
+  RecordingChain rec(chain, trace, RecordOptions{.observe_outputs = false, .board = {}});
   ChainHost host(chain, rec);
   EXPECT_EQ(host.get_status(1), 0x7C03);  // three frames: D0, then the two answer bytes
   host.move(1, true, 3200);               // four frames

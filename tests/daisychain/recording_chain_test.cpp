@@ -3,6 +3,7 @@
 // recording that replays against a fresh chain without a single divergence.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <sstream>
 
@@ -28,7 +29,7 @@ TEST(RecordingChain, WritesTheChainAndTheInitialOutputLevelsFirst) {
 }
 
 TEST(RecordingChain, RecordsEachFrameAtItsCsEdgesWithBothDirections) {
-  RecordedSession s(1, RecordOptions{.observe_outputs = false});
+  RecordedSession s(1, RecordOptions{.observe_outputs = false, .board = {}});
   s.frame({0xD0});
   const Bytes rx = s.frame({0x00});
   const TraceEvent e = s.trace[1];
@@ -58,7 +59,7 @@ TEST(RecordingChain, RecordsPinsFaultsAndTheOutputsTheyChange) {
 }
 
 TEST(RecordingChain, WritesEventsMadeWhileCsIsLowAfterTheFrame) {
-  RecordedSession s(1, RecordOptions{.observe_outputs = false});
+  RecordedSession s(1, RecordOptions{.observe_outputs = false, .board = {}});
   s.rec.advance_to(100);
   s.rec.select();
   s.rec.exchange(0xD0);
@@ -78,7 +79,7 @@ TEST(RecordingChain, WritesEventsMadeWhileCsIsLowAfterTheFrame) {
 TEST(RecordingChain, RecordsSpidevMessagesFrameByFrame) {
   Chain chain(2);
   Trace trace;
-  RecordingChain rec(chain, trace, RecordOptions{.observe_outputs = false});
+  RecordingChain rec(chain, trace, RecordOptions{.observe_outputs = false, .board = {}});
   const Bytes tx0{0xD0, 0xD0}, tx1{0x00, 0x00};
   Bytes rx0(2), rx1(2);
   const SpiTransfer t[] = {{tx0, rx0, 2, 4'000'000, 0, true}, {tx1, rx1, 2, 4'000'000, 0, false}};
@@ -87,6 +88,91 @@ TEST(RecordingChain, RecordsSpidevMessagesFrameByFrame) {
   EXPECT_EQ(bytes(trace[1].miso), (Bytes{0x7C, 0x7C}));
   EXPECT_EQ(trace[0].duration, 16u);  // 2 bytes at 4 MHz: 8 ticks each
   EXPECT_EQ(trace[1].tick, trace[0].end() + BusTiming{}.cs_high_ticks);
+}
+
+/// The native text of `trace`, each line without its time.
+std::vector<std::string> lines_without_time(const Trace& trace, std::size_t from = 0) {
+  std::vector<std::string> lines;
+  for (std::size_t i = from; i < trace.size(); ++i) {
+    const std::string l = NativeTraceWriter::format_event(trace[i]);
+    lines.push_back(l.substr(l.find(' ') + 1));
+  }
+  return lines;
+}
+
+bool has_line(const std::vector<std::string>& lines, const std::string& line) {
+  return std::find(lines.begin(), lines.end(), line) != lines.end();
+}
+
+/// Replays the native text of a recording against a fresh chain of `chips` L6470s.
+ReplayResult replay_text(const std::string& text, std::size_t chips = 1) {
+  NativeTraceReader reader(text, "axis.trace");
+  Chain fresh(chips);
+  return replay_trace(reader, fresh);
+}
+
+TEST(RecordingChain, AnAxisAttachedMidRecordingIsAnEventAndTheSwitchItClosesIsObservedAtItsOwnTick) {
+  RecordedSession s(1);
+  s.each({0xD0, 0x00, 0x00});
+  AxisSpec axis;
+  axis.start_position = 12'800;
+  axis.switches.push_back(SwitchSpec{.name = "home", .position = 0});
+  s.rec.attach_axis(0, axis);
+  s.frame({0x82});  // GoUntil(reset, reverse) at SPD 0x2000: onto the home switch
+  s.frame({0x00});
+  s.frame({0x20});
+  s.frame({0x00});
+  s.wait_ms(3000);
+  const std::vector<std::string> lines = lines_without_time(s.trace);
+  EXPECT_TRUE(has_line(lines, "axis 0 start=12800,switch=home@0:below:no")) << ::testing::PrintToString(lines);
+  EXPECT_TRUE(has_line(lines, "pin 0 SW 1 axis"));  // its level once attached
+  EXPECT_TRUE(has_line(lines, "pin 0 SW 0 axis"));  // the switch closing under GoUntil
+  EXPECT_TRUE(s.chain.chip(0).busy_sync_pin());     // GoUntil ended on the switch
+
+  // The switch closes at the tick the axis reaches it, and the replay's axis does the same.
+  const std::string text = to_native_text(s.trace);
+  const ReplayResult r = replay_text(text);
+  EXPECT_TRUE(r.matched()) << (r.divergences.empty() ? "" : r.divergences[0].report);
+
+  // Without the axis event the replayed carriage never reaches a switch: the observation says so.
+  std::string without = text;
+  const std::size_t at = without.find(" axis 0 ");
+  without.erase(without.rfind('\n', at) + 1, without.find('\n', at) - without.rfind('\n', at));
+  const ReplayResult bare = replay_text(without);
+  ASSERT_FALSE(bare.matched());
+  EXPECT_NE(bare.divergences[0].summary.find("SW expected"), std::string::npos) << bare.divergences[0].summary;
+}
+
+TEST(RecordingChain, AHostDrivenSwitchIsAnInputEvenOnAChipWithAnAxis) {
+  RecordedSession s(1);
+  s.rec.attach_axis(0, AxisSpec{});
+  const std::size_t before = s.trace.size();
+  s.rec.set_sw_pin(0, false);
+  EXPECT_EQ(lines_without_time(s.trace, before), (std::vector<std::string>{"pin 0 SW 0"}));  // no "SW 0 axis"
+}
+
+TEST(RecordingChain, AxisStopsSupplyAndRemovalAreRecordedAndReplayed) {
+  RecordedSession s(1);
+  s.each({0xD0, 0x00, 0x00});
+  s.rec.attach_axis(0, AxisSpec{});
+  s.frame({0x50});  // Run forward at SPD 0x4000
+  s.frame({0x00});
+  s.frame({0x40});
+  s.frame({0x00});
+  s.wait_ms(200);
+  s.rec.set_axis_stops(0, true, -6400, true, 25'600);  // a hard stop ahead: the rotor stalls on it
+  s.rec.set_axis_supply(0, 9'000);
+  s.wait_ms(1500);
+  s.rec.detach_axis(0);
+  s.wait_ms(10);
+  const std::vector<std::string> lines = lines_without_time(s.trace);
+  EXPECT_TRUE(has_line(lines, "axis 0 default"));
+  EXPECT_TRUE(has_line(lines, "stops 0 -6400..25600"));
+  EXPECT_TRUE(has_line(lines, "supply 0 9000"));
+  EXPECT_TRUE(has_line(lines, "axis 0 none"));
+  const ReplayResult r = replay_text(to_native_text(s.trace));
+  EXPECT_TRUE(r.matched()) << (r.divergences.empty() ? "" : r.divergences[0].report);
+  EXPECT_GT(r.pin_checks, 3u);
 }
 
 TEST(RecordingChain, ARecordingOfRandomTrafficReplaysWithoutDivergence) {

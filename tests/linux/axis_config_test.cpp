@@ -3,7 +3,7 @@
 // showing the true position next to ABS_POS and changing the load at runtime.
 #include <gtest/gtest.h>
 
-#include "board/axis_config.hpp"
+#include "core/axis_text.hpp"
 #include "board/board_config.hpp"
 #include "daisychain/host.hpp"
 #include "linux/device_board.hpp"

@@ -150,7 +150,7 @@ TEST_F(Recording, APreloadedHomingRunAgainstTheAxisSwitchRecordsItsWorldAndRepla
   EXPECT_NE(text.find("\nboard bus=0 cs=0 path=/dev/spidev0.0 chips=L6470 "), std::string::npos) << text;
   EXPECT_NE(text.find(" axis.0=stops=-6400..300000,start=51200,switch=home@0:below:no:hyst=64"), std::string::npos) << text;
   EXPECT_NE(text.find("\nboard time=virtual"), std::string::npos) << text;
-  // Replayed through the world it ran in: every MISO byte and BUSY/FLAG level as recorded.
+  // Replayed through the world it ran in: every MISO byte and BUSY/FLAG/SW level as recorded.
   EXPECT_TRUE(replays_clean(trace_));
   const RunResult rep = run_program({l6470emu_program(), "replay", trace_});
   EXPECT_NE(rep.err.find("with an axis behind chip 0 (from the trace's board description)"), std::string::npos) << rep.err;
@@ -159,7 +159,10 @@ TEST_F(Recording, APreloadedHomingRunAgainstTheAxisSwitchRecordsItsWorldAndRepla
   // replay, decode and plot all say so, and the latter two exit 1 unless told to accept it.
   const RunResult bare = run_program({l6470emu_program(), "replay", "--chain", "L6470", trace_});
   EXPECT_EQ(bare.status, 1) << bare.out << bare.err;
-  EXPECT_NE(bare.out.find("BUSY expected high (released), emulated low (busy)"), std::string::npos) << bare.out;
+  // The first thing to differ: the switch the recorded axis closed, at its own tick.
+  EXPECT_NE(bare.out.find("chip 0 SW (driven by its axis) expected low (switch closed), emulated high (switch open)"),
+            std::string::npos)
+      << bare.out;
   const RunResult dec = run_program({l6470emu_program(), "decode", "--chain", "L6470", trace_});
   EXPECT_EQ(dec.status, 1) << dec.out << dec.err;
   EXPECT_NE(dec.out.find("DIVERGED"), std::string::npos) << dec.out;

@@ -56,7 +56,7 @@ TEST(NativeTrace, RoundTripsEveryKindOfEventExactly) {
   partial.miso_known = known;
   t.write(partial);
   t.write(frame_at(40, 0, mosi, {}));  // MISO not captured
-  for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG}) {
+  for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG, TracePin::SW_AXIS}) {
     TraceEvent e;
     e.kind = TraceEventKind::pin;
     e.tick = 50;
@@ -74,6 +74,22 @@ TEST(NativeTrace, RoundTripsEveryKindOfEventExactly) {
     e.value = f == TraceFault::ADCIN ? 17 : 1;
     t.write(e);
   }
+  TraceEvent axis;
+  axis.kind = TraceEventKind::axis;
+  axis.tick = 70;
+  axis.text = "steps=400,stops=-100..100,switch=home@0:below:nc:hyst=8";
+  t.write(axis);
+  TraceEvent stops;
+  stops.kind = TraceEventKind::stops;
+  stops.tick = 70;
+  stops.has_upper_stop = true;
+  stops.upper_stop = -25;
+  t.write(stops);
+  TraceEvent supply;
+  supply.kind = TraceEventKind::supply;
+  supply.tick = 70;
+  supply.supply_mV = 36'000;
+  t.write(supply);
   const std::string text = to_native_text(t);
   const Trace back = read_native_trace(text, "x.trace");
   EXPECT_EQ(back.header.chain, "2*L6470");
@@ -114,11 +130,46 @@ TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
   EXPECT_EQ(error_of(head + "0 frame 10us D0\n0.000005 frame 00\n"),
             "t.trace:3: frame at 0.000005 s starts before the previous frame ended (0.00001000 s)");
   EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance ...')");
-  EXPECT_EQ(error_of(head + "0 blink\n"), "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load or advance)");
+  EXPECT_EQ(error_of(head + "0 blink\n"),
+            "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load, advance, axis, stops or supply)");
   EXPECT_EQ(error_of(head + "0 pin 0 RESET 1\n"), "t.trace:2: unknown pin \"RESET\" (SW, STCK, STBY, BUSY or FLAG)");
   EXPECT_EQ(error_of(head + "0 pin 300 SW 1\n"), "t.trace:2: chip \"300\" is not a chip number (0..255)");
   EXPECT_EQ(error_of(head + "0 fault 0 UVLO maybe\n"), "t.trace:2: UVLO \"maybe\" is not on or off");
   EXPECT_EQ(error_of(head + "0 frame D0\nchain 3\n"), "t.trace:3: 'chain' must come before the first event");
+  EXPECT_EQ(error_of(head + "0 pin 0 BUSY 1 axis\n"), "t.trace:2: too many fields in \"0 pin 0 BUSY 1 axis\"");
+}
+
+TEST(NativeTrace, ReadsTheAxisEventsAndRefusesMalformedOnesByLine) {
+  const std::string head = "l6470emu-trace 2\n";
+  const Trace t = read_native_trace(head +
+                                        "0 axis 1 start=512,switch=home@0:below:no\n"
+                                        "0 pin 1 SW 0 axis\n"
+                                        "0.5 stops 1 -6400..\n"
+                                        "0.5 stops 1 ..\n"
+                                        "0.6 supply 1 7000\n"
+                                        "0.7 axis 1 none\n",
+                                    "a.trace");
+  ASSERT_EQ(t.size(), 6u);
+  EXPECT_EQ(t[0].kind, TraceEventKind::axis);
+  EXPECT_EQ(t[0].text, "start=512,switch=home@0:below:no");
+  EXPECT_EQ(t[1].pin, TracePin::SW_AXIS);
+  EXPECT_TRUE(t[1].is_observation());
+  EXPECT_TRUE(t[2].has_lower_stop);
+  EXPECT_EQ(t[2].lower_stop, -6400);
+  EXPECT_FALSE(t[2].has_upper_stop);
+  EXPECT_FALSE(t[3].has_lower_stop || t[3].has_upper_stop);
+  EXPECT_EQ(t[4].supply_mV, 7000u);
+  EXPECT_EQ(t[5].text, "none");
+  EXPECT_EQ(error_of(head + "0 axis 0\n"), "t.trace:2: axis without a spec (expected 'TIME axis CHIP SPEC' or 'TIME axis CHIP none')");
+  EXPECT_NE(error_of(head + "0 axis 0 stops=9..1\n").find("t.trace:2: axis \"stops=9..1\": "), std::string::npos);
+  EXPECT_EQ(error_of(head + "0 stops 0 5..-5\n"),
+            "t.trace:2: stops \"5..-5\": the lower stop is above the upper one (expected 'TIME stops CHIP LOWER..UPPER', either side may be empty)");
+  EXPECT_EQ(error_of(head + "0 stops 0 5\n"),
+            "t.trace:2: stops \"5\" is not LOWER..UPPER (expected 'TIME stops CHIP LOWER..UPPER', either side may be empty)");
+  EXPECT_EQ(error_of(head + "0 supply 0 12V\n"),
+            "t.trace:2: supply \"12V\" is not a whole number of millivolts (0..1000000) (expected 'TIME supply CHIP MILLIVOLTS')");
+  EXPECT_EQ(error_of("l6470emu-trace 1\n0 supply 0 12000\n"),
+            "t.trace:2: 'supply' events need format version 2 (the first line says 1)");
 }
 
 TEST(NativeTrace, ReportsATruncatedLastLineAsSuch) {

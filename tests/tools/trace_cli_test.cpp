@@ -23,7 +23,7 @@ TEST(ReplayCommand, ExitsZeroWhenTheCaptureMatches) {
   const RunResult r = l6470emu("replay " + fixture_path("three_chips.trace"));
   EXPECT_EQ(r.status, 0) << r.out;
   EXPECT_NE(r.out.find("through 3*L6470 (from the trace)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("30 frames, 90 MISO bytes compared, 18 BUSY/FLAG levels checked: matched"), std::string::npos)
+  EXPECT_NE(r.out.find("30 frames, 90 MISO bytes compared, 18 pin levels checked (BUSY, FLAG, SW the axis drove): matched"), std::string::npos)
       << r.out;
 }
 

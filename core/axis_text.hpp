@@ -1,6 +1,7 @@
-// The axis clause of the board description (axis.K=ITEM,ITEM,...): a motor, its load, hard
-// stops and switches behind chip K, in readable units, parsed into core's AxisSpec and written
-// back. No OS calls; docs/linux.md lists the items.
+// The text of an AxisSpec: the axis clause of the board description (axis.K=ITEM,ITEM,...) and
+// of a native trace's `axis` events — a motor, its load, hard stops and switches behind one
+// chip, in readable units, parsed into AxisSpec and written back. No OS calls;
+// docs/linux.md lists the items.
 #pragma once
 
 #include <string>

@@ -1,6 +1,6 @@
 // Parser and writer of the axis clause: decimal numbers are read as exact fixed-point
 // integers (no floating point), each item checked against its range.
-#include "board/axis_config.hpp"
+#include "core/axis_text.hpp"
 
 #include <array>
 #include <charconv>
