@@ -404,6 +404,20 @@ Tick Chip::next_event_tick() const {
 
 bool Chip::busy_sync_pin() const {
   sync();
+  return busy_level();
+}
+
+Chip::OutputLevels Chip::output_levels() const {
+  sync();  // once: what follows reads the state as of now
+  OutputLevels o;
+  o.busy = busy_level();
+  o.flag = flag_level();
+  o.sw = sw_level_;
+  o.active = motion_active(motion_) || (axis_ && axis_->next_time_event() != kNever);
+  return o;
+}
+
+bool Chip::busy_level() const {
   if (!stby_level_) return true;
   const std::uint32_t step_mode = reg(Reg::STEP_MODE);
   if ((step_mode & kStepModeSyncEn) != 0) {
@@ -413,8 +427,7 @@ bool Chip::busy_sync_pin() const {
   return !motion_busy(motion_, profile_);
 }
 
-bool Chip::flag_pin() const {
-  if (axis_) sync();  // a mechanical event may have latched a flag since
+bool Chip::flag_level() const {
   const std::uint32_t enabled = reg(Reg::ALARM_EN);
   const AlarmFlags& a = latched_;
   for (unsigned bit = 0; bit < 8; ++bit) {
@@ -436,6 +449,11 @@ bool Chip::flag_pin() const {
     if (on) return false;
   }
   return true;
+}
+
+bool Chip::flag_pin() const {
+  if (axis_) sync();  // a mechanical event may have latched a flag since
+  return flag_level();
 }
 
 void Chip::set_sw_pin(bool level) {

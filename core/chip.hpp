@@ -163,6 +163,14 @@ class alignas(64) Chip {
   const Axis* axis() const;
   /// Whether an axis is attached (without bringing it up to now()).
   bool has_axis() const { return static_cast<bool>(axis_); }
+
+  /// What a recording watches, worked out at once: the BUSY\SYNC, FLAG and SW levels
+  /// (busy_sync_pin(), flag_pin(), sw_pin()) and whether the chip changes on its own later
+  /// (next_event_tick() != kNever).
+  struct OutputLevels {
+    bool busy = true, flag = true, sw = true, active = false;
+  };
+  OutputLevels output_levels() const;
   /// Changes the axis's load at runtime (no effect without an axis).
   void set_axis_load(const LoadSpec& load);
   /// Changes the axis's hard stops at runtime (no effect without an axis): a stop put where the
@@ -304,6 +312,9 @@ class alignas(64) Chip {
   // (MOT_STATUS, BUSY, DIR, HiZ, SW_F and SCK_MOD cannot change inside one).
   /// Works the motion out up to now_.
   void sync() const;
+  /// BUSY\SYNC and FLAG from the state as it stands (the pins' levels once synced).
+  bool busy_level() const;
+  bool flag_level() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
   /// The first tick at which it would stop being so, as the state stands, is status_horizon().
   bool status_known_without_sync() const {

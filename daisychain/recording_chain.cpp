@@ -2,6 +2,7 @@
 #include "daisychain/recording_chain.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 #include "core/axis_text.hpp"
 #include "daisychain/chain_spec.hpp"
@@ -114,37 +115,48 @@ void RecordingChain::select_wire() {
 
 void RecordingChain::start_frame() {
   frame_start_ = chain_.now();
-  tx_.clear();
-  rx_.clear();
+  frame_bytes_ = 0;
 }
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
   touched();
   const std::uint8_t miso = chain_.exchange(mosi);
-  if (chain_.selected()) {
-    tx_.push_back(mosi);
-    rx_.push_back(miso);
-  }
+  if (chain_.selected()) keep({&mosi, 1}, {&miso, 1});
   return miso;
+}
+
+void RecordingChain::keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx) {
+  // Into buffers that only ever grow (most frames are a few bytes: a plain loop).
+  const std::size_t at = frame_bytes_, n = tx.size();
+  if (at + n > tx_.size()) {
+    tx_.resize(std::max<std::size_t>(2 * (at + n), 64));
+    rx_.resize(tx_.size());
+  }
+  std::uint8_t* t = tx_.data() + at;
+  std::uint8_t* r = rx_.data() + at;
+  if (n <= 16) {
+    for (std::size_t i = 0; i < n; ++i) {
+      t[i] = tx[i];
+      r[i] = rx[i];
+    }
+  } else {
+    std::memcpy(t, tx.data(), n);
+    std::memcpy(r, rx.data(), n);
+  }
+  frame_bytes_ = at + n;
 }
 
 void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
   touched();
   chain_.exchange(tx, rx);
-  if (chain_.selected()) {
-    tx_.insert(tx_.end(), tx.begin(), tx.end());
-    rx_.insert(rx_.end(), rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()));
-  }
+  if (chain_.selected()) keep(tx, rx);
 }
 
 void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                                    const WireSettings& wire) {
   touched();
   chain_.exchange_wire(tx, rx, wire);
-  if (chain_.selected()) {
-    tx_.insert(tx_.end(), tx.begin(), tx.end());
-    rx_.insert(rx_.end(), rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(tx.size()));
-  }
+  if (chain_.selected()) keep(tx, rx);
 }
 
 void RecordingChain::deselect() {
@@ -168,10 +180,10 @@ void RecordingChain::finish_frame() {
   e.kind = TraceEventKind::frame;
   e.tick = frame_start_;
   e.duration = chain_.now() - frame_start_;
-  e.mosi = tx_;
-  e.miso = rx_;
+  e.mosi = {tx_.data(), frame_bytes_};
+  e.miso = {rx_.data(), frame_bytes_};
   // A frame of no bytes keeps no MISO list (nothing to compare).
-  if (tx_.empty()) e.miso = {};
+  if (frame_bytes_ == 0) e.miso = {};
   emit(e);
   ++frames_;
   for (const TraceEvent& d : deferred_) emit(d);
@@ -309,23 +321,20 @@ void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
            static_cast<std::uint8_t>(bridge == Bridge::A ? TraceFault::STALL_A : TraceFault::STALL_B), active);
 }
 
-void RecordingChain::observe_outputs() {
-  if (!options_.observe_outputs || chain_.selected() || chain_.now() == observed_at_) return;
-  // Untouched since a look that found every chip with nothing to do on its own: still the same.
-  if (idle_ && observed_at_ != kNever) return;
+// observe_outputs() comes here unless nothing can have changed since the last look: the same
+// tick, or a look that found every chip with nothing to do on its own and no touch since.
+void RecordingChain::look_at_outputs() {
   observed_at_ = chain_.now();
   bool idle = true;
   for (std::size_t k = 0; k < chain_.size(); ++k) {
     const Chip& c = chain_.chip(k);
-    if (idle && c.next_event_tick() != kNever) idle = false;
-    if (c.has_axis()) {
-      const std::uint8_t sw = c.sw_pin();
-      if (sw != sw_[k]) {
-        sw_[k] = sw;
-        backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), sw);
-      }
+    const Chip::OutputLevels levels = c.output_levels();
+    idle = idle && !levels.active;
+    if (c.has_axis() && levels.sw != sw_[k]) {
+      sw_[k] = levels.sw;
+      backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), levels.sw);
     }
-    const std::uint8_t busy = c.busy_sync_pin(), flag = c.flag_pin();
+    const std::uint8_t busy = levels.busy, flag = levels.flag;
     if (busy != busy_[k]) {
       busy_[k] = busy;
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::BUSY), busy);

@@ -80,7 +80,12 @@ class RecordingChain final : public SpiDevice {
   /// frames, e.g. a move ending). Looking again with nothing done to the chain through the
   /// recorder in between is free at the same tick, and at any later one while no chip has
   /// anything to do on its own.
-  void observe_outputs();
+  void observe_outputs() {
+    if (!options_.observe_outputs || observed_at_ == chain_.now() || (idle_ && observed_at_ != kNever) ||
+        chain_.selected())
+      return;
+    look_at_outputs();
+  }
   /// The chain was changed behind the recorder's back (through chain()): the next
   /// observe_outputs() looks even at the same tick.
   void outputs_may_have_changed() {
@@ -95,6 +100,8 @@ class RecordingChain final : public SpiDevice {
  private:
   void start_frame();
   void finish_frame();
+  void look_at_outputs();
+  void keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
   Tick first_output_change(std::size_t chip, Tick to, bool& unsure) const;
   void stimulus(const TraceEvent& e);
@@ -104,7 +111,8 @@ class RecordingChain final : public SpiDevice {
   TraceSink& sink_;
   RecordOptions options_;
   Tick frame_start_ = 0;
-  std::vector<std::uint8_t> tx_, rx_;
+  std::vector<std::uint8_t> tx_, rx_;  // the frame's bytes so far: the first frame_bytes_ of them
+  std::size_t frame_bytes_ = 0;
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   void touched() {
     observed_at_ = kNever;

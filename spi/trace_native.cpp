@@ -354,7 +354,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (time_tok[0] < '0' || time_tok[0] > '9') {
     if (time_tok == "chain" || time_tok == "board") fail("'" + std::string(time_tok) + "' must come before the first event");
     if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
-    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault|load|advance ...')");
+    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply ...')");
   }
 
   // Time: seconds, decimal (the writer uses 8 decimals: exact ticks).
@@ -688,6 +688,7 @@ NativeTraceWriter::NativeTraceWriter(std::ostream& out, NativeWriteOptions optio
 NativeTraceWriter::NativeTraceWriter(std::unique_ptr<TraceOutput> output, NativeWriteOptions options)
     : out_(std::move(output)), options_(options) {
   if (!out_) throw std::invalid_argument("NativeTraceWriter: no output");
+  open_runs_ = out_->rewritable() && options_.flush_each_event;
 }
 
 NativeTraceWriter::~NativeTraceWriter() {
@@ -730,7 +731,6 @@ void NativeTraceWriter::abandon() {
 
 /// Open `repeat` lines (a count replaced in place) where the output can be rewritten and every
 /// event must survive a kill; elsewhere closed lines, written when a run ends or at checkpoints.
-bool NativeTraceWriter::open_runs() const { return out_->rewritable() && options_.flush_each_event; }
 
 void NativeTraceWriter::put(const std::string& text) { out_->append(text); }
 

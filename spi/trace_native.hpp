@@ -185,11 +185,12 @@ class NativeTraceWriter final : public TraceSink {
   void write_repeat_line();
   void write_open_repeat_line();
   bool checkpoint_due() const;
-  bool open_runs() const;
+  bool open_runs() const { return open_runs_; }
   const std::string& name() const;
 
   std::unique_ptr<TraceOutput> out_;
   NativeWriteOptions options_;
+  bool open_runs_ = false;  // out_ rewritable and every event flushed: open repeat lines
   bool header_written_ = false;
   bool finished_ = false;
   bool abandoned_ = false;

@@ -129,7 +129,7 @@ TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
             "t.trace:3: time 0.5 s goes backwards (the previous event was at 1.00000000 s)");
   EXPECT_EQ(error_of(head + "0 frame 10us D0\n0.000005 frame 00\n"),
             "t.trace:3: frame at 0.000005 s starts before the previous frame ended (0.00001000 s)");
-  EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance ...')");
+  EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply ...')");
   EXPECT_EQ(error_of(head + "0 blink\n"),
             "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load, advance, axis, stops or supply)");
   EXPECT_EQ(error_of(head + "0 pin 0 RESET 1\n"), "t.trace:2: unknown pin \"RESET\" (SW, STCK, STBY, BUSY or FLAG)");
