@@ -628,11 +628,21 @@ void NativeTraceWriter::Held::assign(const TraceEvent& e) {
   mosi.assign(e.mosi.begin(), e.mosi.end());
   miso.assign(e.miso.begin(), e.miso.end());
   known.assign(e.miso_known.begin(), e.miso_known.end());
+  // FNV-1a over what same_bytes compares (a MISO byte not known counts as 0).
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 0x100000001b3ull; };
+  mix(duration);
+  mix(has_miso);
+  mix(mosi.size());
+  for (std::uint8_t b : mosi) mix(b);
+  mix(known.size());
+  for (std::size_t i = 0; i < miso.size(); ++i) mix(known.empty() || known[i] ? miso[i] + 1u : 0u);
+  print = h;
 }
 
 bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
   // "??" bytes are written whatever their value: compare what the line shows.
-  if (duration != o.duration || has_miso != o.has_miso || mosi != o.mosi || known != o.known) return false;
+  if (print != o.print || duration != o.duration || has_miso != o.has_miso || mosi != o.mosi || known != o.known) return false;
   if (miso.size() != o.miso.size()) return false;
   for (std::size_t i = 0; i < miso.size(); ++i)
     if ((known.empty() || known[i]) && miso[i] != o.miso[i]) return false;
@@ -784,6 +794,7 @@ void NativeTraceWriter::write(const TraceEvent& e) {
   } else {
     if (in_run_) end_run();
     recent_.clear();
+    recent_first_ = 0;
     write_line(e);
   }
   out_->event_end();
@@ -849,9 +860,10 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
   }
   write_line(e);
   if (recent_.size() == 3 * kMaxRepeatGroup) {
-    std::rotate(recent_.begin(), recent_.begin() + 1, recent_.end());  // reuses the oldest one's buffers
-    recent_.back().assign(e);
+    recent_[recent_first_].assign(e);  // the newest takes the oldest one's place (and buffers)
+    recent_first_ = (recent_first_ + 1) % recent_.size();
   } else {
+    straighten_recent();
     recent_.emplace_back().assign(e);
   }
   look_for_run();
@@ -864,16 +876,21 @@ void NativeTraceWriter::look_for_run() {
   const std::size_t n = recent_.size();
   const std::size_t copies = open_runs() ? 3 : 2;
   for (std::size_t k = 1; k <= kMaxRepeatGroup && copies * k <= n; ++k) {
-    const Held* c = &recent_[n - k];
-    const Tick period = c[0].tick - recent_[n - 2 * k].tick;
-    if (period == 0 || c[k - 1].tick + c[k - 1].duration - c[0].tick > period) continue;  // as the reader requires
+    const Held& first = recent(n - k);
+    const Held& last = recent(n - 1);
+    const Tick period = first.tick - recent(n - 2 * k).tick;
+    if (period == 0 || last.tick + last.duration - first.tick > period) continue;  // as the reader requires
     bool same = true;
     for (std::size_t copy = 1; copy < copies && same; ++copy) {
-      const Held* a = &recent_[n - (copy + 1) * k];
-      const Held* b = &recent_[n - copy * k];
-      for (std::size_t j = 0; j < k && same; ++j) same = b[j].tick - a[j].tick == period && b[j].same_bytes(a[j]);
+      const std::size_t a = n - (copy + 1) * k, b = n - copy * k;
+      for (std::size_t j = 0; j < k && same; ++j) {
+        const Held& x = recent(a + j);
+        const Held& y = recent(b + j);
+        same = y.tick - x.tick == period && y.same_bytes(x);
+      }
     }
     if (!same) continue;
+    straighten_recent();
     in_run_ = true;
     run_group_ = k;
     run_period_ = period;
@@ -922,8 +939,15 @@ void NativeTraceWriter::write_repeat_line() {
 
 /// The run is over: its repeat line and the frames of an unfinished repetition go to the file
 /// (an open line has them already), and they are the recent frames from now on.
+void NativeTraceWriter::straighten_recent() {
+  if (recent_first_ == 0) return;
+  std::rotate(recent_.begin(), recent_.begin() + static_cast<std::ptrdiff_t>(recent_first_), recent_.end());
+  recent_first_ = 0;
+}
+
 void NativeTraceWriter::end_run() {
   in_run_ = false;
+  straighten_recent();
   // The frames of the unfinished repetition: the group's first ones, one period on.
   std::vector<Held> partial(run_.begin(), run_.begin() + static_cast<std::ptrdiff_t>(partial_));
   for (Held& h : partial) h.tick += run_period_;

@@ -172,6 +172,7 @@ class NativeTraceWriter final : public TraceSink {
     Tick tick = 0, duration = 0;
     bool has_miso = false;
     std::vector<std::uint8_t> mosi, miso, known;
+    std::uint64_t print = 0;  // a hash of what same_bytes compares: unequal prints, different frames
     void assign(const TraceEvent& e);
     bool same_bytes(const Held& o) const;
     bool same_bytes(const TraceEvent& e) const;
@@ -196,7 +197,14 @@ class NativeTraceWriter final : public TraceSink {
   bool abandoned_ = false;
   std::string line_;
   // Compaction: the frames written since the last pin/fault event (at most 3 groups' worth)...
-  std::vector<Held> recent_;
+  std::vector<Held> recent_;     // a ring once full: the oldest is recent_[recent_first_]
+  std::size_t recent_first_ = 0;
+  Held& recent(std::size_t i) {
+    const std::size_t at = recent_first_ + i;  // i < recent_.size(): one wrap at most
+    return recent_[at < recent_.size() ? at : at - recent_.size()];
+  }
+  /// Makes the ring a plain vector again, oldest first (before the rare edits of recent_).
+  void straighten_recent();
   // ...and the run being collapsed: the group (its last complete repetition), the period,
   // the repetitions not yet in the file (closed lines) or in its count (open lines) and the
   // frames of the repetition under way.
