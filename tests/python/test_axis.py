@@ -52,8 +52,7 @@ def test_a_board_attaches_an_axis_whose_switch_stops_the_motor(l6470_board):
 
 
 def test_a_load_change_is_a_load_event_of_the_recording_and_replays(tmp_path):
-    # The replay is checked on a Board, whose description (axis included) heads the recording; a
-    # Chain's recording has no board lines (docs/trace-format.md), but its load change is an event.
+    # A Board's description (axis included) heads the recording; a Chain's axis is an event.
     board = l6470emu.Board("L6470", options="axis.0=stops=-100000..100000", trace_path=tmp_path / "load.trace")
     spi = board.spidev(0, 0)
     spi.mode = 3
@@ -74,3 +73,39 @@ def test_a_load_change_is_a_load_event_of_the_recording_and_replays(tmp_path):
     chain.set_load(0, "load=2000")
     chain.close()
     assert " load 0 " in (tmp_path / "chain.trace").read_text()
+
+
+def test_an_axis_attached_while_a_chain_records_is_an_event_and_its_switch_replays(tmp_path):
+    chain = l6470emu.Chain("L6470", record=tmp_path / "home.trace")
+    chain.get_status(0)
+    chain.attach_axis(0, "start=2560,switch=home@0")  # after the recording began
+    chain.go_until(0, copy_to_mark=False, forward=False, speed=0x2000)
+    chain.advance(seconds=2)
+    assert chain.axis(0)["switches"]["home"] and chain.busy_pin(0)
+    chain.close()
+    text = (tmp_path / "home.trace").read_text()
+    assert "\nboard chips=L6470\n" in text  # a Chain's own board lines: its chips and checks
+    assert " axis 0 start=2560,switch=home@0:below:no\n" in text
+    assert " pin 0 SW 0 axis\n" in text  # the switch closing, observed at its tick
+    result = l6470emu.replay(tmp_path / "home.trace")
+    assert result.matched and result.pin_checks > 3, result
+    # Without the axis event the carriage never reaches the switch: that is the divergence.
+    (tmp_path / "bare.trace").write_text("".join(
+        line for line in text.splitlines(keepends=True) if " axis 0 start=" not in line))
+    bare = l6470emu.replay(tmp_path / "bare.trace")
+    assert not bare.matched
+    assert "SW (driven by its axis) expected low" in bare.divergences[0].summary
+
+
+def test_an_axis_a_board_attaches_while_recording_is_in_its_trace(tmp_path):
+    board = l6470emu.Board("L6470", trace_path=tmp_path / "board.trace")
+    board.attach_axis(0, "start=500,switch=home@0")
+    spi = board.spidev(0, 0)
+    spi.mode = 3
+    for byte in (0x40, 0x00, 0x02, 0x00):  # Move 512 reverse: onto the switch
+        spi.xfer2([byte])
+    board.advance(1.0)
+    board.close()
+    text = (tmp_path / "board.trace").read_text()
+    assert " axis 0 start=500,switch=home@0:below:no\n" in text, text
+    assert l6470emu.replay(tmp_path / "board.trace").matched
