@@ -408,8 +408,18 @@ bool Chip::busy_sync_pin() const {
 }
 
 Chip::OutputLevels Chip::output_levels() const {
-  sync();  // once: what follows reads the state as of now
   OutputLevels o;
+  if (now_ < status_until_ && stby_level_ && !axis_ && layout_.busy >= 0 &&
+      (reg(Reg::STEP_MODE) & kStepModeSyncEn) == 0) {
+    // Inside the run of uniform ticks the cached STATUS is good for: BUSY is its bit and the
+    // motion neither starts nor ends, so nothing needs working out.
+    o.busy = ((status_word_ >> layout_.busy) & 1u) != 0;
+    o.flag = flag_level();
+    o.sw = sw_level_;
+    o.active = motion_active(motion_);
+    return o;
+  }
+  sync();  // once: what follows reads the state as of now
   o.busy = busy_level();
   o.flag = flag_level();
   o.sw = sw_level_;

@@ -795,6 +795,7 @@ void NativeTraceWriter::write(const TraceEvent& e) {
     if (in_run_) end_run();
     recent_.clear();
     recent_first_ = 0;
+    streak_.fill(0);
     write_line(e);
   }
   out_->event_end();
@@ -866,6 +867,7 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     straighten_recent();
     recent_.emplace_back().assign(e);
   }
+  note_recent(recent_.size() - 1);
   look_for_run();
 }
 
@@ -876,20 +878,12 @@ void NativeTraceWriter::look_for_run() {
   const std::size_t n = recent_.size();
   const std::size_t copies = open_runs() ? 3 : 2;
   for (std::size_t k = 1; k <= kMaxRepeatGroup && copies * k <= n; ++k) {
+    // The last (copies - 1) * k frames each repeat the one k before them, one period apart.
+    if (streak_[k] < (copies - 1) * k) continue;
     const Held& first = recent(n - k);
     const Held& last = recent(n - 1);
-    const Tick period = first.tick - recent(n - 2 * k).tick;
-    if (period == 0 || last.tick + last.duration - first.tick > period) continue;  // as the reader requires
-    bool same = true;
-    for (std::size_t copy = 1; copy < copies && same; ++copy) {
-      const std::size_t a = n - (copy + 1) * k, b = n - copy * k;
-      for (std::size_t j = 0; j < k && same; ++j) {
-        const Held& x = recent(a + j);
-        const Held& y = recent(b + j);
-        same = y.tick - x.tick == period && y.same_bytes(x);
-      }
-    }
-    if (!same) continue;
+    const Tick period = streak_period_[k];
+    if (last.tick + last.duration - first.tick > period) continue;  // as the reader requires
     straighten_recent();
     in_run_ = true;
     run_group_ = k;
@@ -939,6 +933,33 @@ void NativeTraceWriter::write_repeat_line() {
 
 /// The run is over: its repeat line and the frames of an unfinished repetition go to the file
 /// (an open line has them already), and they are the recent frames from now on.
+/// Frame i of recent_ (with the frames before it there) moves each group size's streak on.
+void NativeTraceWriter::note_recent(std::size_t i) {
+  const Held& b = recent(i);
+  for (std::size_t k = 1; k <= kMaxRepeatGroup; ++k) {
+    if (i < k) {
+      streak_[k] = 0;
+      continue;
+    }
+    const Held& a = recent(i - k);
+    const Tick d = b.tick - a.tick;
+    if (d == 0 || b.print != a.print || !b.same_bytes(a)) {
+      streak_[k] = 0;
+    } else if (streak_[k] != 0 && streak_period_[k] == d) {
+      ++streak_[k];
+    } else {
+      streak_[k] = 1;
+      streak_period_[k] = d;
+    }
+  }
+}
+
+/// The streaks over recent_ as it is now (after a run ended and rebuilt it).
+void NativeTraceWriter::recount_recent() {
+  streak_.fill(0);
+  for (std::size_t i = 0; i < recent_.size(); ++i) note_recent(i);
+}
+
 void NativeTraceWriter::straighten_recent() {
   if (recent_first_ == 0) return;
   std::rotate(recent_.begin(), recent_.begin() + static_cast<std::ptrdiff_t>(recent_first_), recent_.end());
@@ -969,6 +990,7 @@ void NativeTraceWriter::end_run() {
   }
   run_.clear();
   partial_ = 0;
+  recount_recent();
   // A new run may start right away among these frames (but not one that includes the old run's
   // group twice: that would have continued the run).
 }

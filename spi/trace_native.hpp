@@ -4,6 +4,7 @@
 // a complete file; collapsing runs of repeated frames into `repeat` lines). No other formats here.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <memory>
@@ -205,6 +206,13 @@ class NativeTraceWriter final : public TraceSink {
   }
   /// Makes the ring a plain vector again, oldest first (before the rare edits of recent_).
   void straighten_recent();
+  // For each group size k: how many of the latest recent frames repeat the frame k before them
+  // (same bytes) at one and the same distance in time, and that distance. A run of k frames
+  // repeated `copies` times is there when the streak reaches (copies - 1) * k.
+  std::array<std::uint64_t, kMaxRepeatGroup + 1> streak_{};
+  std::array<Tick, kMaxRepeatGroup + 1> streak_period_{};
+  void note_recent(std::size_t i);
+  void recount_recent();
   // ...and the run being collapsed: the group (its last complete repetition), the period,
   // the repetitions not yet in the file (closed lines) or in its count (open lines) and the
   // frames of the repetition under way.
