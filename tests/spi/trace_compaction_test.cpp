@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <random>
 #include <sstream>
 
 #include "spi/trace_file.hpp"
@@ -170,6 +171,69 @@ TEST(TraceCompaction, ChainsRepeatLinesAndAcceptsThemFromOtherWriters) {
   const Trace t = read_native_trace(text, "t");
   ASSERT_EQ(t.size(), 8u);
   for (std::size_t i = 0; i < 7; ++i) EXPECT_EQ(t[i].tick, i) << i;
+}
+
+/// Polls of random shapes repeated a random number of times, with odd frames, changed bytes
+/// and shifted times among them: what a collapsing writer must keep frame for frame.
+Trace random_polls(unsigned seed) {
+  std::mt19937 rng(seed);
+  auto pick = [&rng](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  Trace t;
+  t.header.chain = "2";
+  Tick at = 100;
+  for (int block = 0; block < 120; ++block) {
+    const int group = pick(1, 20), repeats = pick(0, 12);
+    const Tick gap = static_cast<Tick>(pick(10, 30));
+    std::vector<Bytes> mosi(static_cast<std::size_t>(group)), miso(mosi.size());
+    for (std::size_t j = 0; j < mosi.size(); ++j) {
+      mosi[j] = {static_cast<std::uint8_t>(pick(0, 3)), static_cast<std::uint8_t>(pick(0, 1))};
+      miso[j] = {static_cast<std::uint8_t>(pick(0, 2)), 0x7C};
+    }
+    for (int r = 0; r <= repeats; ++r) {
+      for (std::size_t j = 0; j < mosi.size(); ++j) {
+        Bytes out = miso[j];
+        if (pick(0, 40) == 0) out[1] = static_cast<std::uint8_t>(pick(0, 255));  // a changed answer
+        t.write(frame_at(at, 7, mosi[j], out));
+        at += gap + (pick(0, 50) == 0 ? 1 : 0);  // now and then a tick late
+      }
+      if (pick(0, 30) == 0) {  // another event between polls ends any run
+        TraceEvent e;
+        e.kind = TraceEventKind::pin;
+        e.tick = at;
+        e.pin = TracePin::SW;
+        e.value = static_cast<std::uint8_t>(pick(0, 1));
+        t.write(e);
+      }
+    }
+  }
+  return t;
+}
+
+TEST(TraceCompaction, RandomPollsReadBackFrameForFrameFromOpenAndClosedRepeatLines) {
+  TempDir dir;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    const Trace t = random_polls(seed);
+    // Closed lines (a stream) and open lines (a plain file rewritten in place).
+    std::ostringstream closed;
+    NativeTraceWriter stream(closed, NativeWriteOptions{false, true});
+    const std::string path = dir.file("open" + std::to_string(seed) + ".trace");
+    NativeTraceWriter file(path);
+    stream.write_header(t.header);
+    file.write_header(t.header);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      stream.write(t[i]);
+      file.write(t[i]);
+    }
+    stream.finish();
+    file.finish();
+    const std::string closed_text = closed.str();
+    const Trace from_stream = read_native_trace(closed_text, "closed.trace");
+    const Trace from_file = read_native_trace(test::read_text(path), "open.trace");
+    expect_same_events(t, from_stream);
+    expect_same_events(t, from_file);
+    // And runs were found (groups above 16 frames, short runs and the odd changes stay lines).
+    EXPECT_LT(std::count(closed_text.begin(), closed_text.end(), '\n'), static_cast<long>(t.size()) * 9 / 10) << seed;
+  }
 }
 
 TEST(TraceCompaction, RefusesMalformedRepeatLinesNamingTheLine) {
