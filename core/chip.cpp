@@ -64,6 +64,7 @@ void Chip::come_out_of_reset() {
 // ---------------------------------------------------------------- SPI
 
 std::uint8_t Chip::decode_byte(std::uint8_t byte) {
+  ++decoded_bytes_;
   if (!stby_level_) return 0x00;
   // Commands see the motion as of now; GetStatus inside a run of uniform ticks needs only
   // the flags, which cannot have changed, so polling does not work the motion out.

@@ -164,6 +164,12 @@ class alignas(64) Chip {
   /// Whether an axis is attached (without bringing it up to now()).
   bool has_axis() const { return static_cast<bool>(axis_); }
 
+  /// How many bytes have gone through the command decoder. A byte that does not (a NOP while
+  /// ready for a command, a GetStatus answered from the cached STATUS) changes nothing but the
+  /// answer being shifted out: a recording that sees this count unchanged over a frame knows
+  /// the frame changed no pin.
+  std::uint64_t decoded_bytes() const { return decoded_bytes_; }
+
   /// What a recording watches, worked out at once: the BUSY\SYNC, FLAG and SW levels
   /// (busy_sync_pin(), flag_pin(), sw_pin()) and whether the chip changes on its own later
   /// (next_event_tick() != kNever).
@@ -283,6 +289,7 @@ class alignas(64) Chip {
   std::uint8_t response_left_ = 0;  // how many of them are the answer (0x00 bytes included; the sanitizer's)
   bool collecting_ = false;
   bool stby_level_ = true;
+  std::uint64_t decoded_bytes_ = 0;  // bytes through decode_byte (decoded_bytes())
   bool ready_for_command_ = true;  // stby_level_ && !collecting_: the next byte is an opcode
   bool has_command_sink_ = false;  // command_sink_ is set: GetStatus goes the way that reports it
   mutable bool live_bits_known_ = false;

@@ -100,14 +100,12 @@ void RecordingChain::advance_to(Tick tick) {
 }
 
 void RecordingChain::select() {
-  touched();
   if (chain_.selected()) return;
   start_frame();
   chain_.select();
 }
 
 void RecordingChain::select_wire() {
-  touched();
   if (chain_.selected()) return;
   start_frame();
   chain_.select_wire();
@@ -115,11 +113,12 @@ void RecordingChain::select_wire() {
 
 void RecordingChain::start_frame() {
   frame_start_ = chain_.now();
+  decoded_at_select_ = decoded_bytes();
   frame_bytes_ = 0;
 }
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
-  touched();
+  if (!chain_.selected()) touched();  // a frame's bytes are judged when CS rises (finish_frame)
   const std::uint8_t miso = chain_.exchange(mosi);
   if (chain_.selected()) keep({&mosi, 1}, {&miso, 1});
   return miso;
@@ -147,32 +146,42 @@ void RecordingChain::keep(std::span<const std::uint8_t> tx, std::span<const std:
 }
 
 void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  touched();
+  if (!chain_.selected()) touched();
   chain_.exchange(tx, rx);
   if (chain_.selected()) keep(tx, rx);
 }
 
 void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                                    const WireSettings& wire) {
-  touched();
+  if (!chain_.selected()) touched();
   chain_.exchange_wire(tx, rx, wire);
   if (chain_.selected()) keep(tx, rx);
 }
 
 void RecordingChain::deselect() {
-  touched();
-  quiet_until_ = 0;
-  if (!chain_.selected()) return;
+  if (!chain_.selected()) {
+    touched();
+    quiet_until_ = 0;
+    return;
+  }
   chain_.deselect();
   finish_frame();
 }
 
 void RecordingChain::deselect_wire() {
-  touched();
-  quiet_until_ = 0;
-  if (!chain_.selected()) return;
+  if (!chain_.selected()) {
+    touched();
+    quiet_until_ = 0;
+    return;
+  }
   chain_.deselect_wire();
   finish_frame();
+}
+
+std::uint64_t RecordingChain::decoded_bytes() const {
+  std::uint64_t n = 0;
+  for (std::size_t k = 0; k < chain_.size(); ++k) n += chain_.chip(k).decoded_bytes();
+  return n;
 }
 
 void RecordingChain::finish_frame() {
@@ -188,6 +197,13 @@ void RecordingChain::finish_frame() {
   ++frames_;
   for (const TraceEvent& d : deferred_) emit(d);
   deferred_.clear();
+  // Only a byte through a chip's decoder changes what the chip drives: a frame of NOPs, or of
+  // GetStatus answered from the cached STATUS, leaves the last look standing (and, with every
+  // chip idle at that look, the outputs are not looked at again).
+  if (decoded_bytes() != decoded_at_select_) {
+    touched();
+    quiet_until_ = 0;
+  }
   observe_outputs();
 }
 

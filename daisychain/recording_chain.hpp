@@ -101,6 +101,7 @@ class RecordingChain final : public SpiDevice {
   void start_frame();
   void finish_frame();
   void look_at_outputs();
+  std::uint64_t decoded_bytes() const;  // over the chips: see Chip::decoded_bytes()
   void keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
   Tick first_output_change(std::size_t chip, Tick to, bool& unsure) const;
@@ -113,6 +114,7 @@ class RecordingChain final : public SpiDevice {
   Tick frame_start_ = 0;
   std::vector<std::uint8_t> tx_, rx_;  // the frame's bytes so far: the first frame_bytes_ of them
   std::size_t frame_bytes_ = 0;
+  std::uint64_t decoded_at_select_ = 0;  // decoded_bytes() when CS fell
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   void touched() {
     observed_at_ = kNever;
