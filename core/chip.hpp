@@ -289,7 +289,6 @@ class alignas(64) Chip {
   std::uint8_t response_left_ = 0;  // how many of them are the answer (0x00 bytes included; the sanitizer's)
   bool collecting_ = false;
   bool stby_level_ = true;
-  std::uint64_t decoded_bytes_ = 0;  // bytes through decode_byte (decoded_bytes())
   bool ready_for_command_ = true;  // stby_level_ && !collecting_: the next byte is an opcode
   bool has_command_sink_ = false;  // command_sink_ is set: GetStatus goes the way that reports it
   mutable bool live_bits_known_ = false;
@@ -300,6 +299,7 @@ class alignas(64) Chip {
   const Variant* table_;  // variant_ or variant_->current_mode
   mutable UniformRun run_;  // fast engine: uniform ticks left from motion_now_
   mutable Tick motion_now_ = 0;
+  std::uint64_t decoded_bytes_ = 0;  // bytes through decode_byte (decoded_bytes()), past the first cache line
   Quirks quirks_;
   StatusLayout layout_;
   MotionEngine engine_ = MotionEngine::fast;
