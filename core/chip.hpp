@@ -299,7 +299,6 @@ class alignas(64) Chip {
   const Variant* table_;  // variant_ or variant_->current_mode
   mutable UniformRun run_;  // fast engine: uniform ticks left from motion_now_
   mutable Tick motion_now_ = 0;
-  std::uint64_t decoded_bytes_ = 0;  // bytes through decode_byte (decoded_bytes()), past the first cache line
   Quirks quirks_;
   StatusLayout layout_;
   MotionEngine engine_ = MotionEngine::fast;
@@ -374,6 +373,7 @@ class alignas(64) Chip {
   mutable bool axis_event_known_ = false;
   bool axis_sw_ = true, axis_stall_ = false, axis_ocd_ = false;  // what the axis last drove
   bool drive_stale_ = true;  // the registers drive_inputs() reads changed since the axis got them
+  std::uint64_t decoded_bytes_ = 0;  // bytes through decode_byte (decoded_bytes()), last: the hot fields keep their places
   /// sync() with an axis: the same engines, stopping at every mechanical event.
   void sync_with_axis();
   /// Lets the axis apply its rules at tick `at` and passes its outputs to the chip's inputs.
