@@ -4,7 +4,7 @@
 # messages: bench/preload_roundtrips.c; its trace is a few repeat lines) and a polling Python
 # client (python3-spidev: a Move, then 100 000 polls of GetStatus and GetParam(ABS_POS), one
 # xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames). Prints each run's
-# CPU time (user + system, best of RUNS), the time per frame and the ratio recorded/unrecorded
+# CPU time (user + system, to the microsecond, best of RUNS), the time per frame and the ratio recorded/unrecorded
 # (goal: at most 1.25), then the .gz recording's size against `gzip -6` of the plain one
 # (goal: at most 1.2x). Usage: bench/recording_bench.sh [BUILD_DIR] [RUNS]
 set -euo pipefail
@@ -33,14 +33,28 @@ for _ in range(int(sys.argv[1])):
     x(0x21, 0, 0, 0)  # GetParam(ABS_POS): a new position in most polls, so few repeat lines
 EOF
 
-# cpu_seconds OUT_TRACE COMMAND...: user+system seconds of one run (OUT_TRACE "" = unrecorded).
+# cpu_seconds OUT_TRACE COMMAND...: user+system seconds of one run (OUT_TRACE "" = unrecorded),
+# from the kernel's accounting of the child to the microsecond (wait4), not /usr/bin/time's 10 ms.
 cpu_seconds() {
   local trace=$1; shift
   rm -f "$trace"
   local env=(L6470EMU_CHAIN="$chain" LD_PRELOAD="$preload")
   [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
-  /usr/bin/time -f "%U %S" -o "$work/time" env "${env[@]}" "$@" >/dev/null
-  awk '{ printf "%.4f\n", $1 + $2 }' "$work/time"
+  "$python" - "${env[@]}" -- "$@" <<'PY'
+import os, sys
+args = sys.argv[1:]
+cut = args.index("--")
+env = dict(os.environ, **dict(a.split("=", 1) for a in args[:cut]))
+null = os.open(os.devnull, os.O_WRONLY)
+pid = os.fork()
+if pid == 0:
+    os.dup2(null, 1)
+    os.execvpe(args[cut + 1], args[cut + 1:], env)
+_, status, usage = os.wait4(pid, 0)
+if status != 0:
+    sys.exit(f"recording_bench: {' '.join(args[cut + 1:])} failed (status {status})")
+print(f"{usage.ru_utime + usage.ru_stime:.6f}")
+PY
 }
 
 best() { sort -g | head -1; }
@@ -59,9 +73,9 @@ bench() {
   p=$(printf '%s\n' "${plain[@]}" | best)
   g=$(printf '%s\n' "${gz[@]}" | best)
   awk -v name="$name" -v f="$frames" -v n="$n" -v p="$p" -v g="$g" 'BEGIN {
-    printf "%-28s %9d frames  unrecorded %7.3f s (%6.0f ns/frame)\n", name, f, n, n * 1e9 / f
-    printf "%-28s %9s         plain      %7.3f s (%6.0f ns/frame)  ratio %.2f\n", "", "", p, p * 1e9 / f, p / n
-    printf "%-28s %9s         .gz        %7.3f s (%6.0f ns/frame)  ratio %.2f\n", "", "", g, g * 1e9 / f, g / n
+    printf "%-28s %9d frames  unrecorded %7.4f s (%6.0f ns/frame)\n", name, f, n, n * 1e9 / f
+    printf "%-28s %9s         plain      %7.4f s (%6.0f ns/frame)  ratio %.2f\n", "", "", p, p * 1e9 / f, p / n
+    printf "%-28s %9s         .gz        %7.4f s (%6.0f ns/frame)  ratio %.2f\n", "", "", g, g * 1e9 / f, g / n
   }'
   # The .gz against gzip -6 of the plain recording, and of its own text (the same events, but
   # with the closed repeat lines a gzip recording writes at its flush points).

@@ -410,14 +410,15 @@ bool Chip::busy_sync_pin() const {
 
 Chip::OutputLevels Chip::output_levels() const {
   OutputLevels o;
-  if (now_ < status_until_ && stby_level_ && !axis_ && layout_.busy >= 0 &&
-      (reg(Reg::STEP_MODE) & kStepModeSyncEn) == 0) {
+  const bool plain = stby_level_ && !axis_ && (reg(Reg::STEP_MODE) & kStepModeSyncEn) == 0;
+  if (plain && now_ < status_until_ && layout_.busy >= 0) {
     // Inside the run of uniform ticks the cached STATUS is good for: BUSY is its bit and the
     // motion neither starts nor ends, so nothing needs working out.
     o.busy = ((status_word_ >> layout_.busy) & 1u) != 0;
     o.flag = flag_level();
     o.sw = sw_level_;
     o.active = motion_active(motion_);
+    o.steady_through = status_until_ - 1;
     return o;
   }
   sync();  // once: what follows reads the state as of now
@@ -425,6 +426,18 @@ Chip::OutputLevels Chip::output_levels() const {
   o.flag = flag_level();
   o.sw = sw_level_;
   o.active = motion_active(motion_) || (axis_ && axis_->next_time_event() != kNever);
+  o.steady_through = now_;
+  // Without an axis or a SYNC clock the levels change on their own only where the motion
+  // leaves its run of uniform ticks (the premise of the STATUS cache: MOT_STATUS and BUSY are
+  // constant inside one), and a latched flag only by something done to the chip.
+  if (plain) {
+    if (!o.active)
+      o.steady_through = kNever;
+    else if (run_.known && now_ - motion_now_ <= run_.left && run_.left < kNever - motion_now_)
+      o.steady_through = motion_now_ + run_.left;
+  } else if (!stby_level_) {
+    o.steady_through = kNever;  // held in standby: BUSY high, nothing moves
+  }
   return o;
 }
 
@@ -439,8 +452,12 @@ bool Chip::busy_level() const {
 }
 
 bool Chip::flag_level() const {
-  const std::uint32_t enabled = reg(Reg::ALARM_EN);
   const AlarmFlags& a = latched_;
+  // Nothing latched (the usual case): released, whatever ALARM_EN enables.
+  if (!(a.uvlo | a.uvlo_adc | a.ocd | a.stall_a | a.stall_b | a.wrong_cmd | a.notperf_cmd | a.sw_evn) &&
+      a.thermal == Thermal::normal)
+    return true;
+  const std::uint32_t enabled = reg(Reg::ALARM_EN);
   for (unsigned bit = 0; bit < 8; ++bit) {
     if (((enabled >> bit) & 1u) == 0) continue;
     bool on = false;

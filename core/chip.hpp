@@ -171,10 +171,13 @@ class alignas(64) Chip {
   std::uint64_t decoded_bytes() const { return decoded_bytes_; }
 
   /// What a recording watches, worked out at once: the BUSY\SYNC, FLAG and SW levels
-  /// (busy_sync_pin(), flag_pin(), sw_pin()) and whether the chip changes on its own later
-  /// (next_event_tick() != kNever).
+  /// (busy_sync_pin(), flag_pin(), sw_pin()), whether the chip changes on its own later
+  /// (next_event_tick() != kNever), and the last tick through which the three levels are sure
+  /// to stay as they are unless something is done to the chip (a byte decoded, a pin, a fault):
+  /// the end of the motion's run of uniform ticks, or now() when that is not known.
   struct OutputLevels {
     bool busy = true, flag = true, sw = true, active = false;
+    Tick steady_through = 0;
   };
   OutputLevels output_levels() const;
   /// Changes the axis's load at runtime (no effect without an axis).

@@ -26,6 +26,13 @@ class Chain final : public SpiDevice {
   Chain(std::size_t n, const Variant& variant = l6470(), Quirks quirks = {});
 
   std::size_t size() const { return chips_.size(); }
+  /// The bytes the chips' decoders have taken so far (Chip::decoded_bytes, summed), read
+  /// without bringing a chip up to time or handing one out (a recording asks at every frame).
+  std::uint64_t decoded_bytes() const {
+    std::uint64_t n = 0;
+    for (const Chip& c : chips_) n += c.decoded_bytes();
+    return n;
+  }
   /// Chip `i`, brought up to the chain's time first (chips advance lazily). The reference
   /// shows the chip as of this call: after the chain's time moves on, call chip(i) again.
   Chip& chip(std::size_t i) const {

@@ -113,7 +113,7 @@ void RecordingChain::select_wire() {
 
 void RecordingChain::start_frame() {
   frame_start_ = chain_.now();
-  decoded_at_select_ = decoded_bytes();
+  decoded_at_select_ = chain_.decoded_bytes();
   frame_bytes_ = 0;
 }
 
@@ -161,7 +161,6 @@ void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<s
 void RecordingChain::deselect() {
   if (!chain_.selected()) {
     touched();
-    quiet_until_ = 0;
     return;
   }
   chain_.deselect();
@@ -171,17 +170,10 @@ void RecordingChain::deselect() {
 void RecordingChain::deselect_wire() {
   if (!chain_.selected()) {
     touched();
-    quiet_until_ = 0;
     return;
   }
   chain_.deselect_wire();
   finish_frame();
-}
-
-std::uint64_t RecordingChain::decoded_bytes() const {
-  std::uint64_t n = 0;
-  for (std::size_t k = 0; k < chain_.size(); ++k) n += chain_.chip(k).decoded_bytes();
-  return n;
 }
 
 void RecordingChain::finish_frame() {
@@ -200,9 +192,8 @@ void RecordingChain::finish_frame() {
   // Only a byte through a chip's decoder changes what the chip drives: a frame of NOPs, or of
   // GetStatus answered from the cached STATUS, leaves the last look standing (and, with every
   // chip idle at that look, the outputs are not looked at again).
-  if (decoded_bytes() != decoded_at_select_) {
+  if (chain_.decoded_bytes() != decoded_at_select_) {
     touched();
-    quiet_until_ = 0;
   }
   observe_outputs();
 }
@@ -226,7 +217,6 @@ void RecordingChain::backdoor(std::size_t chip, TraceEventKind kind, std::uint8_
 
 void RecordingChain::stimulus(const TraceEvent& e) {
   touched();
-  quiet_until_ = 0;
   if (chain_.selected()) {
     deferred_.push_back(e);
     return;
@@ -342,10 +332,12 @@ void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
 void RecordingChain::look_at_outputs() {
   observed_at_ = chain_.now();
   bool idle = true;
+  Tick steady = kNever;
   for (std::size_t k = 0; k < chain_.size(); ++k) {
     const Chip& c = chain_.chip(k);
     const Chip::OutputLevels levels = c.output_levels();
     idle = idle && !levels.active;
+    steady = std::min(steady, levels.steady_through);
     if (c.has_axis() && levels.sw != sw_[k]) {
       sw_[k] = levels.sw;
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), levels.sw);
@@ -361,6 +353,7 @@ void RecordingChain::look_at_outputs() {
     }
   }
   idle_ = idle;
+  quiet_until_ = std::max(quiet_until_, steady);
 }
 
 }  // namespace l6470emu

@@ -78,12 +78,11 @@ class RecordingChain final : public SpiDevice {
   /// Records BUSY/FLAG levels, and the SW level of chips with an axis, that changed since they
   /// were last seen (done after every frame and event; call it to catch a change between
   /// frames, e.g. a move ending). Looking again with nothing done to the chain through the
-  /// recorder in between is free at the same tick, and at any later one while no chip has
-  /// anything to do on its own.
+  /// recorder in between is free at the same tick, and at any later one up to where the last
+  /// look found every level sure to stay (forever when no chip had anything to do on its own).
   void observe_outputs() {
-    if (!options_.observe_outputs || observed_at_ == chain_.now() || (idle_ && observed_at_ != kNever) ||
-        chain_.selected())
-      return;
+    if (!options_.observe_outputs || chain_.selected()) return;
+    if (observed_at_ != kNever && (idle_ || chain_.now() <= quiet_until_)) return;
     look_at_outputs();
   }
   /// The chain was changed behind the recorder's back (through chain()): the next
@@ -101,7 +100,6 @@ class RecordingChain final : public SpiDevice {
   void start_frame();
   void finish_frame();
   void look_at_outputs();
-  std::uint64_t decoded_bytes() const;  // over the chips: see Chip::decoded_bytes()
   void keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
   Tick first_output_change(std::size_t chip, Tick to, bool& unsure) const;
@@ -114,18 +112,21 @@ class RecordingChain final : public SpiDevice {
   Tick frame_start_ = 0;
   std::vector<std::uint8_t> tx_, rx_;  // the frame's bytes so far: the first frame_bytes_ of them
   std::size_t frame_bytes_ = 0;
-  std::uint64_t decoded_at_select_ = 0;  // decoded_bytes() when CS fell
+  std::uint64_t decoded_at_select_ = 0;  // chain_.decoded_bytes() when CS fell
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   void touched() {
     observed_at_ = kNever;
     idle_ = false;
+    quiet_until_ = 0;
   }
   void axis_event(std::size_t chip, TraceEvent& e);
 
   std::vector<std::uint8_t> busy_, flag_, sw_;
   Tick observed_at_ = kNever;  // tick of the last look at the outputs; kNever after any change
   bool idle_ = false;          // at that look no chip had anything to do on its own
-  Tick quiet_until_ = 0;       // no output changes by itself up to here (until the chain is touched)
+  // No output changes by itself up to here (until the chain is touched): the last look's
+  // levels hold. Set by a look (the chips' steady_through) and by advance_to's look ahead.
+  Tick quiet_until_ = 0;
   std::uint64_t frames_ = 0;
 };
 

@@ -2,6 +2,7 @@
 #include "spi/trace.hpp"
 
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 
 namespace l6470emu {
@@ -282,43 +283,93 @@ std::string line_too_long() {
 
 namespace {
 
-/// Appends `v` in decimal, at least `width` digits (zeros in front).
-void append_decimal(std::string& out, std::uint64_t v, int width = 1) {
-  char buf[24];
-  char* p = buf + sizeof buf;
-  do {
-    *--p = static_cast<char>('0' + v % 10);
-    v /= 10;
-  } while (v != 0);
-  while (buf + sizeof buf - p < width) *--p = '0';
-  out.append(p, static_cast<std::size_t>(buf + sizeof buf - p));
+// Every trace line starts with a time, and a recording writes one per frame: digits go two at a
+// time, into a buffer on the stack, then into the string at once.
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+/// Writes `v` in decimal so that it ends just before `end`; returns where it starts.
+char* put_decimal(char* end, std::uint64_t v) {
+  while (v >= 100) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * (v % 100), 2);
+    v /= 100;
+  }
+  if (v >= 10) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * v, 2);
+  } else {
+    *--end = static_cast<char>('0' + v);
+  }
+  return end;
+}
+
+/// Writes the 2 * `pairs` lowest decimal digits of `v` (zeros in front) just before `end`.
+char* put_digit_pairs(char* end, std::uint64_t v, int pairs) {
+  for (int i = 0; i < pairs; ++i) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * (v % 100), 2);
+    v /= 100;
+  }
+  return end;
 }
 
 }  // namespace
 
+char* write_seconds(char* out, Tick t) {
+  char buf[kMaxTimeChars];
+  char* const end = buf + sizeof buf;
+  char* p = put_digit_pairs(end, (t % kTicksPerSecond) * 25, 4);  // 8 digits: nanoseconds / 10
+  *--p = '.';
+  p = put_decimal(p, t / kTicksPerSecond);
+  const auto n = static_cast<std::size_t>(end - p);
+  std::memcpy(out, p, n);
+  return out + n;
+}
+
+char* write_microseconds(char* out, Tick t) {
+  char buf[kMaxTimeChars];
+  char* const end = buf + sizeof buf;
+  char* p = put_digit_pairs(end, (t % kTicksPerMicrosecond) * 25, 1);
+  *--p = '.';
+  p = put_decimal(p, t / kTicksPerMicrosecond);
+  const auto n = static_cast<std::size_t>(end - p);
+  std::memcpy(out, p, n);
+  return out + n;
+}
+
 void append_seconds(std::string& out, Tick t) {
-  append_decimal(out, t / kTicksPerSecond);
-  out += '.';
-  append_decimal(out, (t % kTicksPerSecond) * 25, 8);
+  char buf[kMaxTimeChars];
+  out.append(buf, static_cast<std::size_t>(write_seconds(buf, t) - buf));
 }
 
 void append_microseconds(std::string& out, Tick t) {
-  append_decimal(out, t / kTicksPerMicrosecond);
-  out += '.';
-  append_decimal(out, (t % kTicksPerMicrosecond) * 25, 2);
+  char buf[kMaxTimeChars];
+  out.append(buf, static_cast<std::size_t>(write_microseconds(buf, t) - buf));
+}
+
+char* write_hex_bytes(char* p, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) *p++ = ' ';
+    if (!known.empty() && !known[i]) {
+      *p++ = '?';
+      *p++ = '?';
+      continue;
+    }
+    *p++ = kHex[bytes[i] >> 4];
+    *p++ = kHex[bytes[i] & 15];
+  }
+  return p;
 }
 
 void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known) {
-  static constexpr char kHex[] = "0123456789ABCDEF";
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    if (i) out += ' ';
-    if (!known.empty() && !known[i]) {
-      out += "??";
-      continue;
-    }
-    out += kHex[bytes[i] >> 4];
-    out += kHex[bytes[i] & 15];
-  }
+  if (bytes.empty()) return;
+  const std::size_t at = out.size();
+  out.resize(at + 3 * bytes.size() - 1);
+  write_hex_bytes(out.data() + at, bytes, known);
 }
 
 std::string format_seconds(Tick t) {

@@ -258,6 +258,12 @@ std::string format_microseconds(Tick t);
 /// format_seconds / format_microseconds appended to `out` (no allocation when it has room).
 void append_seconds(std::string& out, Tick t);
 void append_microseconds(std::string& out, Tick t);
+/// The most characters format_seconds or format_microseconds gives.
+inline constexpr std::size_t kMaxTimeChars = 24;
+/// format_seconds / format_microseconds written at `out` (room for kMaxTimeChars); returns the
+/// end of what was written.
+char* write_seconds(char* out, Tick t);
+char* write_microseconds(char* out, Tick t);
 
 // ---- bytes -------------------------------------------------------------------
 
@@ -273,5 +279,7 @@ constexpr int hex_digit_value(char c) {
 std::string hex_bytes(std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
 /// hex_bytes appended to `out`.
 void append_hex_bytes(std::string& out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
+/// hex_bytes written at `out` (room for 3 * bytes.size() characters); returns the end of it.
+char* write_hex_bytes(char* out, std::span<const std::uint8_t> bytes, std::span<const std::uint8_t> known = {});
 
 }  // namespace l6470emu

@@ -9,6 +9,7 @@
 #include "spi/trace_file.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cstring>
 #include <ostream>
@@ -770,6 +771,31 @@ void NativeTraceWriter::write_header(const TraceHeader& header) {
 }
 
 void NativeTraceWriter::write_line(const TraceEvent& e) {
+  constexpr std::size_t kShortFrame = 32;
+  if (e.kind == TraceEventKind::frame && e.mosi.size() <= kShortFrame && e.miso.size() <= kShortFrame) {
+    // The line of a short frame, the most common one, straight from the stack.
+    char buf[2 * kMaxTimeChars + 16 + 6 * kShortFrame];
+    char* p = write_seconds(buf, e.tick);
+    std::memcpy(p, " frame ", 7);
+    p = write_microseconds(p + 7, e.duration);
+    *p++ = 'u';
+    *p++ = 's';
+    if (!e.mosi.empty()) {
+      *p++ = ' ';
+      p = write_hex_bytes(p, e.mosi);
+    }
+    if (!e.miso.empty()) {
+      *p++ = ' ';
+      *p++ = '|';
+      if (!e.mosi.empty()) {
+        *p++ = ' ';
+        p = write_hex_bytes(p, e.miso, e.miso_known);
+      }
+    }
+    *p++ = '\n';
+    out_->append(std::string_view(buf, static_cast<std::size_t>(p - buf)));
+    return;
+  }
   line_.clear();
   append_event(line_, e);
   line_ += '\n';
@@ -793,9 +819,7 @@ void NativeTraceWriter::write(const TraceEvent& e) {
     frame(e);
   } else {
     if (in_run_) end_run();
-    recent_.clear();
-    recent_first_ = 0;
-    streak_.fill(0);
+    forget_recent();
     write_line(e);
   }
   out_->event_end();
@@ -875,15 +899,20 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
 /// lines, which cost a line even when no repetition follows) with a constant period: then the
 /// next ones may be its repetitions.
 void NativeTraceWriter::look_for_run() {
+  if (ready_ == 0) return;  // no group size has its streak (the usual case)
   const std::size_t n = recent_.size();
   const std::size_t copies = open_runs() ? 3 : 2;
   for (std::size_t k = 1; k <= kMaxRepeatGroup && copies * k <= n; ++k) {
-    // The last (copies - 1) * k frames each repeat the one k before them, one period apart.
-    if (streak_[k] < (copies - 1) * k) continue;
+    // The last (copies - 1) * k frames each repeat the one k before them, one period apart
+    // (their prints say so; their bytes must say so too).
+    if ((ready_ >> k & 1u) == 0) continue;
     const Held& first = recent(n - k);
     const Held& last = recent(n - 1);
     const Tick period = streak_period_[k];
     if (last.tick + last.duration - first.tick > period) continue;  // as the reader requires
+    bool same = true;
+    for (std::size_t j = n - (copies - 1) * k; j < n && same; ++j) same = recent(j).same_bytes(recent(j - k));
+    if (!same) continue;
     straighten_recent();
     in_run_ = true;
     run_group_ = k;
@@ -933,31 +962,56 @@ void NativeTraceWriter::write_repeat_line() {
 
 /// The run is over: its repeat line and the frames of an unfinished repetition go to the file
 /// (an open line has them already), and they are the recent frames from now on.
-/// Frame i of recent_ (with the frames before it there) moves each group size's streak on.
+/// Frame i of recent_, the one after the frames noted so far, moves each group size's streak on.
 void NativeTraceWriter::note_recent(std::size_t i) {
   const Held& b = recent(i);
-  for (std::size_t k = 1; k <= kMaxRepeatGroup; ++k) {
-    if (i < k) {
-      streak_[k] = 0;
-      continue;
-    }
-    const Held& a = recent(i - k);
-    const Tick d = b.tick - a.tick;
-    if (d == 0 || b.print != a.print || !b.same_bytes(a)) {
-      streak_[k] = 0;
-    } else if (streak_[k] != 0 && streak_period_[k] == d) {
+  const std::uint64_t* const prints = history_print_.data() + history_at_;
+  const Tick* const ticks = history_tick_.data() + history_at_;
+  // Most frames differ from the one k before them, for every k: their prints tell at once.
+  std::uint32_t match = 0;
+#pragma GCC unroll 16
+  for (std::size_t k = 1; k <= kMaxRepeatGroup; ++k)
+    match |= static_cast<std::uint32_t>(prints[k - 1] == b.print) << k;
+  match &= (2u << history_size_) - 2;  // k = 1 .. history_size_
+  const std::uint64_t copies = open_runs() ? 3 : 2;
+  std::uint32_t live = 0, ready = 0;
+  for (std::uint32_t m = match; m != 0; m &= m - 1) {
+    const unsigned k = static_cast<unsigned>(std::countr_zero(m));
+    const Tick d = b.tick - ticks[k - 1];
+    if (d == 0) continue;
+    if ((live_ >> k & 1u) != 0 && streak_period_[k] == d) {
       ++streak_[k];
     } else {
       streak_[k] = 1;
       streak_period_[k] = d;
     }
+    live |= 1u << k;
+    if (streak_[k] >= (copies - 1) * k) ready |= 1u << k;
   }
+  for (std::uint32_t gone = live_ & ~live; gone != 0; gone &= gone - 1) streak_[std::countr_zero(gone)] = 0;
+  live_ = live;
+  ready_ = ready;
+  history_at_ = (history_at_ + kMaxRepeatGroup - 1) % kMaxRepeatGroup;
+  history_print_[history_at_] = history_print_[history_at_ + kMaxRepeatGroup] = b.print;
+  history_tick_[history_at_] = history_tick_[history_at_ + kMaxRepeatGroup] = b.tick;
+  if (history_size_ < kMaxRepeatGroup) ++history_size_;
 }
 
 /// The streaks over recent_ as it is now (after a run ended and rebuilt it).
 void NativeTraceWriter::recount_recent() {
   streak_.fill(0);
+  live_ = ready_ = 0;
+  history_size_ = 0;
   for (std::size_t i = 0; i < recent_.size(); ++i) note_recent(i);
+}
+
+/// No frame before the next one counts (a pin or fault line came between).
+void NativeTraceWriter::forget_recent() {
+  recent_.clear();
+  recent_first_ = 0;
+  streak_.fill(0);
+  live_ = ready_ = 0;
+  history_size_ = 0;
 }
 
 void NativeTraceWriter::straighten_recent() {
@@ -1009,15 +1063,15 @@ void NativeTraceWriter::append_event(std::string& s, const TraceEvent& e) {
 void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
   switch (e.kind) {
     case TraceEventKind::frame:
-      s += " frame ";
+      s.append(" frame ", 7);
       append_microseconds(s, e.duration);
-      s += "us";
+      s.append("us", 2);
       if (!e.mosi.empty()) {
         s += ' ';
         append_hex_bytes(s, e.mosi);
       }
       if (!e.miso.empty()) {
-        s += " |";
+        s.append(" |", 2);
         if (!e.mosi.empty()) {
           s += ' ';
           append_hex_bytes(s, e.miso, e.miso_known);

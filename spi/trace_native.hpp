@@ -209,10 +209,21 @@ class NativeTraceWriter final : public TraceSink {
   // For each group size k: how many of the latest recent frames repeat the frame k before them
   // (same bytes) at one and the same distance in time, and that distance. A run of k frames
   // repeated `copies` times is there when the streak reaches (copies - 1) * k.
-  std::array<std::uint64_t, kMaxRepeatGroup + 1> streak_{};
+  // The streaks go by the frames' prints; look_for_run compares the bytes of a streak that is
+  // long enough before it starts a run.
+  std::array<std::uint64_t, kMaxRepeatGroup + 1> streak_{};  // valid where live_ has bit k, else 0
   std::array<Tick, kMaxRepeatGroup + 1> streak_period_{};
+  std::uint32_t live_ = 0;   // bit k: group size k has a streak
+  std::uint32_t ready_ = 0;  // bit k: group size k's streak is long enough for a run (look_for_run)
+  // The prints and ticks of the last kMaxRepeatGroup frames noted, newest first from
+  // history_at_: each is stored twice (at j and j + kMaxRepeatGroup) so that the k-th latest
+  // is at history_at_ + k - 1 without wrapping. history_size_ of them are valid.
+  std::array<std::uint64_t, 2 * kMaxRepeatGroup> history_print_{};
+  std::array<Tick, 2 * kMaxRepeatGroup> history_tick_{};
+  std::size_t history_at_ = 0, history_size_ = 0;
   void note_recent(std::size_t i);
   void recount_recent();
+  void forget_recent();
   // ...and the run being collapsed: the group (its last complete repetition), the period,
   // the repetitions not yet in the file (closed lines) or in its count (open lines) and the
   // frames of the repetition under way.
