@@ -6,7 +6,11 @@
 # xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames). Prints each run's
 # CPU time (user + system, to the microsecond, best of RUNS), the time per frame and the ratio recorded/unrecorded
 # (goal: at most 1.25), then the .gz recording's size against `gzip -6` of the plain one
-# (goal: at most 1.2x). Usage: bench/recording_bench.sh [BUILD_DIR] [RUNS]
+# (goal: at most 1.2x). With valgrind installed it then counts the instructions per frame of
+# each client unrecorded and recorded (cachegrind, startup subtracted): the same on every run and
+# under any load, where CPU time also carries what the code's placement does to the caches (a
+# tight C loop moved 1.2x to 1.4x by it). L6470EMU_BENCH_NO_VALGRIND=1 skips the counts.
+# Usage: bench/recording_bench.sh [BUILD_DIR] [RUNS]
 set -euo pipefail
 build=${1:-build}
 runs=${2:-3}
@@ -95,4 +99,39 @@ if "$python" -c 'import spidev' 2>/dev/null; then
   bench "Python client (GetStatus)" "$((py_polls * 7 + 4))" "$python" "$work/poll.py" "$py_polls"
 else
   echo "Python client: skipped ($python has no spidev module; Debian: python3-spidev)"
+fi
+
+# instructions NAME FRAMES BASE_ARG FULL_ARG COMMAND... (the frame count argument last): the
+# instructions per frame, unrecorded and recorded, each run once with BASE_ARG and once with
+# FULL_ARG so that the start-up (Python's own, the board's) drops out.
+count_instructions() {
+  local trace=$1 arg=$2; shift 2
+  rm -f "$trace"
+  local env=(L6470EMU_CHAIN="$chain" LD_PRELOAD="$preload")
+  [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
+  env "${env[@]}" valgrind --tool=cachegrind --cache-sim=no --branch-sim=no --cachegrind-out-file=/dev/null \
+    "$@" "$arg" 2>&1 >/dev/null | awk '/I *refs:/ { gsub(",", "", $NF); print $NF }' | tail -1
+}
+instructions() {
+  local name=$1 frames=$2 base=$3 full=$4; shift 4
+  local n0 n1 p0 p1
+  n0=$(count_instructions "" "$base" "$@")
+  n1=$(count_instructions "" "$full" "$@")
+  p0=$(count_instructions "$work/i.trace" "$base" "$@")
+  p1=$(count_instructions "$work/i.trace" "$full" "$@")
+  awk -v name="$name" -v f="$frames" -v n0="$n0" -v n1="$n1" -v p0="$p0" -v p1="$p1" 'BEGIN {
+    n = (n1 - n0) / f; p = (p1 - p0) / f
+    printf "%-28s %9d frames  unrecorded %7.0f instructions/frame, recorded %7.0f: ratio %.2f\n", name, f, n, p, p / n
+  }'
+}
+if [ -n "${L6470EMU_BENCH_NO_VALGRIND:-}" ]; then
+  exit 0
+elif ! command -v valgrind >/dev/null; then
+  echo "instruction counts: skipped (no valgrind; Debian: valgrind)"
+  exit 0
+fi
+echo "instructions per frame (valgrind cachegrind, start-up subtracted; independent of load):"
+instructions "C client (NOP messages)" 100000 0 100000 "$client" /dev/spidev0.0
+if "$python" -c 'import spidev' 2>/dev/null; then
+  instructions "Python client (GetStatus)" 35000 0 5000 "$python" "$work/poll.py"
 fi
