@@ -318,27 +318,26 @@ char* put_digit_pairs(char* end, std::uint64_t v, int pairs) {
 
 }  // namespace
 
-char* write_seconds(char* out, Tick t) {
+namespace {
+
+/// `t` in units of `per_unit` ticks with 2 * `pairs` decimals (each tick 25 hundred-millionths of
+/// a second: exact), written at `out`; returns the end.
+char* write_ticks_as(char* out, Tick t, Tick per_unit, int pairs) {
   char buf[kMaxTimeChars];
   char* const end = buf + sizeof buf;
-  char* p = put_digit_pairs(end, (t % kTicksPerSecond) * 25, 4);  // 8 digits: nanoseconds / 10
+  char* p = put_digit_pairs(end, (t % per_unit) * 25, pairs);
   *--p = '.';
-  p = put_decimal(p, t / kTicksPerSecond);
+  p = put_decimal(p, t / per_unit);
   const auto n = static_cast<std::size_t>(end - p);
   std::memcpy(out, p, n);
   return out + n;
 }
 
-char* write_microseconds(char* out, Tick t) {
-  char buf[kMaxTimeChars];
-  char* const end = buf + sizeof buf;
-  char* p = put_digit_pairs(end, (t % kTicksPerMicrosecond) * 25, 1);
-  *--p = '.';
-  p = put_decimal(p, t / kTicksPerMicrosecond);
-  const auto n = static_cast<std::size_t>(end - p);
-  std::memcpy(out, p, n);
-  return out + n;
-}
+}  // namespace
+
+char* write_seconds(char* out, Tick t) { return write_ticks_as(out, t, kTicksPerSecond, 4); }
+
+char* write_microseconds(char* out, Tick t) { return write_ticks_as(out, t, kTicksPerMicrosecond, 1); }
 
 void append_seconds(std::string& out, Tick t) {
   char buf[kMaxTimeChars];

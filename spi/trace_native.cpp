@@ -770,28 +770,42 @@ void NativeTraceWriter::write_header(const TraceHeader& header) {
   out_->event_end();
 }
 
+namespace {
+
+/// The most characters write_frame_body writes for a frame of these many MOSI and MISO bytes.
+constexpr std::size_t frame_body_room(std::size_t mosi, std::size_t miso) {
+  return 7 + kMaxTimeChars + 2 + 3 * mosi + 3 + 3 * miso;  // " frame " TIME "us" " BYTES" " | BYTES"
+}
+
+/// A frame line after its time (" frame 1.75us D0 | 00") written at `p`; returns its end.
+char* write_frame_body(char* p, const TraceEvent& e) {
+  std::memcpy(p, " frame ", 7);
+  p = write_microseconds(p + 7, e.duration);
+  *p++ = 'u';
+  *p++ = 's';
+  if (!e.mosi.empty()) {
+    *p++ = ' ';
+    p = write_hex_bytes(p, e.mosi);
+  }
+  if (!e.miso.empty()) {
+    *p++ = ' ';
+    *p++ = '|';
+    if (!e.mosi.empty()) {
+      *p++ = ' ';
+      p = write_hex_bytes(p, e.miso, e.miso_known);
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
 void NativeTraceWriter::write_line(const TraceEvent& e) {
   constexpr std::size_t kShortFrame = 32;
   if (e.kind == TraceEventKind::frame && e.mosi.size() <= kShortFrame && e.miso.size() <= kShortFrame) {
     // The line of a short frame, the most common one, straight from the stack.
-    char buf[2 * kMaxTimeChars + 16 + 6 * kShortFrame];
-    char* p = write_seconds(buf, e.tick);
-    std::memcpy(p, " frame ", 7);
-    p = write_microseconds(p + 7, e.duration);
-    *p++ = 'u';
-    *p++ = 's';
-    if (!e.mosi.empty()) {
-      *p++ = ' ';
-      p = write_hex_bytes(p, e.mosi);
-    }
-    if (!e.miso.empty()) {
-      *p++ = ' ';
-      *p++ = '|';
-      if (!e.mosi.empty()) {
-        *p++ = ' ';
-        p = write_hex_bytes(p, e.miso, e.miso_known);
-      }
-    }
+    char buf[kMaxTimeChars + frame_body_room(kShortFrame, kShortFrame) + 1];
+    char* p = write_frame_body(write_seconds(buf, e.tick), e);
     *p++ = '\n';
     out_->append(std::string_view(buf, static_cast<std::size_t>(p - buf)));
     return;
@@ -960,8 +974,6 @@ void NativeTraceWriter::write_repeat_line() {
   checkpoint_tick_ = run_.back().tick;
 }
 
-/// The run is over: its repeat line and the frames of an unfinished repetition go to the file
-/// (an open line has them already), and they are the recent frames from now on.
 /// Frame i of recent_, the one after the frames noted so far, moves each group size's streak on.
 void NativeTraceWriter::note_recent(std::size_t i) {
   const Held& b = recent(i);
@@ -988,7 +1000,6 @@ void NativeTraceWriter::note_recent(std::size_t i) {
     live |= 1u << k;
     if (streak_[k] >= (copies - 1) * k) ready |= 1u << k;
   }
-  for (std::uint32_t gone = live_ & ~live; gone != 0; gone &= gone - 1) streak_[std::countr_zero(gone)] = 0;
   live_ = live;
   ready_ = ready;
   history_at_ = (history_at_ + kMaxRepeatGroup - 1) % kMaxRepeatGroup;
@@ -999,7 +1010,6 @@ void NativeTraceWriter::note_recent(std::size_t i) {
 
 /// The streaks over recent_ as it is now (after a run ended and rebuilt it).
 void NativeTraceWriter::recount_recent() {
-  streak_.fill(0);
   live_ = ready_ = 0;
   history_size_ = 0;
   for (std::size_t i = 0; i < recent_.size(); ++i) note_recent(i);
@@ -1009,9 +1019,7 @@ void NativeTraceWriter::recount_recent() {
 void NativeTraceWriter::forget_recent() {
   recent_.clear();
   recent_first_ = 0;
-  streak_.fill(0);
-  live_ = ready_ = 0;
-  history_size_ = 0;
+  recount_recent();
 }
 
 void NativeTraceWriter::straighten_recent() {
@@ -1020,6 +1028,8 @@ void NativeTraceWriter::straighten_recent() {
   recent_first_ = 0;
 }
 
+/// The run is over: its repeat line and the frames of an unfinished repetition go to the file
+/// (an open line has them already), and they are the recent frames from now on.
 void NativeTraceWriter::end_run() {
   in_run_ = false;
   straighten_recent();
@@ -1062,22 +1072,12 @@ void NativeTraceWriter::append_event(std::string& s, const TraceEvent& e) {
 
 void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
   switch (e.kind) {
-    case TraceEventKind::frame:
-      s.append(" frame ", 7);
-      append_microseconds(s, e.duration);
-      s.append("us", 2);
-      if (!e.mosi.empty()) {
-        s += ' ';
-        append_hex_bytes(s, e.mosi);
-      }
-      if (!e.miso.empty()) {
-        s.append(" |", 2);
-        if (!e.mosi.empty()) {
-          s += ' ';
-          append_hex_bytes(s, e.miso, e.miso_known);
-        }
-      }
+    case TraceEventKind::frame: {
+      const std::size_t at = s.size();
+      s.resize(at + frame_body_room(e.mosi.size(), e.miso.size()));
+      s.resize(static_cast<std::size_t>(write_frame_body(s.data() + at, e) - s.data()));
       break;
+    }
     case TraceEventKind::pin:
       s += " pin " + std::to_string(e.chip) + " " + std::string(to_string(e.pin)) + (e.value ? " 1" : " 0");
       if (e.pin == TracePin::SW_AXIS) s += " axis";

@@ -211,7 +211,7 @@ class NativeTraceWriter final : public TraceSink {
   // repeated `copies` times is there when the streak reaches (copies - 1) * k.
   // The streaks go by the frames' prints; look_for_run compares the bytes of a streak that is
   // long enough before it starts a run.
-  std::array<std::uint64_t, kMaxRepeatGroup + 1> streak_{};  // valid where live_ has bit k, else 0
+  std::array<std::uint64_t, kMaxRepeatGroup + 1> streak_{};  // meaningful only where live_ has bit k
   std::array<Tick, kMaxRepeatGroup + 1> streak_period_{};
   std::uint32_t live_ = 0;   // bit k: group size k has a streak
   std::uint32_t ready_ = 0;  // bit k: group size k's streak is long enough for a run (look_for_run)
