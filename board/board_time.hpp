@@ -20,6 +20,10 @@ class HostClock {
   virtual ~HostClock() = default;
   /// CLOCK_MONOTONIC, ns.
   virtual std::int64_t monotonic_ns() = 0;
+  /// CLOCK_MONOTONIC to within a few ms, cheaper to read (the kernel's CLOCK_MONOTONIC_COARSE):
+  /// for choices made by the hundred milliseconds on every event, such as when a recording
+  /// flushes. The same clock as monotonic_ns() unless a host has a cheaper one.
+  virtual std::int64_t coarse_monotonic_ns() { return monotonic_ns(); }
   /// CLOCK_REALTIME, ns.
   virtual std::int64_t realtime_ns() = 0;
   /// Returns no earlier than CLOCK_MONOTONIC == `monotonic_ns` (at once when it has passed).

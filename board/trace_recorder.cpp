@@ -61,11 +61,10 @@ std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(
 
 ChainTraceRecorder::ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path,
                                        const std::string& board)
-    : sink_(std::move(sink)), recording_(chain, *sink_, RecordOptions{.board = board}), path_(std::move(path)) {}
+    : sink_(std::move(sink)), error_(&sink_->error), recording_(chain, *sink_, RecordOptions{.board = board}),
+      path_(std::move(path)) {}
 
 ChainTraceRecorder::~ChainTraceRecorder() = default;
-
-const std::string& ChainTraceRecorder::error() const { return sink_->error; }
 
 void ChainTraceRecorder::set_input(std::size_t chip, Pin pin, bool level) {
   if (pin == Pin::SW) recording_.set_sw_pin(chip, level);

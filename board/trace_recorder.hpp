@@ -55,13 +55,14 @@ class ChainTraceRecorder {
   const std::string& path() const { return path_; }
   std::uint64_t frames() const { return recording_.frames_recorded(); }
   /// The first write error ("" while all is well); events after it are dropped.
-  const std::string& error() const;
+  const std::string& error() const { return *error_; }
 
  private:
   class Sink;
   ChainTraceRecorder(Chain& chain, std::unique_ptr<Sink> sink, std::string path, const std::string& board);
 
   std::unique_ptr<Sink> sink_;
+  const std::string* error_;  // the sink's (read on every frame: no call into the sink)
   RecordingChain recording_;
   std::string path_;
 };

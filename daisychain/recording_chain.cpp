@@ -177,14 +177,12 @@ void RecordingChain::deselect_wire() {
 }
 
 void RecordingChain::finish_frame() {
-  TraceEvent e;
-  e.kind = TraceEventKind::frame;
+  TraceEvent& e = frame_event_;  // a frame event with every other field at its default
   e.tick = frame_start_;
   e.duration = chain_.now() - frame_start_;
   e.mosi = {tx_.data(), frame_bytes_};
-  e.miso = {rx_.data(), frame_bytes_};
   // A frame of no bytes keeps no MISO list (nothing to compare).
-  if (frame_bytes_ == 0) e.miso = {};
+  e.miso = {rx_.data(), frame_bytes_};
   emit(e);
   ++frames_;
   for (const TraceEvent& d : deferred_) emit(d);

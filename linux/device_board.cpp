@@ -21,9 +21,9 @@ DeviceBoard::DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostCloc
     : log_(log), board_(config, [&log](std::string_view line) { log.line(line); }, host) {
   board_.set_edge_sink([this](const PinEdge& e) { report_edge(e); });
   // Recordings: plain files through a shared mapping (no system call per event), gzip flushed
-  // by size and host time.
+  // by size and host time (the coarse clock: it is read on every event, to 200 ms).
   board_.set_trace_output_opener([&host](const std::string& path) {
-    return open_recording_output(path, [&host] { return host.monotonic_ns(); });
+    return open_recording_output(path, [&host] { return host.coarse_monotonic_ns(); });
   });
   unsigned spi_minor = 0;
   for (const ChainConfig& cc : config.chains) {

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -64,12 +65,22 @@ class MappedOutput final : public TraceOutput {
     const std::uint64_t word = offset / 8 * 8;
     if (!text.empty() && offset + text.size() < word + 8) {
       // The new bytes and the zero byte that ends the text, in one aligned 8-byte store.
-      char bytes[8];
-      std::memcpy(bytes, map_ + word, 8);
-      std::memcpy(bytes + (offset - word), text.data(), text.size());
-      bytes[offset - word + text.size()] = '\0';
       std::uint64_t value;
-      std::memcpy(&value, bytes, 8);
+      if (offset == word && text.size() == 7 && std::endian::native == std::endian::little) {
+        // An open repeat line's count field and newline: two loads that overlap by a byte, put
+        // together in a register (bytes stored one by one and read back as a word would wait
+        // for the stores).
+        std::uint32_t lo, hi;
+        std::memcpy(&lo, text.data(), 4);
+        std::memcpy(&hi, text.data() + 3, 4);
+        value = lo | std::uint64_t{hi >> 8} << 32;
+      } else {
+        char bytes[8];
+        std::memcpy(bytes, map_ + word, 8);
+        for (std::size_t i = 0; i < text.size(); ++i) bytes[offset - word + i] = text[i];
+        bytes[offset - word + text.size()] = '\0';
+        std::memcpy(&value, bytes, 8);
+      }
       std::atomic_ref<std::uint64_t>(*reinterpret_cast<std::uint64_t*>(map_ + word))
           .store(value, std::memory_order_release);
       size_ = offset + text.size();

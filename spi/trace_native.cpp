@@ -620,6 +620,13 @@ namespace {
 constexpr std::uint64_t kCheckpointRepetitions = 1024;  // gzip/stream: a run in progress is written this often...
 constexpr Tick kCheckpointTicks = kTicksPerSecond;      // ...or after this much trace time
 
+/// Whether the n bytes at a and b are equal (a frame's few bytes: a loop, not a call to memcmp).
+bool same_small(const std::uint8_t* a, const std::uint8_t* b, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (a[i] != b[i]) return false;
+  return true;
+}
+
 }  // namespace
 
 void NativeTraceWriter::Held::assign(const TraceEvent& e) {
@@ -651,14 +658,15 @@ bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
 }
 
 bool NativeTraceWriter::Held::same_bytes(const TraceEvent& e) const {
-  // As same_bytes(Held) with `e` held (without copying it).
-  const bool e_has_miso = !e.miso.empty();
-  if (duration != e.duration || has_miso != e_has_miso || !std::equal(mosi.begin(), mosi.end(), e.mosi.begin(), e.mosi.end()) ||
-      !std::equal(known.begin(), known.end(), e.miso_known.begin(), e.miso_known.end()))
+  // As same_bytes(Held) with `e` held (without copying it). Sizes first, then the few bytes.
+  const std::size_t n = mosi.size();
+  if (duration != e.duration || n != e.mosi.size() || miso.size() != e.miso.size() || known.size() != e.miso_known.size())
     return false;
-  if (miso.size() != e.miso.size()) return false;
+  if (!same_small(mosi.data(), e.mosi.data(), n)) return false;
+  if (known.empty()) return same_small(miso.data(), e.miso.data(), miso.size());
+  if (!same_small(known.data(), e.miso_known.data(), known.size())) return false;
   for (std::size_t i = 0; i < miso.size(); ++i)
-    if ((known.empty() || known[i]) && miso[i] != e.miso[i]) return false;
+    if (known[i] && miso[i] != e.miso[i]) return false;
   return true;
 }
 
@@ -847,15 +855,35 @@ std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group,
 
 namespace {
 
-/// The count of an open repeat line (at most kMaxOpenRepeatCount): 6 characters, right-aligned,
-/// and the newline.
-std::string_view open_count_field(std::uint64_t count, char (&buf)[7]) {
+/// The count field of an open repeat line holding `count` (at most kMaxOpenRepeatCount): 6
+/// characters, right-aligned, and the newline, as the bytes of a word in memory order (its 8th
+/// byte 0).
+std::uint64_t open_count_word(std::uint64_t count) {
+  char field[8];
   for (int i = 5; i >= 0; --i) {
-    buf[i] = count != 0 || i == 5 ? static_cast<char>('0' + count % 10) : ' ';
+    field[i] = count != 0 || i == 5 ? static_cast<char>('0' + count % 10) : ' ';
     count /= 10;
   }
-  buf[6] = '\n';
-  return {buf, 7};
+  field[6] = '\n';
+  field[7] = '\0';
+  std::uint64_t word;
+  std::memcpy(&word, field, 8);
+  return word;
+}
+
+/// The byte of `word` at memory offset i.
+constexpr unsigned byte_shift(unsigned i) { return std::endian::native == std::endian::little ? 8 * i : 8 * (7 - i); }
+
+/// The same word for one more (below kMaxOpenRepeatCount): the digits carried like an
+/// odometer's, in a register (no division, no byte stores for a wider load to trip over).
+std::uint64_t step_open_count_word(std::uint64_t word) {
+  unsigned i = 5;
+  while ((word >> byte_shift(i) & 0xff) == '9') {
+    word ^= std::uint64_t{'9' ^ '0'} << byte_shift(i);
+    --i;
+  }
+  const std::uint64_t digit = word >> byte_shift(i) & 0xff;
+  return word ^ ((digit ^ (digit == ' ' ? '1' : digit + 1)) << byte_shift(i));
 }
 
 }  // namespace
@@ -887,8 +915,8 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
       if (open_runs()) {
         // The count and the end of its line, in the 8-byte word that also holds the first byte
         // of the frame lines after it: one store makes them the repetition's count instead.
-        char field[7];
-        out_->replace_tail(count_offset_, open_count_field(line_count_, field));
+        count_word_ = step_open_count_word(count_word_);
+        out_->replace_tail(count_offset_, std::string_view(reinterpret_cast<const char*>(&count_word_), 7));
         if (line_count_ == kMaxOpenRepeatCount) end_run();
       } else if (options_.flush_each_event && checkpoint_due()) {
         write_repeat_line();
@@ -959,8 +987,8 @@ void NativeTraceWriter::write_open_repeat_line() {
   field = (field + 7) / 8 * 8;
   line_.append(static_cast<std::size_t>(field - start - line_.size()), ' ');
   count_offset_ = field;
-  char count[7];
-  line_ += open_count_field(0, count);
+  count_word_ = open_count_word(0);
+  line_.append(reinterpret_cast<const char*>(&count_word_), 7);
   put(line_);
 }
 

@@ -237,6 +237,7 @@ class NativeTraceWriter final : public TraceSink {
   std::uint64_t run_repetitions_ = 0;  // repetitions of the run so far, on every line
   Tick line_base_ = 0;            // tick of the group's last frame as the file has it before that line
   std::uint64_t count_offset_ = 0;  // open line: where its count field starts in the output
+  std::uint64_t count_word_ = 0;  // open line: its count field and newline as written, in memory order
   Tick checkpoint_tick_ = 0;
 };
 
