@@ -900,10 +900,18 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
       if (++partial_ < run_group_) {
         if (open_runs()) {
           // A killed process leaves it; taken into the count below. Only its time is new.
-          line_.clear();
-          append_seconds(line_, e.tick);
-          line_ += run_bodies_[partial_ - 1];
-          put(line_);
+          const std::string& body = run_bodies_[partial_ - 1];
+          char buf[kMaxTimeChars + 128];
+          if (body.size() <= sizeof buf - kMaxTimeChars) {  // a short frame's line, from the stack
+            char* p = write_seconds(buf, e.tick);
+            std::memcpy(p, body.data(), body.size());
+            out_->append(std::string_view(buf, static_cast<std::size_t>(p - buf) + body.size()));
+          } else {
+            line_.clear();
+            append_seconds(line_, e.tick);
+            line_ += body;
+            put(line_);
+          }
         }
         return;
       }
