@@ -9,7 +9,8 @@
 # (goal: at most 1.2x). With valgrind installed it then counts the instructions per frame of
 # each client unrecorded and recorded (cachegrind, startup subtracted): the same on every run and
 # under any load, where CPU time also carries what the code's placement does to the caches (a
-# tight C loop moved 1.2x to 1.4x by it). L6470EMU_BENCH_NO_VALGRIND=1 skips the counts.
+# tight C loop moved 1.1x to 1.4x by it before the message path was placed side by side: README,
+# § Performance). L6470EMU_BENCH_NO_VALGRIND=1 skips the counts.
 # Usage: bench/recording_bench.sh [BUILD_DIR] [RUNS]
 set -euo pipefail
 build=${1:-build}
@@ -49,6 +50,7 @@ import os, sys
 args = sys.argv[1:]
 cut = args.index("--")
 env = dict(os.environ, **dict(a.split("=", 1) for a in args[:cut]))
+env.pop("L6470EMU_BENCH_NO_VALGRIND", None)  # the benchmark's own switch: the preload would warn of it
 null = os.open(os.devnull, os.O_WRONLY)
 pid = os.fork()
 if pid == 0:
