@@ -13,7 +13,8 @@
 namespace l6470emu {
 
 /// How often a gzip recording hands its compressed data to the OS: every 64 KiB of text or
-/// every 200 ms of host time, whichever comes first.
+/// 200 ms of host time after the last flush, whichever comes first (while a run of repeated
+/// frames is all that is new, ever further apart: TraceFlushPolicy::gzip_quiet_interval_ns).
 inline constexpr std::size_t kRecordingGzipFlushBytes = 64 * 1024;
 inline constexpr std::int64_t kRecordingGzipFlushNs = 200'000'000;
 

@@ -72,7 +72,7 @@ class TraceFileWriter {
   TraceFileWriter& operator=(const TraceFileWriter&) = delete;
 
   void write(std::string_view text);
-  /// Hands everything written so far to the OS. For gzip, a sync flush point: a reader of the
+  /// Hands everything written so far to the OS. For gzip, a (partial) flush point: a reader of the
   /// file, even one cut off right after it, gets every byte written before it.
   void flush();
   /// Finishes the file (flush, gzip trailer, close); throws on a write error. Idempotent.

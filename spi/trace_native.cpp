@@ -730,7 +730,7 @@ void NativeTraceWriter::finish() {
 void NativeTraceWriter::flush_if_due() {
   if (finished_ || abandoned_) return;
   // A quiet moment in a run: its repeat line goes with the flush the output is due for.
-  if (in_run_ && !open_runs() && line_count_ > 0 && out_->flush_due().value_or(false)) write_repeat_line();
+  if (in_run_ && !open_runs() && line_count_ > 0 && out_->flush_due().value_or(false)) write_repeat_line(true);
   out_->flush_if_due();
 }
 
@@ -927,7 +927,7 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
         out_->replace_tail(count_offset_, std::string_view(reinterpret_cast<const char*>(&count_word_), 7));
         if (line_count_ == kMaxOpenRepeatCount) end_run();
       } else if (options_.flush_each_event && checkpoint_due()) {
-        write_repeat_line();
+        write_repeat_line(true);
       }
       return;
     }
@@ -1000,11 +1000,14 @@ void NativeTraceWriter::write_open_repeat_line() {
   put(line_);
 }
 
-void NativeTraceWriter::write_repeat_line() {
+void NativeTraceWriter::write_repeat_line(bool progress_only) {
   if (line_count_ == 0) return;
   line_ = format_repeat(line_base_, run_group_, line_count_, run_period_);
   line_ += '\n';
-  put(line_);
+  if (progress_only)
+    out_->append_run_progress(line_);
+  else
+    put(line_);
   line_count_ = 0;
   line_base_ = run_.back().tick;
   checkpoint_tick_ = run_.back().tick;

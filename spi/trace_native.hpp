@@ -109,7 +109,7 @@ class NativeTraceReader final : public TraceReader {
 /// Choices for a NativeTraceWriter.
 struct NativeWriteOptions {
   /// Hand every event to the OS before write() returns (a plain file: each line; a gzip file:
-  /// a sync-flush point by size and time, TraceFlushPolicy), so a process that is killed leaves
+  /// a flush point by size and time, TraceFlushPolicy), so a process that is killed leaves
   /// a trace that ends with the last event written (gzip: the last flush point).
   bool flush_each_event = true;
   /// Collapse a group of up to kMaxRepeatGroup frames that repeats with a constant period
@@ -129,7 +129,8 @@ inline constexpr std::uint64_t kMaxOpenRepeatCount = 999'999;
 /// open `repeat` line whose count is replaced in place as repetitions complete, the frames of
 /// an unfinished repetition following it as frame lines; in a gzip file, every event up to the
 /// last flush point (TraceFlushPolicy), where a run in progress is written as a closed `repeat`
-/// line at most every 1024 repetitions or every second of trace time.
+/// line (an output without a flush policy: at least every 1024 repetitions or every second of
+/// trace time).
 class NativeTraceWriter final : public TraceSink {
  public:
   /// Creates or truncates `path`. Throws std::runtime_error when it cannot.
@@ -184,7 +185,9 @@ class NativeTraceWriter final : public TraceSink {
   void frame(const TraceEvent& e);
   void look_for_run();
   void end_run();
-  void write_repeat_line();
+  /// The run's repeat line for the repetitions since the last one; `progress_only` when the run
+  /// goes on (a checkpoint), not when it ends.
+  void write_repeat_line(bool progress_only = false);
   void write_open_repeat_line();
   bool checkpoint_due() const;
   bool open_runs() const { return open_runs_; }

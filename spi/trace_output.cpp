@@ -1,6 +1,7 @@
 // TraceOutput for files (stdio or zlib through TraceFileWriter) and streams.
 #include "spi/trace_output.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <ostream>
@@ -22,6 +23,10 @@ class FileOutput final : public TraceOutput {
     if (policy_.clock) last_flush_ns_ = policy_.clock();
   }
   void append(std::string_view text) override {
+    append_run_progress(text);
+    news_ = true;
+  }
+  void append_run_progress(std::string_view text) override {
     file_.write(text);
     unflushed_ += text.size();
   }
@@ -51,13 +56,20 @@ class FileOutput final : public TraceOutput {
   const std::string& name() const override { return file_.path(); }
 
  private:
-  bool interval_passed() const {
-    return policy_.clock && policy_.clock() - last_flush_ns_ >= policy_.gzip_interval_ns;
+  /// The time between flushes: the policy's, or longer while only a run's progress is new.
+  std::int64_t interval() const {
+    std::int64_t t = policy_.gzip_interval_ns;
+    if (news_) return t;
+    for (unsigned i = 0; i < quiet_flushes_ && t < policy_.gzip_quiet_interval_ns; ++i) t *= 2;
+    return std::max(policy_.gzip_interval_ns, std::min(t, policy_.gzip_quiet_interval_ns));
   }
+  bool interval_passed() const { return policy_.clock && policy_.clock() - last_flush_ns_ >= interval(); }
   void flush() {
     file_.flush();
     unflushed_ = 0;
     flushed_once_ = true;
+    quiet_flushes_ = news_ ? 0 : quiet_flushes_ + 1;
+    news_ = false;
     if (policy_.clock) last_flush_ns_ = policy_.clock();
   }
 
@@ -65,6 +77,8 @@ class FileOutput final : public TraceOutput {
   TraceFlushPolicy policy_;
   std::uint64_t unflushed_ = 0;
   bool flushed_once_ = false;
+  bool news_ = false;           // text other than a run's progress since the last flush
+  unsigned quiet_flushes_ = 0;  // flushes in a row that took only a run's progress
   std::int64_t last_flush_ns_ = 0;
 };
 

@@ -18,11 +18,17 @@ namespace l6470emu {
 struct TraceFlushPolicy {
   /// Plain files: at the end of every event (each line is in the file before the event returns).
   bool plain_every_event = true;
-  /// gzip files: a sync-flush point once this many bytes of text came since the last one...
+  /// gzip files: a flush point once this many bytes of text came since the last one...
   std::size_t gzip_bytes = 64 * 1024;
   /// ...or once this much host time passed since the last one (checked at the end of each event
   /// and by flush_if_due()); needs `clock`.
   std::int64_t gzip_interval_ns = 200'000'000;
+  /// While all that is new is the progress of one run of repeated frames (its `repeat` line
+  /// written at a flush point), the interval doubles at each flush up to this, and drops back to
+  /// gzip_interval_ns with anything else: an unchanging poll loop costs a line and a flush
+  /// marker per 12.8 s instead of per 200 ms (which made a long run's .gz twice the size gzip -6
+  /// gives its plain trace), and a kill loses at most that much of it.
+  std::int64_t gzip_quiet_interval_ns = 12'800'000'000;
   /// The host's monotonic clock in ns, for gzip_interval_ns; empty = by size only.
   std::function<std::int64_t()> clock;
 };
@@ -33,14 +39,18 @@ class TraceOutput {
   virtual ~TraceOutput() = default;
   /// Appends `text` (whole lines). Throws std::runtime_error (one line naming the output) on failure.
   virtual void append(std::string_view text) = 0;
+  /// The same, for a line that only brings a run of repeated frames up to date (a `repeat`
+  /// line written at a flush point): an output may flush such news less often (TraceFlushPolicy).
+  virtual void append_run_progress(std::string_view text) { append(text); }
   /// The end of one event: what the output holds is handed to the OS as its policy says.
   virtual void event_end() {}
   /// Hands what is held to the OS if the policy's time has come (a quiet recording).
   virtual void flush_if_due() {}
-  /// Whether what is held would go to the OS now, by the output's own flush policy (a gzip
-  /// recording's size and time): a writer holding back a run's repeat line writes it only then,
-  /// so that no flush leaves it out and no line is written that no flush needs. nullopt: the
-  /// output has no such policy (the writer keeps its own checkpoints).
+  /// Whether what is held, with a run's progress appended (append_run_progress), would go to the
+  /// OS now, by the output's own flush policy (a gzip recording's size and time): a writer
+  /// holding back a run's repeat line writes it only then, so that no flush leaves it out and no
+  /// line is written that no flush needs. nullopt: the output has no such policy (the writer
+  /// keeps its own checkpoints).
   virtual std::optional<bool> flush_due() const { return std::nullopt; }
   /// Bytes appended so far, after replacements (where the next append goes).
   virtual std::uint64_t size() const = 0;
