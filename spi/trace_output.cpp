@@ -57,18 +57,16 @@ class FileOutput final : public TraceOutput {
 
  private:
   /// The time between flushes: the policy's, or longer while only a run's progress is new.
-  std::int64_t interval() const {
-    std::int64_t t = policy_.gzip_interval_ns;
-    if (news_) return t;
-    for (unsigned i = 0; i < quiet_flushes_ && t < policy_.gzip_quiet_interval_ns; ++i) t *= 2;
-    return std::max(policy_.gzip_interval_ns, std::min(t, policy_.gzip_quiet_interval_ns));
-  }
+  std::int64_t interval() const { return news_ ? policy_.gzip_interval_ns : quiet_interval_ns_; }
   bool interval_passed() const { return policy_.clock && policy_.clock() - last_flush_ns_ >= interval(); }
   void flush() {
     file_.flush();
     unflushed_ = 0;
     flushed_once_ = true;
-    quiet_flushes_ = news_ ? 0 : quiet_flushes_ + 1;
+    // Twice as long after each flush that took only a run's progress, back to the policy's after any other.
+    quiet_interval_ns_ = news_ ? policy_.gzip_interval_ns
+                               : std::max(policy_.gzip_interval_ns,
+                                          std::min(2 * quiet_interval_ns_, policy_.gzip_quiet_interval_ns));
     news_ = false;
     if (policy_.clock) last_flush_ns_ = policy_.clock();
   }
@@ -77,8 +75,9 @@ class FileOutput final : public TraceOutput {
   TraceFlushPolicy policy_;
   std::uint64_t unflushed_ = 0;
   bool flushed_once_ = false;
-  bool news_ = false;           // text other than a run's progress since the last flush
-  unsigned quiet_flushes_ = 0;  // flushes in a row that took only a run's progress
+  bool news_ = false;  // text other than a run's progress since the last flush
+  // The interval while only a run's progress is new: doubled by each flush that took only that.
+  std::int64_t quiet_interval_ns_ = policy_.gzip_interval_ns;
   std::int64_t last_flush_ns_ = 0;
 };
 
