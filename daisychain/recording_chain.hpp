@@ -112,7 +112,7 @@ class RecordingChain final : public SpiDevice {
   Tick frame_start_ = 0;
   std::vector<std::uint8_t> tx_, rx_;  // the frame's bytes so far: the first frame_bytes_ of them
   std::size_t frame_bytes_ = 0;
-  TraceEvent frame_event_;  // the frame written at CS rising (built anew costs more than the frame)
+  TraceEvent frame_event_;  // the frame written at CS rising, kept (building one per frame cost more than the rest)
   std::uint64_t decoded_at_select_ = 0;  // chain_.decoded_bytes() when CS fell
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   void touched() {
