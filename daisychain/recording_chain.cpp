@@ -181,7 +181,7 @@ void RecordingChain::finish_frame() {
   e.tick = frame_start_;
   e.duration = chain_.now() - frame_start_;
   e.mosi = {tx_.data(), frame_bytes_};
-  // A frame of no bytes keeps no MISO list (nothing to compare).
+  // A frame of no bytes gets an empty MISO list (nothing to compare).
   e.miso = {rx_.data(), frame_bytes_};
   emit(e);
   ++frames_;
