@@ -168,11 +168,13 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv, std:
   // own options checked: those before its first word (CLI11 would name a word of the program).
   if (argc >= 2) {
     for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
-      if (sub->get_name() != argv[1] || !(sub->get_prefix_command() || sub->get_name() == "run")) continue;
+      if (sub->get_name() != argv[1] || !(sub->get_prefix_command() || sub->get_name() == "run" || sub->get_name() == "campaign")) continue;
       for (int i = 2; i < argc && argv[i][0] == '-'; ++i) {
         const std::string arg = argv[i];
         if (arg == "--") break;
-        const std::string word = arg.substr(0, arg.find('='));
+        // "-j4": a short option with its value attached.
+        const bool short_attached = arg.size() > 2 && arg[1] != '-';
+        const std::string word = short_attached ? arg.substr(0, 2) : arg.substr(0, arg.find('='));
         const CLI::Option* known = nullptr;
         for (const CLI::Option* o : sub->get_options()) {
           for (const std::string& l : o->get_lnames()) known = known != nullptr ? known : ("--" + l == word ? o : nullptr);
@@ -185,7 +187,7 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv, std:
           err << "\n";
           return kUsageError;
         }
-        if (known->get_items_expected_min() > 0 && word == arg) ++i;  // its value follows
+        if (known->get_items_expected_min() > 0 && word == arg && !short_attached) ++i;  // its value follows
       }
     }
   }

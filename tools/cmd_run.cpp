@@ -23,6 +23,7 @@
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
 #include "linux/device_board.hpp"
+#include "tools/run_outcome.hpp"
 #include "linux/run_report.hpp"
 #include "linux/scenario_file.hpp"
 #include "linux/serve/daemon.hpp"
@@ -355,6 +356,8 @@ RunCommand::RunCommand(CLI::App& app) {
                    "kernel (the kernel's own /dev/spidevB.C and /dev/gpiochipN through CUSE and UHID, wall time; root, "
                    "modules cuse uhid hid-cp2112: static and Go programs too)")
       ->check(CLI::IsMember({"preload", "kernel"}));
+  // For `campaign`: how the run ended, as JSON (linux/run_outcome.hpp); not shown in --help.
+  cmd_->add_option("--outcome", outcome_, "write how the run ended as JSON (for campaign)")->group("");
   cmd_->add_flag("--verbose,-v", verbose_, "also print what the world did, step by step, and every expectation that held");
   cmd_->add_option("program", program_, "the program and its arguments (after --)")->required();
 }
@@ -490,6 +493,18 @@ std::optional<int> RunCommand::run() {
   out << "l6470emu run: " << expectations << " expectation" << (expectations == 1 ? "" : "s") << ", "
       << failures.size() << " failed; exit " << status << ": " << status_words(status) << why << "\n";
 
+  if (!outcome_.empty()) {
+    RunOutcome o;
+    o.status = status;
+    o.exited = exited;
+    o.code = code;
+    o.signal = signal;
+    o.end_tick = end_tick;
+    o.ended = ended;
+    o.failures = failures;
+    if (cause_block) o.detail = cause_block->detail;
+    if (!write_run_outcome(outcome_, o)) std::cerr << "l6470emu run: cannot write " << outcome_ << "\n";
+  }
   if (!junit_.empty()) {
     std::ostringstream x;
     const std::string suite = scenario.name.empty() ? "run" : scenario.name;
