@@ -310,9 +310,12 @@ void VirtualScheduler::decide_locked(bool forced) {
     if (hooks_.next_world) d = std::min(d, hooks_.next_world());
     for (const auto& [id, tick] : timers_) d = std::min(d, tick);
     if (d == kNever) {
-      // Every thread waits for something outside the process, or for nothing that can come.
+      // Every thread waits for something outside the process, or for nothing that can come
+      // (the time limit aside: it ends a run that goes on, not one that cannot).
       if (!forced && running_ == 0) check_deadlock_locked();
-      return;
+      const Tick limit = hooks_.time_limit ? hooks_.time_limit() : kNever;
+      if (limit == kNever) return;
+      d = limit;
     }
     d = std::max(d, hooks_.now());
     hooks_.advance_to(d);

@@ -59,6 +59,10 @@ class VirtualScheduler {
     /// The world's next change whatever the threads wait for (a scenario's next step, a run's
     /// time limit; kNever: none): always a wake-up, so never a deadlock while one is to come.
     std::function<Tick()> next_world;
+    /// The run's time limit (kNever: none): the clocks jump there when every thread waits for
+    /// it alone, but only once the waits were found to be no deadlock (a thread that nothing but
+    /// the limit can wake is deadlocked, limit or not).
+    std::function<Tick()> time_limit;
     std::function<void(int)> fire_timer;     ///< a timer set with set_timer() expired
     std::function<std::int64_t()> real_ns;   ///< the real monotonic clock, ns (idle grace)
     std::function<void(std::string_view)> log;  ///< diagnostics (the idle-grace line)

@@ -34,6 +34,7 @@
 #include "linux/scenario_yaml.hpp"
 #include "spi/trace.hpp"
 #include "tools/campaign_plan.hpp"
+#include "tools/cli_errors.hpp"
 #include "tools/campaign_report.hpp"
 #include "tools/run_outcome.hpp"
 #include "tools/trace_input.hpp"
@@ -77,6 +78,7 @@ std::string output_problem(const std::string& path, const std::vector<std::strin
   struct stat st {};
   const bool exists = stat(path.c_str(), &st) == 0;
   if (exists && !S_ISREG(st.st_mode)) return "not a regular file";
+  if (exists && (st.st_mode & 0222) == 0) return "a read-only file";
   for (const std::string& in : inputs) {
     struct stat is {};
     if (exists && !in.empty() && stat(in.c_str(), &is) == 0 && is.st_dev == st.st_dev && is.st_ino == st.st_ino)
@@ -208,6 +210,10 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
                    "survived-unread)");
   cmd_->add_option("--timeout", timeout_, "simulated time limit of each run (default: the scenario's, else twice the clean run and at least 10 s more)");
   cmd_->add_option("--wall-timeout", wall_timeout_s_, "wall-clock seconds a rerun may take before it is judged hang (default 60)");
+  cmd_->add_option("--reproducers", reproducers_,
+                   "which reruns get a reproducing scenario file: failing (default: silent_failure, hang, deadlock, crash "
+                   "and what --fail-on fails) or all")
+      ->check(one_of({"failing", "all"}));
   cmd_->add_flag("--list", list_, "run the clean run and print the faults and injection points it gives, without rerunning");
   cmd_->add_option("program", program_, "the program and its arguments (after --)");
   merge_ = cmd_->add_subcommand("merge", "join the JSON reports of a campaign's shards into the report of the whole");
@@ -547,7 +553,7 @@ int CampaignCommand::run_campaign() {
     for (const std::string& a : board_args) r.command += " " + shell_word(a);
     r.command += " --scenario " + shell_word(repro_path) + " --";
     for (const std::string& a : program_) r.command += " " + shell_word(a);
-    if (r.verdict == Verdict::silent_failure || r.verdict == Verdict::hang || r.verdict == Verdict::deadlock ||
+    if (reproducers_ == "all" || r.verdict == Verdict::silent_failure || r.verdict == Verdict::hang || r.verdict == Verdict::deadlock ||
         r.verdict == Verdict::crash || r.fails(fail_on)) {
       if (write_file(repro_path, yaml)) r.reproducer = repro_path;
     }

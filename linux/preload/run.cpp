@@ -69,8 +69,10 @@ bool in_run() { return g_board != nullptr; }
 
 Tick run_next_tick() {
   if (!g_board) return kNever;
-  return std::min(g_board->scenario_next_tick(), g_timeout);
+  return g_board->scenario_next_tick();
 }
+
+Tick run_time_limit() { return g_board ? g_timeout : kNever; }
 
 void run_time_reached(Tick now) {
   if (!g_board || now < g_timeout) return;

@@ -18,8 +18,10 @@ namespace l6470emu::preload {
 void start_run(DeviceBoard& board);
 /// Whether this process is part of a run.
 bool in_run();
-/// The next tick the world changes at: the scenario's next timed step or the time limit (kNever).
+/// The next tick the world changes at: the scenario's next timed step (kNever: none).
 Tick run_next_tick();
+/// The run's simulated time limit (kNever: none).
+Tick run_time_limit();
 /// Virtual time reached `now`: at or past the time limit the run ends here (report, status
 /// kTimeoutExitStatus), with what was recorded finished first.
 void run_time_reached(Tick now);

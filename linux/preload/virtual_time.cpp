@@ -146,6 +146,7 @@ VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   };
   h.next_edge = [&board] { return board.next_edge_tick(); };
   h.next_world = [] { return run_next_tick(); };
+  h.time_limit = [] { return run_time_limit(); };
   h.fire_timer = [](int fd) { fire_virtual_timerfd(fd); };
   h.real_ns = [] { return real_clock_ns(CLOCK_MONOTONIC); };
   h.log = [](std::string_view line) { log_line(line); };
