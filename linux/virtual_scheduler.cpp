@@ -308,15 +308,15 @@ void VirtualScheduler::decide_locked(bool forced) {
     }
     if (board && hooks_.next_edge) d = std::min(d, hooks_.next_edge());
     if (hooks_.next_world) d = std::min(d, hooks_.next_world());
+    const Tick limit = hooks_.time_limit ? hooks_.time_limit() : kNever;
     for (const auto& [id, tick] : timers_) d = std::min(d, tick);
     if (d == kNever) {
       // Every thread waits for something outside the process, or for nothing that can come
       // (the time limit aside: it ends a run that goes on, not one that cannot).
       if (!forced && running_ == 0) check_deadlock_locked();
-      const Tick limit = hooks_.time_limit ? hooks_.time_limit() : kNever;
       if (limit == kNever) return;
-      d = limit;
     }
+    d = std::min(d, limit);
     d = std::max(d, hooks_.now());
     hooks_.advance_to(d);
     for (auto it = timers_.begin(); it != timers_.end();) {

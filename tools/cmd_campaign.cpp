@@ -201,6 +201,8 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
   cmd_->add_option("--scenario", scenario_file_, "scenario file: its actions run in every rerun and its expectations are the oracle");
   cmd_->add_option("--faults", faults_, "faults to raise, comma separated, or all (default): every fault each chip allows");
   cmd_->add_option("--points", points_, "injection points: phases (default) or every-command");
+  cmd_->add_option("--chips", only_chips_, "only these chips, comma separated, as numbered (1, 0,2, spidev0.1:0)");
+  cmd_->add_option("--at", only_points_, "only the injection points of these names, comma separated (during_motion,at_Move_2)");
   cmd_->add_option("-j,--jobs", jobs_, "reruns at once (default: the number of CPUs)");
   cmd_->add_option("--shard", shard_, "run only shard K of N (K/N): reruns K-1, K-1+N, ...; join with campaign merge");
   cmd_->add_option("--json", json_, "write the report as JSON (reproducing scenarios are written beside it)");
@@ -431,11 +433,33 @@ int CampaignCommand::run_campaign() {
   // 3. The plan: fault by fault, chip by chip, point by point.
   std::vector<std::vector<InjectionPoint>> points(chips.size());
   for (std::size_t s = 0; s < chips.size(); ++s) points[s] = injection_points(chips[s], selection);
+  const auto words = [](const std::string& list) {
+    std::vector<std::string> out;
+    for (std::size_t at = 0; at <= list.size();) {
+      const std::size_t comma = std::min(list.find(',', at), list.size());
+      out.push_back(list.substr(at, comma - at));
+      at = comma + 1;
+    }
+    return out;
+  };
+  std::vector<bool> chip_wanted(chips.size(), only_chips_.empty());
+  for (const std::string& w : only_chips_.empty() ? std::vector<std::string>{} : words(only_chips_)) {
+    bool found = false;
+    for (std::size_t s = 0; s < chips.size(); ++s)
+      if (w == std::to_string(chips[s].number) || w == chips[s].chain_name + ":" + std::to_string(chips[s].number)) {
+        chip_wanted[s] = true;
+        found = true;
+      }
+    if (!found) return usage("--chips: the board has no chip " + quoted_text(w));
+  }
+  const std::vector<std::string> wanted_points = only_points_.empty() ? std::vector<std::string>{} : words(only_points_);
   std::vector<PlannedRerun> plan;
   for (const FaultSpec* f : selected)
     for (std::size_t s = 0; s < chips.size(); ++s) {
-      if (!fault_unavailable(f->fault, *chips[s].variant, chips[s].has_axis).empty()) continue;
-      for (const InjectionPoint& p : points[s]) plan.push_back(PlannedRerun{plan.size(), f, s, p});
+      if (!chip_wanted[s] || !fault_unavailable(f->fault, *chips[s].variant, chips[s].has_axis).empty()) continue;
+      for (const InjectionPoint& p : points[s])
+        if (wanted_points.empty() || std::find(wanted_points.begin(), wanted_points.end(), p.name) != wanted_points.end())
+          plan.push_back(PlannedRerun{plan.size(), f, s, p});
     }
   const bool user_oracle = has_expectations(user);
   const Tick rerun_timeout =

@@ -133,6 +133,13 @@ TEST_F(RunCommand, TheSimulatedTimeLimitEndsTheRunWithItsOwnStatus) {
       << r.err;
 }
 
+TEST_F(RunCommand, AProgramThatOnlyTheTimeLimitCouldWakeIsDeadlockedNotTimedOut) {
+  // A semaphore nobody posts: the limit would end the run, but nothing else ever could.
+  const RunResult r = run({"--chain", "bus=0 cs=0 chips=L6470", "--timeout", "10s"}, {client("virtual_deadlock"), "sem"});
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("deadlocked in virtual time"), std::string::npos) << r.err;
+}
+
 TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
   const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "200ms"}, python("time.sleep(30)\n"));
   EXPECT_EQ(r.status, kRunTimedOut) << r.err;
