@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -102,10 +103,20 @@ bool write_file(const std::string& path, const std::string& text) {
 // inherited); killed whole after `wall_limit_s` or when the campaign is stopped.
 struct Ended {
   int wstatus = 0;
-  bool wall_killed = false;
+  bool wall_killed = false;  // written under g_watch.m until the process was waited for
   bool stopped = false;
   bool started = false;
 };
+struct Watched {
+  pid_t pid;
+  std::chrono::steady_clock::time_point deadline;
+  Ended* end;
+};
+struct {
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<Watched> running;
+} g_watch;
 Ended run_process(const std::vector<std::string>& argv, const std::string& out_path, double wall_limit_s) {
   Ended end;
   posix_spawn_file_actions_t actions;
@@ -132,26 +143,53 @@ Ended run_process(const std::vector<std::string>& argv, const std::string& out_p
   posix_spawnattr_destroy(&attr);
   if (error != 0) return end;
   end.started = true;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wall_limit_s);
-  auto nap = std::chrono::microseconds(100);
-  while (true) {
-    const pid_t r = waitpid(pid, &end.wstatus, WNOHANG);
-    if (r == pid) break;
-    if (r < 0 && errno != EINTR) break;
-    const bool late = std::chrono::steady_clock::now() >= deadline;
-    if (late || g_stop.load()) {
-      (late ? end.wall_killed : end.stopped) = true;
-      kill(-pid, SIGKILL);
-      while (waitpid(pid, &end.wstatus, 0) < 0 && errno == EINTR) {
-      }
-      break;
-    }
-    std::this_thread::sleep_for(nap);
-    nap = std::min(nap * 2, std::chrono::microseconds(5000));
+  {
+    std::lock_guard lock(g_watch.m);
+    g_watch.running.push_back(Watched{pid, std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(wall_limit_s)), &end});
+  }
+  while (waitpid(pid, &end.wstatus, 0) < 0 && errno == EINTR) {
+  }
+  {
+    std::lock_guard lock(g_watch.m);
+    std::erase_if(g_watch.running, [pid](const Watched& w) { return w.pid == pid; });
   }
   kill(-pid, SIGKILL);  // whatever the program left behind in its group
   return end;
 }
+
+// The guard of every run in progress: ends the whole process group of one past its wall-clock
+// limit, or of all of them once the campaign is asked to stop. Lives while the campaign runs.
+class Watchdog {
+ public:
+  Watchdog() : thread_([this] { loop(); }) {}
+  ~Watchdog() {
+    {
+      std::lock_guard lock(g_watch.m);
+      done_ = true;
+    }
+    g_watch.cv.notify_all();
+    thread_.join();
+  }
+
+ private:
+  void loop() {
+    std::unique_lock lock(g_watch.m);
+    while (!done_) {
+      const auto now = std::chrono::steady_clock::now();
+      const bool stop = g_stop.load() != 0;
+      for (Watched& w : g_watch.running) {
+        if (w.end->wall_killed || w.end->stopped) continue;
+        if (stop || now >= w.deadline) {
+          (stop ? w.end->stopped : w.end->wall_killed) = true;
+          kill(-w.pid, SIGKILL);
+        }
+      }
+      g_watch.cv.wait_for(lock, std::chrono::milliseconds(20));
+    }
+  }
+  bool done_ = false;
+  std::thread thread_;
+};
 
 // Each frame's CS-fall tick and a hash of its MOSI bytes, in order.
 std::vector<std::pair<Tick, std::uint64_t>> frame_hashes(const std::string& path) {
@@ -395,6 +433,7 @@ int CampaignCommand::run_campaign() {
   const std::string clean_trace = work + "/clean.trace", clean_outcome = work + "/clean.json";
   clean_argv.insert(clean_argv.end(), {"--record", clean_trace, "--outcome", clean_outcome, "--"});
   clean_argv.insert(clean_argv.end(), program_.begin(), program_.end());
+  Watchdog watchdog;
   std::cerr << "l6470emu campaign: the clean run\n";
   const Ended clean_end = run_process(clean_argv, "", wall_timeout_s_);
   if (g_stop.load()) return 128 + g_stop.load();

@@ -11,6 +11,9 @@ libgpiod-like lines in virtual time (l6470emu.board). The pytest plugin (l6470em
 gives tests the l6470_chain, l6470_board and spidev_board fixtures; preload_library() finds
 libl6470emu-preload.so for running unmodified programs.
 l6470emu.units converts register values to physical units (step/s, mA, ...) and back.
+campaign() runs `l6470emu campaign` (every fault at every point of a program's run, each rerun
+judged) and returns its report as a CampaignResult; campaign_merge() joins shards' reports
+(docs/campaigns-python.md).
 """
 from ._l6470emu import (
     DEFAULT_MAX_FRAMES,
@@ -46,6 +49,7 @@ from ._l6470emu import (
 )
 from ._paths import preload_library, program
 from ._status import Status
+from .campaign import CampaignError, CampaignResult, FirstFailure, Rerun, campaign, campaign_merge
 from . import units
 from .board import Board
 
@@ -55,6 +59,8 @@ __all__ = [
     "TICKS_PER_SECOND",
     "Board",
     "Bridge",
+    "CampaignError",
+    "CampaignResult",
     "Chain",
     "ChipMotion",
     "CommandMark",
@@ -62,10 +68,12 @@ __all__ = [
     "Diagnostic",
     "Divergence",
     "FirstDivergence",
+    "FirstFailure",
     "Fault",
     "Reg",
     "Motion",
     "RegisterInfo",
+    "Rerun",
     "ReplayResult",
     "SANITIZER_EXIT_STATUS",
     "SanitizerError",
@@ -76,6 +84,8 @@ __all__ = [
     "TraceError",
     "TraceEvent",
     "__version__",
+    "campaign",
+    "campaign_merge",
     "check_rules",
     "decode",
     "motion",

@@ -20,6 +20,15 @@ fails the test with the sanitizer's report (l6470emu.SanitizerError in process; 
 l6470emu.SANITIZER_EXIT_STATUS under the preload). The marker's keywords change that:
   @pytest.mark.l6470_chain("L6470", check="warn", check_allow=["FRAME_LENGTH"])
 
+A fault campaign per test (docs/campaigns-python.md): a test that runs its program with
+spidev_board.run() and carries the l6470emu_campaign marker becomes one case per (fault, chip,
+injection point), e.g. test_move[ocd-chip0-during_motion]; in each, run() runs the program
+plainly, then `l6470emu campaign` for that one rerun, and the case fails when the rerun's verdict
+is one of fail_on (default silent_failure, hang, deadlock, crash) and is skipped when the clean
+run has no such point:
+  @pytest.mark.l6470emu_campaign(faults=("ocd", "uvlo"), points=("during_motion",), chips=(0,),
+                                 fail_on=None)
+
 Installed, the plugin is registered through its pytest11 entry point; from a build tree, put
 `pytest_plugins = ["l6470emu.pytest_plugin"]` in the top conftest.py (with the build's python/
 directory on PYTHONPATH).
@@ -28,7 +37,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence, Union
+from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import pytest
 
@@ -36,6 +45,29 @@ _MARKER = "l6470_chain"
 _BOARD_MARKER = "l6470_board"
 _BOARD_OPTIONS = ("bus", "cs", "options", "description", "patch_time", "record")
 _DEFAULT_CHIPS = ("L6470",)
+_CAMPAIGN_MARKER = "l6470emu_campaign"
+_CAMPAIGN_OPTIONS = ("faults", "points", "chips", "fail_on")
+#: the l6470emu_campaign marker's default faults: the ones every L6470, L6480, L6482 and
+#: powerSTEP01 can have (name faults= for an L6472, which has no stall detection: no stall_a)
+DEFAULT_CAMPAIGN_FAULTS: Tuple[str, ...] = ("ocd", "thermal_warning", "thermal_bridge_shutdown", "uvlo", "stall_a",
+                                            "sw_close", "stby_pulse")
+#: the l6470emu_campaign marker's default injection points: one per phase of a driver's traffic
+DEFAULT_CAMPAIGN_POINTS: Tuple[str, ...] = ("after_config", "during_motion", "idle_polling", "before_last_command")
+#: the l6470emu_campaign marker's default chips: chip 0 (the MISO end)
+DEFAULT_CAMPAIGN_CHIPS: Tuple[int, ...] = (0,)
+
+
+class CampaignCase(NamedTuple):
+    """One case of a test carrying the l6470emu_campaign marker: the fault raised, on which chip,
+    at which injection point of the clean run. Its id is "FAULT-chipN-POINT"."""
+    fault: str
+    chip: int
+    point: str
+
+    @property
+    def id(self) -> str:
+        """The case's part of the test id: "ocd-chip0-during_motion"."""
+        return f"{self.fault}-chip{self.chip}-{self.point}"
 
 
 def pytest_configure(config):
@@ -48,6 +80,69 @@ def pytest_configure(config):
         "markers",
         f"{_BOARD_MARKER}(bus=0, cs=0, options='', description=None, patch_time=True, record=True): "
         "how the l6470_board fixture builds its board")
+    config.addinivalue_line(
+        "markers",
+        f"{_CAMPAIGN_MARKER}(faults={DEFAULT_CAMPAIGN_FAULTS!r}, points={DEFAULT_CAMPAIGN_POINTS!r}, chips=(0,), "
+        "fail_on=None): a fault campaign of a spidev_board test: one case per (fault, chip, point), in which "
+        "spidev_board.run() also reruns the program with that fault at that point and fails the case on a verdict "
+        "of fail_on (default silent_failure, hang, deadlock, crash); docs/campaigns-python.md")
+
+
+def _names(value, what: str) -> Tuple:
+    """A marker keyword's list: a sequence, or a comma string."""
+    if isinstance(value, (str, int)):
+        value = [v.strip() for v in str(value).split(",")] if isinstance(value, str) else [value]
+    try:
+        names = tuple(value)
+    except TypeError:
+        raise pytest.UsageError(f"@pytest.mark.{_CAMPAIGN_MARKER}: {what} is a list, not {value!r}") from None
+    if not names or any(n == "" for n in names):
+        raise pytest.UsageError(f"@pytest.mark.{_CAMPAIGN_MARKER}: {what} is empty")
+    return names
+
+
+def _campaign_options(marker):
+    """The l6470emu_campaign marker's (faults, points, chips, fail_on), defaults filled in."""
+    unknown = sorted(set(marker.kwargs) - set(_CAMPAIGN_OPTIONS))
+    if unknown or marker.args:
+        raise pytest.UsageError(f"@pytest.mark.{_CAMPAIGN_MARKER}: unknown argument(s) {unknown or list(marker.args)}; "
+                                f"the keywords are {', '.join(_CAMPAIGN_OPTIONS)}")
+    faults = _names(marker.kwargs.get("faults", DEFAULT_CAMPAIGN_FAULTS), "faults")
+    points = _names(marker.kwargs.get("points", DEFAULT_CAMPAIGN_POINTS), "points")
+    chips = _names(marker.kwargs.get("chips", DEFAULT_CAMPAIGN_CHIPS), "chips")
+    try:
+        chips = tuple(int(c) for c in chips)
+    except ValueError:
+        raise pytest.UsageError(f"@pytest.mark.{_CAMPAIGN_MARKER}: chips are numbers (0 is the MISO end), "
+                                f"not {chips!r}") from None
+    fail_on = marker.kwargs.get("fail_on")
+    if fail_on is not None:
+        from .campaign import FAIL_ON_NAMES
+
+        fail_on = _names(fail_on, "fail_on")
+        bad = [v for v in fail_on if v not in FAIL_ON_NAMES]
+        if bad:
+            raise pytest.UsageError(f"@pytest.mark.{_CAMPAIGN_MARKER}: fail_on: {bad} not verdicts; "
+                                    f"verdicts: {', '.join(FAIL_ON_NAMES)}")
+    return faults, points, chips, fail_on
+
+
+def pytest_generate_tests(metafunc):
+    """A test with the l6470emu_campaign marker: one case per (fault, chip, point), through the
+    l6470emu_campaign_case fixture (which spidev_board requests)."""
+    marker = metafunc.definition.get_closest_marker(_CAMPAIGN_MARKER)
+    if marker is None:
+        return
+    if "spidev_board" not in metafunc.fixturenames:
+        other = [f for f in ("l6470_board", "l6470_chain") if f in metafunc.fixturenames]
+        raise pytest.UsageError(
+            f"{metafunc.definition.nodeid}: @pytest.mark.{_CAMPAIGN_MARKER} needs the spidev_board fixture: a campaign "
+            "reruns a program under the preload library"
+            + (f" ({' and '.join(other)} run the code in the test process, which a campaign cannot rerun)"
+               if other else ""))
+    faults, points, chips, _ = _campaign_options(marker)
+    cases = [CampaignCase(f, c, p) for f in faults for c in chips for p in points]
+    metafunc.parametrize("l6470emu_campaign_case", cases, ids=[c.id for c in cases], indirect=True)
 
 
 def _check(request):

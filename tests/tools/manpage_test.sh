@@ -10,7 +10,7 @@ if LC_ALL=C grep -n '[^ -~	]' "$page" | head -3 | grep .; then fail "non-ASCII b
 text=$(LC_ALL=C MANWIDTH=100 man -l "$page" 2>&1) || fail "man -l $page"
 printf '%s\n' "$text" | grep -n '??\|<micro>\|warning' && fail "characters man could not show in ASCII (above)"
 printf '%s\n' "$text" | grep -q 'looked at, in us' || fail "no 'in us' for the VCD sampling option"
-for sub in demo tables serve ctl replay decode convert plot units; do
+for sub in demo tables serve ctl run campaign replay decode convert plot units; do
   printf '%s\n' "$text" | grep -q "^   $sub\$" || fail "no SUBCOMMANDS section for $sub"
 done
 utf8=$(LC_ALL=C.UTF-8 MANWIDTH=100 man -l "$page" 2>&1)
