@@ -396,6 +396,16 @@ int CampaignCommand::run_campaign() {
     else if (faults_ != "all") return usage("--faults: " + std::string(f->name) + " cannot be raised on this board: " + why);
   }
   if (selected.empty()) return usage("no fault to raise on this board");
+  for (std::size_t at = 0; !only_chips_.empty() && at <= only_chips_.size();) {
+    const std::size_t comma = std::min(only_chips_.find(',', at), only_chips_.size());
+    const std::string w = only_chips_.substr(at, comma - at);
+    at = comma + 1;
+    bool found = false;
+    for (std::size_t c = 0; c < probe.chain_count(); ++c)
+      for (std::size_t k = 0; k < probe.chip_count(c); ++k)
+        found = found || w == std::to_string(k) || w == probe.chain_name(c) + ":" + std::to_string(k);
+    if (!found) return usage("--chips: the board has no chip " + quoted_text(w));
+  }
 
   // 2. The clean run, recorded.
   const char* tmp = std::getenv("TMPDIR");

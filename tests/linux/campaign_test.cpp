@@ -172,6 +172,7 @@ TEST_F(Campaign, BadInputIsOneLineAndStatusTwoAndNothingRuns) {
       {{"--json", "/no/such/dir/c.json"}, "cannot write '/no/such/dir/c.json'"},
       {{"--junit", client("campaign_driver")}, "an output never overwrites an input"},
       {{"--fail-on", "silent"}, "'silent' is not a verdict"},
+      {{"--chips", "1"}, "--chips: the board has no chip '1'"},
   };
   for (const auto& [args, said] : cases) {
     const RunResult r = campaign(args, "careful");
