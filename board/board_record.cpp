@@ -45,7 +45,7 @@ bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, 
   if (c.recorder)
     c.recorder->fault(chip, fault, value);
   else
-    apply_fault(c.chain.chip(chip), fault, value);
+    apply_fault(c.chain, chip, fault, value);
   emit_changes(c, c.chain.now());
   return true;
 }

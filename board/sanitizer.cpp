@@ -267,7 +267,7 @@ void ChainChecker::check_decode(std::size_t k, const Chip& chip, std::uint8_t by
   // An answer a new GetParam, GetStatus or ResetDevice drops, or a command's last argument byte
   // with bits the chip drops: the chips raise no flag for either, so the checker looks before
   // they decode.
-  if (!chip.spi_enabled()) return;
+  if (!chain_.hears_frame(k)) return;  // in standby, or missing the frame (a lost_frame fault)
   const std::size_t len = static_cast<std::size_t>(frame_bytes_);
   if (chip.arguments_missing() == 1) {
     check_unused_bits(k, chip, (chip.arguments_so_far() << 8) | byte, decoded_at(len, k));

@@ -119,7 +119,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
         act.kind = enum_at<ScenarioAction::Kind>(a, "kind", 6);
         act.chip = chip_of(a.at("chip"));
         act.level = a.at("level").get<bool>();
-        act.fault = enum_at<TraceFault>(a, "fault", 7);
+        act.fault = enum_at<TraceFault>(a, "fault", kTraceFaultCount);
         act.value = a.at("value").get<std::uint8_t>();
         act.load.inertia_g_mm2 = a.at("load").at(0).get<std::uint32_t>();
         act.load.friction_uNm = a.at("load").at(1).get<std::uint32_t>();

@@ -62,6 +62,9 @@ std::string describe(const ScenarioAction& a) {
     case ScenarioAction::Kind::fault:
       if (a.fault == TraceFault::THERMAL) return "THERMAL " + std::string(thermal_name(a.value));
       if (a.fault == TraceFault::ADCIN) return "ADCIN " + std::to_string(a.value);
+      if (a.fault == TraceFault::POWER_CYCLE) return "power cycle (reset)";
+      if (a.fault == TraceFault::MISO_FLIP) return "MISO flip of bit " + std::to_string(a.value & 7u) + " in the next frame";
+      if (a.fault == TraceFault::LOST_FRAME) return "next frame lost";
       return std::string(to_string(a.fault)) + (a.value ? " on" : " off");
     case ScenarioAction::Kind::load:
       return "load: inertia " + std::to_string(a.load.inertia_g_mm2) + " g·mm², friction " +

@@ -81,6 +81,9 @@ void ChainTraceRecorder::fault(std::size_t chip, TraceFault fault, std::uint8_t 
     case TraceFault::STALL_B: recording_.set_stall(chip, Bridge::B, value != 0); break;
     case TraceFault::THERMAL: recording_.set_thermal(chip, static_cast<Thermal>(value & 3)); break;
     case TraceFault::ADCIN: recording_.set_adc_input(chip, value); break;
+    case TraceFault::POWER_CYCLE: recording_.power_cycle(chip); break;
+    case TraceFault::MISO_FLIP: recording_.miso_flip(chip, value); break;
+    case TraceFault::LOST_FRAME: recording_.lost_frame(chip); break;
   }
 }
 
@@ -101,6 +104,18 @@ void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value) {
     case TraceFault::STALL_B: chip.set_stall(Bridge::B, value != 0); break;
     case TraceFault::THERMAL: chip.set_thermal(static_cast<Thermal>(value & 3)); break;
     case TraceFault::ADCIN: chip.set_adc_input(value); break;
+    case TraceFault::POWER_CYCLE: chip.power_cycle(); break;
+    case TraceFault::MISO_FLIP:
+    case TraceFault::LOST_FRAME: break;  // the wire's: see the Chain overload
+  }
+}
+
+void apply_fault(Chain& chain, std::size_t chip, TraceFault fault, std::uint8_t value) {
+  switch (fault) {
+    case TraceFault::POWER_CYCLE: chain.power_cycle(chip); break;
+    case TraceFault::MISO_FLIP: chain.arm_miso_flip(chip, value & 7u); break;
+    case TraceFault::LOST_FRAME: chain.arm_lost_frame(chip); break;
+    default: apply_fault(chain.chip(chip), fault, value); break;
   }
 }
 

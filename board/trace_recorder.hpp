@@ -67,8 +67,12 @@ class ChainTraceRecorder {
   std::string path_;
 };
 
-/// Applies a backdoor event to `chip` without recording it (what ChainTraceRecorder::fault
-/// does when nothing records).
+/// Applies a backdoor event to chip `chip` of `chain` without recording it (what
+/// ChainTraceRecorder::fault does when nothing records): the wire faults and POWER_CYCLE go
+/// through the chain (Chain::arm_miso_flip, arm_lost_frame, power_cycle).
+void apply_fault(Chain& chain, std::size_t chip, TraceFault fault, std::uint8_t value);
+/// Applies a chip's own backdoor event (not a wire fault: those need the chain, and are
+/// ignored here; POWER_CYCLE leaves a chain's shift register to the chain).
 void apply_fault(Chip& chip, TraceFault fault, std::uint8_t value);
 
 /// The trace file of chain `name` when a board with `chains` chains records to `path`: `path`

@@ -604,6 +604,14 @@ void Chip::set_overcurrent(bool active) {
   apply_forced_hiz();
 }
 
+void Chip::power_cycle() {
+  sync();
+  touched();
+  reset_logic();  // the shaft's travel is kept: the rotor does not move with the power
+  if (stby_level_) come_out_of_reset();
+  if (axis_) axis_after_change();
+}
+
 void Chip::set_stall(Bridge bridge, bool active) {
   (bridge == Bridge::A ? condition_.stall_a : condition_.stall_b) = active;
   latches_dirty();

@@ -150,6 +150,13 @@ class alignas(64) Chip {
   void set_overcurrent(bool active);
   /// Stall (step loss) detected on a bridge.
   void set_stall(Bridge bridge, bool active);
+  /// A brown-out: the chip loses its supply and gets it back at once. It comes back as a new
+  /// chip does (registers at reset, ABS_POS 0, bridges HiZ, UVLO latched, FLAG low), dropping
+  /// any command being collected and any answer; its pins, the physical conditions (thermal,
+  /// overcurrent...) and its axis, whose rotor stays where it is with the bridges off, remain.
+  /// With STBY\RST held low the logic stays in reset. The shift register is the chain's
+  /// (Chain::power_cycle empties it).
+  void power_cycle();
 
   // ---- the mechanical world (optional) ----------------------------------------
 

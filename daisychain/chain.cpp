@@ -1,6 +1,7 @@
 // Chain: the shared shift register of a daisy chain, kept as a ring buffer so a
 // byte costs O(1) whatever the chain length. Chips in standby break the chain
-// (their SDO floats; modelled as 0x00 and the bytes they receive are lost).
+// (their SDO floats; modelled as 0x00 and the bytes they receive are lost). A chip missing a
+// frame (a lost_frame fault) is one for that frame; a MISO flip touches only what the host reads.
 #include "daisychain/chain.hpp"
 
 #include <algorithm>
@@ -28,10 +29,77 @@ void Chain::select() {
     chips_touched_ = false;
   }
   standby_in_frame_ = any_standby_;
+  odd_frame_ = standby_in_frame_;
+  if (faults_armed_) take_armed_faults();
   // A chip in standby drives 0x00 and holds nothing it could pass on.
   if (standby_in_frame_)
     for (std::size_t i = 0; i < chips_.size(); ++i)
-      if (!chips_[i].spi_enabled()) set_shift_register(i, 0x00);
+      if (!listening(i)) set_shift_register(i, 0x00);
+}
+
+void Chain::take_armed_faults() {
+  faults_armed_ = false;
+  flips_.swap(flips_armed_);  // flips_ is empty between frames
+  flips_armed_.clear();
+  if (!deaf_armed_.empty()) {
+    const std::size_t n = chips_.size();
+    if (deaf_.size() != n) {
+      deaf_.assign(n, 0);
+      deaf_held_.assign(n, 0);
+    }
+    for (const std::size_t k : deaf_armed_) {
+      deaf_[k] = 1;
+      deaf_held_[k] = shift_register(k);  // what it holds on to while it hears nothing
+    }
+    deaf_armed_.clear();
+    deaf_in_frame_ = true;
+    standby_in_frame_ = true;  // the standby model, for this frame, for the deaf chips
+  }
+  odd_frame_ = standby_in_frame_ || !flips_.empty();
+  end_of_frame_work_ = end_of_frame_work_ || deaf_in_frame_ || !flips_.empty();
+}
+
+void Chain::arm_miso_flip(std::size_t i, std::uint8_t bit) {
+  (void)chips_.at(i);
+  const auto mask = static_cast<std::uint8_t>(1u << (bit & 7u));
+  faults_armed_ = true;
+  for (auto& f : flips_armed_)
+    if (f.first == i) {
+      f.second = static_cast<std::uint8_t>(f.second | mask);
+      return;
+    }
+  flips_armed_.emplace_back(i, mask);
+}
+
+void Chain::arm_lost_frame(std::size_t i) {
+  (void)chips_.at(i);
+  faults_armed_ = true;
+  if (std::find(deaf_armed_.begin(), deaf_armed_.end(), i) == deaf_armed_.end()) deaf_armed_.push_back(i);
+}
+
+void Chain::power_cycle(std::size_t i) {
+  (void)chips_.at(i);
+  if (selected_) {
+    power_cycles_.push_back(i);
+    end_of_frame_work_ = true;
+    return;
+  }
+  power_cycle_now(i);
+}
+
+void Chain::power_cycle_now(std::size_t i) {
+  chip(i).power_cycle();  // (chip() brings it up to now and forgets that the chain was quiet)
+  chips_touched_ = true;
+  // Its shift register and SDO latch lost their contents with the power.
+  store_latches();
+  latch_[i] = 0;
+  set_shift_register(i, 0x00);
+  if (i < received_.size()) received_[i] = 0x00;
+}
+
+void Chain::apply_flips(std::uint64_t at, std::span<std::uint8_t> rx) const {
+  for (const auto& [k, mask] : flips_)
+    if (k >= at && k - at < rx.size()) rx[k - at] = static_cast<std::uint8_t>(rx[k - at] ^ mask);
 }
 
 bool Chain::any_in_standby() const {
@@ -41,6 +109,13 @@ bool Chain::any_in_standby() const {
 }
 
 std::uint8_t Chain::exchange(std::uint8_t mosi) {
+  const std::uint64_t at = bytes_in_frame_;
+  std::uint8_t miso = shift_byte(mosi);
+  if (odd_frame_ && selected_ && !flips_.empty()) apply_flips(at, {&miso, 1});
+  return miso;
+}
+
+std::uint8_t Chain::shift_byte(std::uint8_t mosi) {
   if (!selected_) return 0x00;  // SDO is high impedance while CS is high
   ++bytes_in_frame_;
   const std::size_t n = ring_.size();
@@ -49,19 +124,25 @@ std::uint8_t Chain::exchange(std::uint8_t mosi) {
   head_ = head_ + 1 == n ? 0 : head_ + 1;
   if (standby_in_frame_) {
     for (std::size_t i = 0; i < n; ++i)
-      if (!chips_[i].spi_enabled()) set_shift_register(i, 0x00);
-    if (!chips_[0].spi_enabled()) return 0x00;
+      if (!listening(i)) set_shift_register(i, 0x00);
+    if (!listening(0)) return 0x00;
   }
   return miso;
 }
 
+void Chain::exchange_odd(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
+  const std::uint64_t at = bytes_in_frame_;
+  exchange_slow(tx, rx);
+  if (selected_ && !flips_.empty()) apply_flips(at, rx.first(tx.size()));
+}
+
 void Chain::exchange_slow(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
-  if (!selected_ || tx.size() < ring_.size()) {
-    for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = exchange(tx[i]);
+  if (!selected_ || (standby_in_frame_ && tx.size() < ring_.size())) {
+    for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = shift_byte(tx[i]);
     return;
   }
-  if (exchange_through_standby(tx, rx)) return;
-  shift_bytes(tx, rx);  // STBY rose since the frame began: a plain shift
+  if (standby_in_frame_ && exchange_through_standby(tx, rx)) return;
+  shift_bytes(tx, rx);  // no chip in standby (STBY rose since the frame began): a plain shift
 }
 
 namespace {
@@ -146,7 +227,7 @@ bool Chain::exchange_through_standby(std::span<const std::uint8_t> tx, std::span
   const std::size_t n = ring_.size();
   std::size_t first = n, last = 0;
   for (std::size_t i = 0; i < n; ++i)
-    if (!chips_[i].spi_enabled()) {
+    if (!listening(i)) {
       first = std::min(first, i);
       last = i;
     }
@@ -164,9 +245,55 @@ bool Chain::exchange_through_standby(std::span<const std::uint8_t> tx, std::span
 void Chain::deselect() {
   if (!selected_) return;
   selected_ = false;
+  if (end_of_frame_work_) return end_odd_frame(bytes_in_frame_ != 0);
   // A CS pulse without clocks leaves the shift registers as they are: nothing is decoded.
   if (bytes_in_frame_ == 0) return;
   decode_shift_registers();
+}
+
+void Chain::end_odd_frame(bool clocked) {
+  end_of_frame_work_ = false;
+  if (clocked) {
+    if (deaf_in_frame_)
+      decode_around_deaf_chips();
+    else
+      decode_shift_registers();
+  } else {
+    // A CS pulse without clocks: the wire faults wait for a frame that clocks a byte.
+    for (const auto& [k, mask] : flips_) {
+      faults_armed_ = true;
+      bool merged = false;
+      for (auto& f : flips_armed_)
+        if (f.first == k) {
+          f.second = static_cast<std::uint8_t>(f.second | mask);
+          merged = true;
+        }
+      if (!merged) flips_armed_.emplace_back(k, mask);
+    }
+    if (deaf_in_frame_)
+      for (std::size_t k = 0; k < deaf_.size(); ++k)
+        if (deaf_[k]) {
+          set_shift_register(k, deaf_held_[k]);
+          arm_lost_frame(k);
+        }
+  }
+  flips_.clear();
+  if (deaf_in_frame_) {
+    std::fill(deaf_.begin(), deaf_.end(), std::uint8_t{0});
+    deaf_in_frame_ = false;
+  }
+  for (const std::size_t k : power_cycles_) power_cycle_now(k);
+  power_cycles_.clear();
+}
+
+void Chain::decode_around_deaf_chips() {
+  // The frame's end for the chips that heard it; a deaf chip's register gets back the byte it
+  // held, which it shifts out in the next frame.
+  ++frames_;
+  quiet_ = false;
+  const std::size_t n = chips_.size();
+  for (std::size_t i = 0, slot = head_; i < n; ++i, slot = slot + 1 == n ? 0 : slot + 1)
+    ring_[slot] = deaf_[i] ? deaf_held_[i] : chips_[i].on_byte_at(now_, ring_[slot]);
 }
 
 // The loop every polled byte of a chain goes through. Its start is pinned to a 64-byte boundary:

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/chip.hpp"
@@ -47,7 +48,7 @@ class Chain final : public SpiDevice {
   void select() override;
   std::uint8_t exchange(std::uint8_t mosi) override;
   void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override {
-    if (!selected_ || standby_in_frame_) return exchange_slow(tx, rx);
+    if (!selected_ || odd_frame_) return exchange_odd(tx, rx);
     shift_bytes(tx, rx);
   }
   void deselect() override;
@@ -67,6 +68,25 @@ class Chain final : public SpiDevice {
 
   /// The earliest next_event_tick() of the chips.
   Tick next_event_tick() const;
+
+  // ---- the wire's faults and a chip's brown-out (the backdoor; board/ records them) ----------
+  // The two wire faults are one-shot: armed now, they act on the next CS frame that clocks at
+  // least one byte (one armed while CS is low waits for the frame after this one) and are gone.
+
+  /// The next frame: bit `bit` (0..7) of MISO byte `i` as the host reads it (the byte chip `i`
+  /// drives, at its position in the chain) is inverted. The chips are not affected: it is the wire.
+  void arm_miso_flip(std::size_t i, std::uint8_t bit);
+  /// The next frame: chip `i` misses it, as if its CS stayed high. It shifts nothing (like a
+  /// chip in standby it drives 0x00 and what reaches it is lost), decodes nothing, and its
+  /// register keeps the byte it held; its state and motion are untouched.
+  void arm_lost_frame(std::size_t i);
+  /// Chip `i` loses power and is back at once (Chip::power_cycle): its shift register and SDO
+  /// latch are empty. With CS low it happens at the CS rising edge, after the chips decode (a
+  /// recording writes it after the frame: a replay does the same).
+  void power_cycle(std::size_t i);
+  /// Whether chip `i` takes part in the frame under way (or the next one): not in standby, and
+  /// not missing it for a lost frame.
+  bool hears_frame(std::size_t i) const { return listening(i); }
 
   /// CS frames that clocked at least one byte, since the chain was made.
   std::uint64_t frames() const { return frames_; }
@@ -89,9 +109,9 @@ class Chain final : public SpiDevice {
   void select_wire() override;
   /// Clocks `tx` as a host with `wire` settings does; rx gets what the host reads.
   void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override {
-    if (tx.size() == 1 && selected_ && wire.mode == 3 && !wire.lsb_first && !standby_in_frame_) {
+    if (tx.size() == 1 && selected_ && wire.mode == 3 && !wire.lsb_first && !odd_frame_) {
       // One byte on the byte path (a clock-idle-high byte: the latches are where previous_bit0 says).
-      rx[0] = last_out0_ = exchange(tx[0]);
+      rx[0] = last_out0_ = shift_byte(tx[0]);
       mosi_level_ = tx[0] & 1u;
       latch_at_ = LatchAt::previous_bit0;
       return;
@@ -120,6 +140,22 @@ class Chain final : public SpiDevice {
  private:
   void set_shift_register(std::size_t i, std::uint8_t v) { ring_[(head_ + i) % ring_.size()] = v; }
   bool any_in_standby() const;
+  /// Whether chip `i` shifts and decodes in this frame: SPI enabled and not deaf (a lost frame).
+  bool listening(std::size_t i) const { return chips_[i].spi_enabled() && (!deaf_in_frame_ || !deaf_[i]); }
+  /// exchange() of one byte as the chips see it (no wire fault applied).
+  std::uint8_t shift_byte(std::uint8_t mosi);
+  /// exchange() of a span when odd_frame_ (or CS high): the chips' way, then the wire's flips.
+  void exchange_odd(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
+  /// The armed wire faults become this frame's (at the CS falling edge).
+  void take_armed_faults();
+  /// Inverts the bits of this frame's MISO flips that fall in `rx`, the frame's bytes from `at` on.
+  void apply_flips(std::uint64_t at, std::span<std::uint8_t> rx) const;
+  /// The CS rising edge of a frame with a deaf chip or a power cycle waiting: the chips decode
+  /// (the deaf ones not), the wire faults end, the power cycles happen.
+  void end_odd_frame(bool clocked);
+  /// decode_shift_registers() leaving out the deaf chips, whose registers get their bytes back.
+  void decode_around_deaf_chips();
+  void power_cycle_now(std::size_t i);
   /// The CS rising edge of a frame that clocked bytes: every chip decodes its register (SPI
   /// mode 3, whole bytes) and loads its answer byte into it. A frame of NOPs to a quiet chain
   /// (see quiet_) is known to change nothing.
@@ -140,7 +176,18 @@ class Chain final : public SpiDevice {
   std::vector<std::uint8_t> ring_;  // shift registers; logical register i is ring_[(head_ + i) % N]
   std::size_t head_ = 0;
   bool selected_ = false;
-  bool standby_in_frame_ = false;  // some chip was in standby at the CS falling edge
+  bool standby_in_frame_ = false;  // some chip was in standby (or deaf) at the CS falling edge
+  bool odd_frame_ = false;         // standby_in_frame_, or a MISO flip in this frame: not the plain byte path
+
+  // The wire faults (arm_miso_flip, arm_lost_frame) and power cycles waiting for a CS rising edge.
+  bool faults_armed_ = false;      // something is armed for the next frame
+  bool deaf_in_frame_ = false;     // a chip misses this frame (deaf_)
+  bool end_of_frame_work_ = false;  // deaf_in_frame_ or power cycles waiting: deselect takes the long way
+  std::vector<std::pair<std::size_t, std::uint8_t>> flips_armed_, flips_;  // (chip, mask): next frame's, this frame's
+  std::vector<std::size_t> deaf_armed_;     // chips to miss the next frame
+  std::vector<std::uint8_t> deaf_;          // per chip: misses this frame (sized on first use)
+  std::vector<std::uint8_t> deaf_held_;     // per chip: the byte its register held at the CS falling edge
+  std::vector<std::size_t> power_cycles_;   // chips to power-cycle at the CS rising edge
   mutable bool chips_touched_ = true;  // chip() handed out a chip since the last look at STBY pins
   // Every chip is ready for an opcode with no answer byte left (Chip::on_nop_at), as the last
   // frame of NOPs left them and nothing reached them since: the next frame of NOPs changes nothing.

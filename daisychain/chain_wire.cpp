@@ -19,7 +19,7 @@ namespace l6470emu {
 // frames with a chip in standby (whose register is forced to 0) they are stored.
 
 std::uint8_t Chain::latch_at(std::size_t i) const {
-  if (!chips_[i].spi_enabled()) return 0;  // a chip in standby has its logic, latch included, reset
+  if (!listening(i)) return 0;  // a chip in standby has its logic, latch included, reset (a deaf one: see below)
   switch (latch_at_) {
     case LatchAt::stored: return i < latch_.size() ? latch_[i] : 0;
     case LatchAt::register_msb: return shift_register(i) >> 7;
@@ -77,11 +77,11 @@ std::uint8_t Chain::wire_byte(std::uint8_t host_byte, const WireSettings& wire) 
     // shifted out is taken before the shift.
     if (latch_.size() != chips_.size()) latch_.assign(chips_.size(), 0);
     for (std::size_t i = 0; i < chips_.size(); ++i)
-      latch_[i] = chips_[i].spi_enabled() ? static_cast<std::uint8_t>(shift_register(i) & 1u) : 0;
-    out0 = exchange(in);
+      latch_[i] = listening(i) ? static_cast<std::uint8_t>(shift_register(i) & 1u) : 0;
+    out0 = shift_byte(in);
     latch_at_ = LatchAt::stored;
   } else {
-    out0 = exchange(in);
+    out0 = shift_byte(in);
     last_out0_ = out0;
     latch_at_ = fx.stale_first_bit ? LatchAt::register_msb : LatchAt::previous_bit0;
   }
@@ -96,19 +96,22 @@ void Chain::exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std:
     return;
   }
   if (tx.empty()) return;
+  const std::uint64_t at = bytes_in_frame_;
   if (wire.mode == 3 && !wire.lsb_first && !standby_in_frame_) {
     // The byte path. A clock-idle-high byte leaves every latch where previous_bit0 finds it,
     // whatever the frame's earlier bytes left.
     if (tx.size() == 1)
-      rx[0] = exchange(tx[0]);
+      rx[0] = shift_byte(tx[0]);
     else
-      exchange(tx, rx);
+      shift_bytes(tx, rx);
     last_out0_ = rx[tx.size() - 1];
     mosi_level_ = tx[tx.size() - 1] & 1u;
     latch_at_ = LatchAt::previous_bit0;
-    return;
+  } else {
+    for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = wire_byte(tx[i], wire);
   }
-  for (std::size_t i = 0; i < tx.size(); ++i) rx[i] = wire_byte(tx[i], wire);
+  // A MISO flip is on the wire to the host: the bytes as the host reads them.
+  if (!flips_.empty()) apply_flips(at, rx.first(tx.size()));
 }
 
 void Chain::deselect_wire() {
@@ -128,6 +131,10 @@ void Chain::deselect_wire() {
       std::memcpy(received_.data(), ring_.data() + head_, n - head_);
       std::memcpy(received_.data() + (n - head_), ring_.data(), head_);
     }
+    // A chip that missed the frame received nothing: its register keeps the byte it held.
+    if (deaf_in_frame_)
+      for (std::size_t i = 0; i < n; ++i)
+        if (deaf_[i]) received_[i] = deaf_held_[i];
     if (latch_at_ == LatchAt::register_msb)
       latch_at_ = LatchAt::received_msb;
     else if (latch_at_ == LatchAt::previous_bit0)

@@ -150,6 +150,10 @@ class Decoder {
       what = "fault " + std::string(to_string(e.fault)) + " ";
       if (e.fault == TraceFault::THERMAL) what += thermal_name(e.value);
       else if (e.fault == TraceFault::ADCIN) what = "ADCIN level: ADC_OUT code " + std::to_string(e.value);
+      else if (e.fault == TraceFault::POWER_CYCLE) what = "power cycle (brown-out): the chip is back as at power-up";
+      else if (e.fault == TraceFault::MISO_FLIP)
+        what = "MISO flip: bit " + std::to_string(e.value & 7u) + " of this chip's MISO byte in the next frame inverted";
+      else if (e.fault == TraceFault::LOST_FRAME) what = "lost frame: the chip misses the next frame";
       else what += level ? "on" : "off";
     }
     put(t, stamp(t) + chip_column(e.chip) + what, e.chip);

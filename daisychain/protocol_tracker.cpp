@@ -66,7 +66,8 @@ void ProtocolTracker::begin_frame(const TraceEvent& frame, std::span<std::uint8_
   for (std::size_t k = 0; k < n; ++k) {
     ChipTrack& c = chips_[k];
     Answer& a = c.answer;
-    if (a.active && k < len) {
+    const bool hears = chain_.hears_frame(k);
+    if (a.active && k < len && hears) {
       // The answer byte in chip k's register left on MISO byte k.
       const unsigned shift = 8u * (a.len - 1u - a.loaded);
       a.seen = static_cast<std::uint8_t>(a.seen | (1u << a.loaded));
@@ -77,7 +78,8 @@ void ProtocolTracker::begin_frame(const TraceEvent& frame, std::span<std::uint8_
       }
     }
     const Chip& chip = chain_.chip(k);
-    c.enabled = chip.spi_enabled();
+    c.enabled = hears;
+    c.lost = hears != chip.spi_enabled();  // not in standby: missing this frame (a lost frame)
     c.was_collecting = chip.collecting_arguments();
     c.table = &chip.registers();
     c.byte = chain_.shift_register(k);
@@ -163,7 +165,8 @@ void ProtocolTracker::end_frame() {
         if (observer_) {
           ProtocolEvent e = event_here(ProtocolEvent::Kind::diagnostic, k);
           e.issue = ProtocolEvent::Issue::standby;
-          e.text = "in standby (STBY\\RST low): ignores " + host_byte_for(k);
+          e.text = (c.lost ? "misses this frame (a lost frame: as if its CS stayed high): ignores "
+                           : "in standby (STBY\\RST low): ignores ") + host_byte_for(k);
           report(std::move(e));
         }
         continue;
@@ -332,6 +335,14 @@ void ProtocolTracker::apply(const TraceEvent& e) {
     case TraceFault::STALL_B: chip.set_stall(Bridge::B, e.value != 0); break;
     case TraceFault::THERMAL: chip.set_thermal(static_cast<Thermal>(e.value & 3u)); break;
     case TraceFault::ADCIN: chip.set_adc_input(e.value); break;
+    case TraceFault::POWER_CYCLE:
+      chain_.power_cycle(e.chip);  // (between frames: at once)
+      // A power cycle resets the logic: no command, no answer.
+      if (c.answer.active) finish_answer(e.chip, AnswerEnd::replaced);
+      c.collect.active = false;
+      break;
+    case TraceFault::MISO_FLIP: chain_.arm_miso_flip(e.chip, e.value & 7u); break;
+    case TraceFault::LOST_FRAME: chain_.arm_lost_frame(e.chip); break;
   }
 }
 
@@ -352,7 +363,7 @@ std::string ProtocolTracker::describe_miso(std::size_t i) const {
   if (i >= n) return "MOSI byte " + std::to_string(i - n) + " coming back through the chain (frame longer than the chain)";
   const ChipTrack& c = chips_[i];
   const Answer& a = c.answer;
-  if (!c.enabled) return numbering_.label(i) + ": in standby, drives 0x00";
+  if (!c.enabled) return numbering_.label(i) + (c.lost ? ": misses this frame (lost frame), drives 0x00" : ": in standby, drives 0x00");
   if (!a.active) return numbering_.label(i) + ": no answer pending (0x00)";
   return numbering_.label(i) + ": byte " + std::to_string(a.loaded + 1) + " of " + std::to_string(a.len) +
          " of the " + opcode_name(a.opcode, *a.table) + " answer (decoded in frame " + std::to_string(a.frame + 1) +
@@ -362,7 +373,7 @@ std::string ProtocolTracker::describe_miso(std::size_t i) const {
 std::string ProtocolTracker::describe_decode(std::size_t k) const {
   const ChipTrack& c = chips_[k];
   std::string s = numbering_.label(k) + ": ";
-  if (!c.enabled) return s + "in standby, ignores " + byte_hex(c.byte);
+  if (!c.enabled) return s + (c.lost ? "misses this frame (lost frame), ignores " : "in standby, ignores ") + byte_hex(c.byte);
   if (c.was_collecting) {
     const Collect& col = c.collect;
     return s + "argument byte " + std::to_string(col.seen + 1) + " of " + std::to_string(col.op.arg_bytes) + " of " +

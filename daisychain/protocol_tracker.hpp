@@ -143,7 +143,8 @@ class ProtocolTracker {
     Collect collect;
     // Filled by begin_frame for end_frame.
     std::uint8_t byte = 0;
-    bool enabled = true;
+    bool enabled = true;  // takes part in the frame (Chain::hears_frame)
+    bool lost = false;    // not in standby, yet misses the frame (a lost frame)
     bool was_collecting = false;
     const Variant* table = nullptr;
   };

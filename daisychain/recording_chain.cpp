@@ -325,6 +325,20 @@ void RecordingChain::set_stall(std::size_t chip, Bridge bridge, bool active) {
            static_cast<std::uint8_t>(bridge == Bridge::A ? TraceFault::STALL_A : TraceFault::STALL_B), active);
 }
 
+void RecordingChain::power_cycle(std::size_t chip) {
+  chain_.power_cycle(chip);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::POWER_CYCLE), 0);
+}
+void RecordingChain::miso_flip(std::size_t chip, std::uint8_t bit) {
+  // Armed for the frame after any under way, as a replay arms it after this frame's line.
+  chain_.arm_miso_flip(chip, bit & 7u);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::MISO_FLIP), bit & 7u);
+}
+void RecordingChain::lost_frame(std::size_t chip) {
+  chain_.arm_lost_frame(chip);
+  backdoor(chip, TraceEventKind::fault, static_cast<std::uint8_t>(TraceFault::LOST_FRAME), 0);
+}
+
 // observe_outputs() comes here unless nothing can have changed since the last look: the same
 // tick, or a look that found every chip with nothing to do on its own and no touch since.
 void RecordingChain::look_at_outputs() {

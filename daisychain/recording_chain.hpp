@@ -60,6 +60,14 @@ class RecordingChain final : public SpiDevice {
   void set_thermal(std::size_t chip, Thermal t);
   void set_overcurrent(std::size_t chip, bool active);
   void set_stall(std::size_t chip, Bridge bridge, bool active);
+  /// Chip `chip` loses power and is back at once (Chain::power_cycle); recorded as
+  /// `fault K POWER_CYCLE`. With CS low it happens, and is written, after the frame.
+  void power_cycle(std::size_t chip);
+  /// The next frame's MISO byte at chip `chip`'s position has bit `bit` inverted
+  /// (Chain::arm_miso_flip); recorded as `fault K MISO_FLIP BIT`.
+  void miso_flip(std::size_t chip, std::uint8_t bit);
+  /// Chip `chip` misses the next frame (Chain::arm_lost_frame); recorded as `fault K LOST_FRAME`.
+  void lost_frame(std::size_t chip);
   /// The load on chip `chip`'s axis changes (no effect on the chip without an axis, but recorded).
   void set_axis_load(std::size_t chip, const LoadSpec& load);
   /// An axis is attached to chip `chip` (replacing one it had), recorded as an `axis` event

@@ -229,7 +229,7 @@ class Reader {
     if (!m.IsMap()) fail(m, "do", "expects a map such as {sw: close}");
     const std::vector<std::string> kinds{"sw", "stby_rst", "fault", "thermal", "adcin", "load", "block", "supply_mV"};
     std::vector<std::string> keys = kinds;
-    keys.insert(keys.end(), {"clear", "chip", "chain"});
+    keys.insert(keys.end(), {"clear", "bit", "chip", "chain"});
     check_keys(m, "do:", keys);
     ScenarioAction a;
     a.chip = chip_of(m, dflt);
@@ -237,6 +237,7 @@ class Reader {
     for (const auto& k : kinds) n += m[k] ? 1 : 0;
     if (n != 1) fail(m, "do", "names exactly one action: sw, stby_rst, fault, thermal, adcin, load, block or supply_mV");
     if (m["clear"] && !m["fault"]) fail(m["clear"], "clear", "only with fault:");
+    if (m["bit"] && !m["fault"]) fail(m["bit"], "bit", "only with fault: miso_flip");
     if (const YAML::Node v = m["sw"]) {
       a.kind = ScenarioAction::Kind::sw;
       a.level = choice(v, "sw", {"close", "open"}) == "open";
@@ -245,10 +246,20 @@ class Reader {
       a.level = choice(v, "stby_rst", {"low", "high"}) == "high";
     } else if (const YAML::Node v = m["fault"]) {
       a.kind = ScenarioAction::Kind::fault;
-      const std::string f = choice(v, "fault", {"ocd", "uvlo", "uvlo_adc", "stall_a", "stall_b"});
-      a.fault = f == "ocd" ? TraceFault::OCD : f == "uvlo" ? TraceFault::UVLO : f == "uvlo_adc" ? TraceFault::UVLO_ADC
-                : f == "stall_a" ? TraceFault::STALL_A : TraceFault::STALL_B;
-      a.value = m["clear"] && flag(m["clear"], "clear") ? 0 : 1;
+      const std::string f =
+          choice(v, "fault", {"ocd", "uvlo", "uvlo_adc", "stall_a", "stall_b", "reset", "miso_flip", "lost_frame"});
+      if (f == "reset" || f == "miso_flip" || f == "lost_frame") {
+        // One-shot events: nothing to clear.
+        if (m["clear"]) fail(m["clear"], "clear", "not with fault: " + f + " (it happens once: nothing to clear)");
+        if (m["bit"] && f != "miso_flip") fail(m["bit"], "bit", "only with fault: miso_flip");
+        a.fault = f == "reset" ? TraceFault::POWER_CYCLE : f == "miso_flip" ? TraceFault::MISO_FLIP : TraceFault::LOST_FRAME;
+        a.value = f == "miso_flip" ? static_cast<std::uint8_t>(m["bit"] ? integer(m["bit"], "bit", 0, 7) : 7) : 0;
+      } else {
+        if (m["bit"]) fail(m["bit"], "bit", "only with fault: miso_flip");
+        a.fault = f == "ocd" ? TraceFault::OCD : f == "uvlo" ? TraceFault::UVLO : f == "uvlo_adc" ? TraceFault::UVLO_ADC
+                  : f == "stall_a" ? TraceFault::STALL_A : TraceFault::STALL_B;
+        a.value = m["clear"] && flag(m["clear"], "clear") ? 0 : 1;
+      }
     } else if (const YAML::Node v = m["thermal"]) {
       a.kind = ScenarioAction::Kind::fault;
       a.fault = TraceFault::THERMAL;

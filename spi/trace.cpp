@@ -28,6 +28,9 @@ std::string_view to_string(TraceFault fault) {
     case TraceFault::STALL_B: return "STALL_B";
     case TraceFault::THERMAL: return "THERMAL";
     case TraceFault::ADCIN: return "ADCIN";
+    case TraceFault::POWER_CYCLE: return "POWER_CYCLE";
+    case TraceFault::MISO_FLIP: return "MISO_FLIP";
+    case TraceFault::LOST_FRAME: return "LOST_FRAME";
   }
   return "?";
 }

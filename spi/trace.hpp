@@ -77,7 +77,16 @@ enum class TraceFault : std::uint8_t {
   STALL_B,   ///< stall / step loss on bridge B; 1 = on, 0 = off
   THERMAL,   ///< die temperature class: value is a core Thermal (0 normal .. 3 device shutdown)
   ADCIN,     ///< ADCIN level: value is the 5-bit ADC_OUT code
+  // One-shot events (nothing to end):
+  POWER_CYCLE,  ///< a brown-out: the chip loses power and is back at once (Chip::power_cycle); value 0
+  MISO_FLIP,    ///< the wire: the next frame's MISO byte at the chip's position has bit `value` (0..7) inverted
+  LOST_FRAME,   ///< the wire: the chip misses the next frame, as if its CS stayed high; value 0
 };
+/// How many TraceFault values there are.
+inline constexpr unsigned kTraceFaultCount = static_cast<unsigned>(TraceFault::LOST_FRAME) + 1;
+/// Whether a fault is one of the wire's (MISO_FLIP, LOST_FRAME): it acts on the chain's next
+/// CS frame, not on the chip.
+constexpr bool is_wire_fault(TraceFault f) { return f == TraceFault::MISO_FLIP || f == TraceFault::LOST_FRAME; }
 
 /// Datasheet names used in the native format and in reports.
 std::string_view to_string(TracePin pin);

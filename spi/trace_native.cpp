@@ -499,14 +499,23 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     } else {
       e.kind = TraceEventKind::fault;
       bool found = false;
-      for (TraceFault f : {TraceFault::UVLO, TraceFault::UVLO_ADC, TraceFault::OCD, TraceFault::STALL_A,
-                           TraceFault::STALL_B, TraceFault::THERMAL, TraceFault::ADCIN})
-        if (name == to_string(f)) {
-          e.fault = f;
+      for (unsigned f = 0; f < kTraceFaultCount; ++f)
+        if (name == to_string(static_cast<TraceFault>(f))) {
+          e.fault = static_cast<TraceFault>(f);
           found = true;
         }
-      if (!found) fail("unknown fault " + quoted(name) + " (UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL or ADCIN)");
-      if (e.fault == TraceFault::THERMAL) {
+      if (!found)
+        fail("unknown fault " + quoted(name) +
+             " (UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL, ADCIN, POWER_CYCLE, MISO_FLIP or LOST_FRAME)");
+      if (e.fault == TraceFault::POWER_CYCLE || e.fault == TraceFault::LOST_FRAME) {
+        // One-shot: the line ends with the name.
+        if (!value.empty()) fail("too many fields in " + quoted(line) + " (" + std::string(name) + " takes no value)");
+        e.value = 0;
+      } else if (e.fault == TraceFault::MISO_FLIP) {
+        unsigned long bit = 0;
+        if (!parse_uint(value, 7, bit)) fail("MISO_FLIP " + quoted(value) + " is not a bit number (0..7)");
+        e.value = static_cast<std::uint8_t>(bit);
+      } else if (e.fault == TraceFault::THERMAL) {
         found = false;
         for (std::uint8_t t = 0; t < 4; ++t)
           if (value == thermal_name(t)) {
@@ -1122,8 +1131,12 @@ void NativeTraceWriter::append_event_body(std::string& s, const TraceEvent& e) {
       if (e.pin == TracePin::SW_AXIS) s += " axis";
       break;
     case TraceEventKind::fault:
-      s += " fault " + std::to_string(e.chip) + " " + std::string(to_string(e.fault)) + " ";
-      if (e.fault == TraceFault::THERMAL)
+      s += " fault " + std::to_string(e.chip) + " " + std::string(to_string(e.fault));
+      if (e.fault == TraceFault::POWER_CYCLE || e.fault == TraceFault::LOST_FRAME) break;  // no value
+      s += ' ';
+      if (e.fault == TraceFault::MISO_FLIP)
+        s += std::to_string(e.value & 7u);
+      else if (e.fault == TraceFault::THERMAL)
         s += thermal_name(e.value);
       else if (e.fault == TraceFault::ADCIN)
         s += std::to_string(e.value);

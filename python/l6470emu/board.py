@@ -191,9 +191,12 @@ class Board:
         """Drives an input pin (SW, STCK, STBY_RST) as the physical world would."""
         self._core.drive(chain, chip, _pin_index(pin), bool(level))
 
-    def fault(self, chip: int, fault, value: int = 1, *, chain: int = 0) -> None:
-        """A backdoor event: UVLO, UVLO_ADC, OCD, STALL_A, STALL_B 0/1, THERMAL 0..3, ADCIN 0..31."""
-        self._core.fault(chain, chip, fault, value)
+    def fault(self, chip: int, fault, value: Optional[int] = None, *, chain: int = 0) -> None:
+        """A backdoor event: UVLO, UVLO_ADC, OCD, STALL_A, STALL_B 0/1 (default 1), THERMAL 0..3,
+        ADCIN 0..31; the one-shot POWER_CYCLE (a brown-out) and LOST_FRAME (the chip misses the
+        next CS frame) take no value, MISO_FLIP the bit 0..7 (default 7) inverted in the chip's
+        MISO byte of the next frame."""
+        self._core.fault(chain, chip, fault, -1 if value is None else value)
 
     def attach_axis(self, chip: int = 0, spec: str = "default", *, chain: int = 0) -> None:
         """Puts a motor, load, stops and switches behind chip `chip`: the board description's

@@ -210,7 +210,10 @@ void bind_board(py::module_& m) {
   b.def("fault", [](PyBoard& s, long long c, long long k, py::handle fault, long long value) {
     const std::size_t chain = chain_arg(s, c);
     const TraceFault f = fault_from(fault);
-    const long long hi = f == TraceFault::THERMAL ? 3 : f == TraceFault::ADCIN ? 31 : 1;
+    // value -1: the default (on; bit 7 for MISO_FLIP); POWER_CYCLE and LOST_FRAME take none.
+    if (value < 0) value = f == TraceFault::MISO_FLIP ? 7 : f == TraceFault::POWER_CYCLE || f == TraceFault::LOST_FRAME ? 0 : 1;
+    if (f == TraceFault::POWER_CYCLE || f == TraceFault::LOST_FRAME) value = 0;
+    const long long hi = f == TraceFault::THERMAL ? 3 : f == TraceFault::ADCIN ? 31 : f == TraceFault::MISO_FLIP ? 7 : 1;
     if (value < 0 || value > hi) throw py::value_error("fault value " + std::to_string(value) + ": 0.." + std::to_string(hi));
     s.board().inject_fault(chain, chip_arg(s, chain, k), f, static_cast<std::uint8_t>(value));
   });

@@ -447,7 +447,13 @@ Time does not advance by itself: call advance() between frames as a bus would ta
              const std::size_t k = chip_arg(p, chip);
              const TraceFault f = fault_from(fault);
              std::uint8_t v = 0;
-             if (f == TraceFault::THERMAL)
+             if (f == TraceFault::POWER_CYCLE || f == TraceFault::LOST_FRAME)
+               v = 0;  // one-shot: no value
+             else if (f == TraceFault::MISO_FLIP)
+               v = value.is_none() ? 7 : static_cast<std::uint8_t>(int_in_range(value, "value", 0, 7));
+             else if (value.is_none())
+               v = 1;
+             else if (f == TraceFault::THERMAL)
                v = static_cast<std::uint8_t>(thermal_from(value));
              else if (f == TraceFault::ADCIN)
                v = static_cast<std::uint8_t>(int_in_range(value, "value", 0, 31));
@@ -455,9 +461,11 @@ Time does not advance by itself: call advance() between frames as a bus would ta
                v = level_arg(value, "value");
              p.fault(k, f, v);
            },
-           py::arg("chip"), py::arg("fault"), py::arg("value"),
-           "A backdoor event as a trace writes it: fault UVLO/UVLO_ADC/OCD/STALL_A/STALL_B with value True/False, "
-           "THERMAL with a Thermal, ADCIN with a code 0..31.");
+           py::arg("chip"), py::arg("fault"), py::arg("value") = py::none(),
+           "A backdoor event as a trace writes it: fault UVLO/UVLO_ADC/OCD/STALL_A/STALL_B with value True/False "
+           "(default True), THERMAL with a Thermal, ADCIN with a code 0..31; the one-shot POWER_CYCLE (a brown-out) "
+           "and LOST_FRAME (the chip misses the next frame) take no value, MISO_FLIP the bit 0..7 (default 7) "
+           "inverted in the chip's MISO byte of the next frame.");
 
   // ---- recording and diagnostics --------------------------------------------------------
   c.def_property_readonly("recording", &PyChain::recording, "Whether frames, pins and faults are being recorded.")

@@ -180,9 +180,11 @@ TraceFault fault_from(py::handle value) {
   if (py::isinstance<TraceFault>(value)) return value.cast<TraceFault>();
   if (py::isinstance<py::str>(value)) {
     const std::string s = value.cast<std::string>();
-    for (std::uint8_t f = 0; f <= static_cast<std::uint8_t>(TraceFault::ADCIN); ++f)
+    for (unsigned f = 0; f < kTraceFaultCount; ++f)
       if (same_name(to_string(static_cast<TraceFault>(f)), s)) return static_cast<TraceFault>(f);
-    throw py::value_error("fault: \"" + s + "\" is not UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL or ADCIN");
+    throw py::value_error("fault: \"" + s +
+                          "\" is not UVLO, UVLO_ADC, OCD, STALL_A, STALL_B, THERMAL, ADCIN, POWER_CYCLE, MISO_FLIP or "
+                          "LOST_FRAME");
   }
   throw py::type_error("fault: an l6470emu.Fault or its name is needed");
 }

@@ -104,7 +104,7 @@ void PyChain::set_adc_input(std::size_t chip, std::uint8_t code) { fault(chip, T
 
 void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
   if (!rec_) {
-    apply_fault(chain_->chip(chip), fault, value);
+    apply_fault(*chain_, chip, fault, value);
     return;
   }
   switch (fault) {
@@ -115,6 +115,9 @@ void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
     case TraceFault::STALL_B: rec_->set_stall(chip, Bridge::B, value != 0); break;
     case TraceFault::THERMAL: rec_->set_thermal(chip, static_cast<Thermal>(value & 3)); break;
     case TraceFault::ADCIN: rec_->set_adc_input(chip, value); break;
+    case TraceFault::POWER_CYCLE: rec_->power_cycle(chip); break;
+    case TraceFault::MISO_FLIP: rec_->miso_flip(chip, value); break;
+    case TraceFault::LOST_FRAME: rec_->lost_frame(chip); break;
   }
 }
 

@@ -59,7 +59,10 @@ void bind_registers(py::module_& m) {
       .value("STALL_A", TraceFault::STALL_A)
       .value("STALL_B", TraceFault::STALL_B)
       .value("THERMAL", TraceFault::THERMAL)
-      .value("ADCIN", TraceFault::ADCIN);
+      .value("ADCIN", TraceFault::ADCIN)
+      .value("POWER_CYCLE", TraceFault::POWER_CYCLE)
+      .value("MISO_FLIP", TraceFault::MISO_FLIP)
+      .value("LOST_FRAME", TraceFault::LOST_FRAME);
 
   py::class_<RegisterInfo>(m, "RegisterInfo", "One row of a variant's register table.")
       .def_property_readonly("address", [](const RegisterInfo& r) { return r.address; }, "PARAM address 0x01..0x1F")

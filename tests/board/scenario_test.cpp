@@ -3,12 +3,19 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
 #include <stdexcept>
 #include <vector>
 
 #include "board/board.hpp"
 #include "board/scenario.hpp"
 #include "board/scenario_runner.hpp"
+#include "daisychain/replay.hpp"
+#include "spi/trace_native.hpp"
 #include "spi/message.hpp"
 
 namespace l6470emu::test {
@@ -316,6 +323,74 @@ TEST(ScenarioRunner, ChipNumbersAreTheUsersNumbering) {
   EXPECT_TRUE(runner.failures().empty());
 }
 
+ScenarioAction one_shot(TraceFault fault, std::size_t chip, std::uint8_t value = 0) {
+  ScenarioAction a;
+  a.kind = ScenarioAction::Kind::fault;
+  a.fault = fault;
+  a.value = value;
+  a.chip.number = chip;
+  return a;
+}
+
+TEST(ScenarioRunner, TheOneShotFaultsActAtTheirTicksAndTheRecordingReplaysThemExactly) {
+  VirtualBoard v("chips=L6470,L6470,L6470; time=virtual");
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("l6470emu-one-shot-" + std::to_string(std::random_device{}()) + ".trace")).string();
+  ASSERT_EQ(v.board.start_recording(0, path), "");
+  Scenario s;
+  s.steps.push_back(at_time(ticks_from_ms(10), one_shot(TraceFault::POWER_CYCLE, 0), "s.yaml:1"));
+  s.steps.push_back(at_time(ticks_from_ms(20), one_shot(TraceFault::MISO_FLIP, 1, 7), "s.yaml:2"));
+  s.steps.push_back(at_time(ticks_from_ms(30), one_shot(TraceFault::LOST_FRAME, 0), "s.yaml:3"));
+  ScenarioRunner runner(v.board, s);
+  std::array<std::uint8_t, 3> rx{};
+  auto frame = [&](std::array<std::uint8_t, 3> tx) {
+    SpiTransfer t;
+    t.tx = tx;
+    t.rx = rx;
+    t.len = 3;
+    v.board.transfer(0, std::span<const SpiTransfer>(&t, 1));
+    runner.after_transfer();
+    return rx;
+  };
+  using Three = std::array<std::uint8_t, 3>;
+  frame({0xD0, 0xD0, 0xD0});
+  frame({0x00, 0x00, 0x00});
+  frame({0x00, 0x00, 0x00});  // the power-up UVLO latches released
+  frame({0x2A, 0x2A, 0x2A});  // GetParam(KVAL_RUN): the answers wait in the registers
+  runner.advance_to(ticks_from_ms(15));
+  EXPECT_FALSE(v.board.pin_level(0, 0, Pin::FLAG)) << "chip 0 is back with UVLO latched";
+  EXPECT_EQ(frame({0x00, 0x00, 0x00}), (Three{0x00, 0x29, 0x29})) << "chip 0's answer went with the power";
+  frame({0x2A, 0x2A, 0x2A});
+  runner.advance_to(ticks_from_ms(25));
+  EXPECT_EQ(frame({0x00, 0x00, 0x00}), (Three{0x29, 0x29 ^ 0x80, 0x29})) << "chip 1's MSB inverted on the wire";
+  runner.advance_to(ticks_from_ms(35));
+  frame({0x0A, 0x0A, 0x0A});  // SetParam(KVAL_RUN): chip 0 misses it
+  frame({0x00, 0x22, 0x33});
+  v.board.with_chain(0, [](Chain& c) {
+    EXPECT_EQ(c.chip(0).peek(Reg::KVAL_RUN), 0x29u);
+    EXPECT_EQ(c.chip(1).peek(Reg::KVAL_RUN), 0x22u);
+    EXPECT_EQ(c.chip(2).peek(Reg::KVAL_RUN), 0x33u);
+  });
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty());
+  ASSERT_GE(runner.log().size(), 3u);
+  ASSERT_TRUE(v.board.stop_recording(0));
+
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::remove(path.c_str());
+  EXPECT_NE(text.str().find(" fault 0 POWER_CYCLE\n"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find(" fault 1 MISO_FLIP 7\n"), std::string::npos);
+  EXPECT_NE(text.str().find(" fault 0 LOST_FRAME\n"), std::string::npos);
+  NativeTraceReader reader(text.str(), "one-shot.trace");
+  Chain fresh(3);
+  const ReplayResult r = replay_trace(reader, fresh);
+  EXPECT_TRUE(r.matched()) << (r.divergences.empty() ? "" : r.divergences[0].report);
+  EXPECT_EQ(r.divergent_frames, 0u);
+  EXPECT_EQ(r.frames, 9u);
+}
+
 TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
   Scenario s;
   s.name = "homing";
@@ -333,6 +408,8 @@ TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
   cmd.command = "GoUntil";
   cmd.count = 3;
   s.steps.push_back(expect_at(cmd, st));
+  s.steps.push_back(at_time(9, one_shot(TraceFault::LOST_FRAME, 1)));
+  s.steps.push_back(at_time(10, one_shot(TraceFault::MISO_FLIP, 0, 5)));
   std::string error;
   const auto back = deserialize_scenario(serialize_scenario(s), error);
   ASSERT_TRUE(back) << error;

@@ -74,7 +74,7 @@ TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
             "l6470emu: scenario s.yaml:3: key 'sw': 'shut' is not one of close, open");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {falt: ocd}\n"),
             "l6470emu: scenario s.yaml:3: key 'falt': unknown (did you mean fault?) in do:; known: sw, stby_rst, fault, "
-            "thermal, adcin, load, block, supply_mV, clear, chip, chain");
+            "thermal, adcin, load, block, supply_mV, clear, bit, chip, chain");
   EXPECT_EQ(error_of("steps:\n  - at: 1.0000001s\n    do: {sw: close}\n"),
             "l6470emu: scenario s.yaml:2: key 'at': expects a duration (250ns, 1us, 10ms, 2.5s, 1min: whole ticks of "
             "250 ns), got '1.0000001s'");
@@ -87,6 +87,56 @@ TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
   EXPECT_EQ(error_of(std::string(100, '[')), "l6470emu: scenario s.yaml:1: nested deeper than a scenario can be");
   EXPECT_EQ(error_of("steps:\n  - at: end\n    expect: {sanitizer: dirty}\n"),
             "l6470emu: scenario s.yaml:3: key 'sanitizer': takes clean (no rule of the chip broken)");
+}
+
+TEST(ScenarioFile, TheOneShotFaultsReadIntoTheirTraceFaults) {
+  const ScenarioParse p = parse_scenario_yaml(R"(steps:
+  - at: 1.25s
+    do: {fault: reset, chip: 0}
+  - at: 2s
+    do: {fault: miso_flip, bit: 3, chip: 1}
+  - at: 3s
+    do: {fault: miso_flip}
+  - at: 4s
+    do: {fault: lost_frame, chip: 2}
+)",
+                                              "f.yaml");
+  ASSERT_TRUE(p.scenario) << p.error;
+  const Scenario& s = *p.scenario;
+  ASSERT_EQ(s.steps.size(), 4u);
+  EXPECT_EQ(s.steps[0].action->kind, ScenarioAction::Kind::fault);
+  EXPECT_EQ(s.steps[0].action->fault, TraceFault::POWER_CYCLE);
+  EXPECT_EQ(s.steps[0].when.tick, ticks_from_ms(1250));
+  EXPECT_EQ(s.steps[1].action->fault, TraceFault::MISO_FLIP);
+  EXPECT_EQ(s.steps[1].action->value, 3u);
+  EXPECT_EQ(s.steps[1].action->chip.number, 1u);
+  EXPECT_EQ(s.steps[2].action->fault, TraceFault::MISO_FLIP);
+  EXPECT_EQ(s.steps[2].action->value, 7u) << "bit 7, the MSB, by default";
+  EXPECT_EQ(s.steps[3].action->fault, TraceFault::LOST_FRAME);
+  EXPECT_EQ(s.steps[3].action->chip.number, 2u);
+}
+
+TEST(ScenarioFile, AMisspelledOneShotFaultIsNamedWithTheNearMiss) {
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: rest}\n"),
+            "l6470emu: scenario s.yaml:3: key 'fault': 'rest' is not one of ocd, uvlo, uvlo_adc, stall_a, stall_b, reset, "
+            "miso_flip, lost_frame (did you mean reset?)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flp}\n"),
+            "l6470emu: scenario s.yaml:3: key 'fault': 'miso_flp' is not one of ocd, uvlo, uvlo_adc, stall_a, stall_b, "
+            "reset, miso_flip, lost_frame (did you mean miso_flip?)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: lost_frme}\n"),
+            "l6470emu: scenario s.yaml:3: key 'fault': 'lost_frme' is not one of ocd, uvlo, uvlo_adc, stall_a, stall_b, "
+            "reset, miso_flip, lost_frame (did you mean lost_frame?)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bti: 3}\n"),
+            "l6470emu: scenario s.yaml:3: key 'bti': unknown (did you mean bit?) in do:; known: sw, stby_rst, fault, "
+            "thermal, adcin, load, block, supply_mV, clear, bit, chip, chain");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bit: 8}\n"),
+            "l6470emu: scenario s.yaml:3: key 'bit': 8 is out of range (0..7)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: reset, clear: true}\n"),
+            "l6470emu: scenario s.yaml:3: key 'clear': not with fault: reset (it happens once: nothing to clear)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: ocd, bit: 2}\n"),
+            "l6470emu: scenario s.yaml:3: key 'bit': only with fault: miso_flip");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: lost_frame, bit: 2}\n"),
+            "l6470emu: scenario s.yaml:3: key 'bit': only with fault: miso_flip");
 }
 
 TEST(ScenarioFile, DurationsAreWholeTicksOfTheChip) {

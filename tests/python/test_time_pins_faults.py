@@ -116,3 +116,18 @@ def test_stby_rst_low_holds_the_chip_in_reset_with_spi_silent():
     assert chain.frame(b"\xD0\xD0") == b"\x00\x00" and chain.status(1) == 0
     chain.set_stby_rst_pin(1, True)  # rising edge: power-up state
     assert chain.get_status(1) == 0x7C03 and chain.position(1) == 0
+
+
+def test_the_one_shot_faults_act_once():
+    chain = l6470emu.Chain(["L6470", "L6470"])
+    chain.get_status(0)
+    chain.set_param(0, Reg.KVAL_RUN, 0x55)
+    chain.fault(0, l6470emu.Fault.POWER_CYCLE)
+    assert chain.get_param(0, Reg.KVAL_RUN) == 0x29 and chain.status(0).UVLO
+    chain.frame(bytes([0x2A, 0x2A]))  # GetParam(KVAL_RUN): the answers wait in the registers
+    chain.fault(1, "MISO_FLIP")  # bit 7 by default
+    assert list(chain.frame(bytes(2))) == [0x29, 0x29 ^ 0x80]
+    chain.fault(0, "LOST_FRAME")
+    chain.frame(bytes([0x0A, 0x0A]))  # SetParam(KVAL_RUN): chip 0 misses it
+    chain.frame(bytes([0x00, 0x44]))
+    assert chain.get_param(0, Reg.KVAL_RUN) == 0x29 and chain.get_param(1, Reg.KVAL_RUN) == 0x44
