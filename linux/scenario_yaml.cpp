@@ -39,6 +39,9 @@ std::string_view fault_word(TraceFault f) {
     case TraceFault::UVLO_ADC: return "uvlo_adc";
     case TraceFault::STALL_A: return "stall_a";
     case TraceFault::STALL_B: return "stall_b";
+    case TraceFault::POWER_CYCLE: return "reset";
+    case TraceFault::MISO_FLIP: return "miso_flip";
+    case TraceFault::LOST_FRAME: return "lost_frame";
     default: return "";
   }
 }
@@ -54,6 +57,10 @@ std::string action_text(const ScenarioAction& a) {
         o << "thermal: " << thermal_name(a.value);
       else if (a.fault == TraceFault::ADCIN)
         o << "adcin: " << unsigned{a.value};
+      else if (a.fault == TraceFault::MISO_FLIP)
+        o << "fault: miso_flip, bit: " << unsigned{a.value};
+      else if (a.fault == TraceFault::POWER_CYCLE || a.fault == TraceFault::LOST_FRAME)
+        o << "fault: " << fault_word(a.fault);
       else
         o << "fault: " << fault_word(a.fault) << (a.value == 0 ? ", clear: true" : "");
       break;

@@ -106,10 +106,6 @@ std::string fault_unavailable(CampaignFault fault, const Variant& variant, bool 
     case CampaignFault::block:
       if (!has_axis) return "the chip has no axis (axis.K= in the board description)";
       break;
-    case CampaignFault::reset:
-    case CampaignFault::miso_flip:
-    case CampaignFault::lost_frame:
-      return "not modelled yet";
     default:
       break;
   }
@@ -310,8 +306,15 @@ std::vector<ScenarioStep> fault_steps(CampaignFault fault, const ChipRun& chip, 
     }
     case CampaignFault::reset:
     case CampaignFault::miso_flip:
-    case CampaignFault::lost_frame:
+    case CampaignFault::lost_frame: {  // events of a moment: nothing to clear
+      ScenarioAction a;
+      a.kind = ScenarioAction::Kind::fault;
+      a.fault = fault == CampaignFault::reset ? TraceFault::POWER_CYCLE
+                : fault == CampaignFault::miso_flip ? TraceFault::MISO_FLIP : TraceFault::LOST_FRAME;
+      a.value = fault == CampaignFault::miso_flip ? 7 : 0;
+      steps.push_back(at_step(tick, chip, a));
       break;
+    }
   }
   return steps;
 }

@@ -287,10 +287,10 @@ def campaign(program: Sequence[PathArg], *, board: Optional[PathArg] = None, cha
             raise ValueError(_usage_line(output))
         if 3 <= status <= 7:
             raise CampaignError(status, output)
-        if not json_file.exists():
-            raise RuntimeError(f"l6470emu campaign exited with {status} without writing its report:\n{output}")
         if cwd is not None and not json_file.is_absolute():
             json_file = Path(cwd) / json_file
+        if not json_file.exists():
+            raise RuntimeError(f"l6470emu campaign exited with {status} without writing its report:\n{output}")
         result = _result(status, output, json_file, chosen_fail_on, None)
         keep = temporary is None or any(r.reproducer for r in result.reruns)
         if keep:

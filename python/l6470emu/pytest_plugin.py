@@ -7,6 +7,7 @@ Fixtures:
                  the code under test are the board's (options: the l6470_board marker)
   spidev_board   runs a program (your unmodified driver) under libl6470emu-preload.so with an
                  emulated /dev/spidevB.C and /dev/gpiochipN, recording a native trace
+  l6470emu_campaign_case  the test's l6470emu_campaign case (fault, chip, point), or None
 
 The chips come from the l6470_chain marker, chip 0 (the MISO end) first; default one L6470:
   @pytest.mark.l6470_chain("L6470", "2xL6480")
@@ -221,6 +222,9 @@ class SpidevBoard:
     on a gpiochip, in virtual time by default (the program's clocks and sleeps are the
     board's: fast and deterministic). Each run gets a freshly powered-up board and records
     its traffic into trace_path, which trace(), decode() and replay() read.
+
+    In a case of the l6470emu_campaign marker (campaign_case is not None), run() also runs the
+    campaign of that case: see run().
     """
 
     def __init__(self, chips: Sequence[str], directory: Path, check: str = "error",
@@ -244,6 +248,38 @@ class SpidevBoard:
         #: where the preload library's diagnostics go
         self.log_path: Path = directory / "spidev_board.log"
         self._directory = directory
+        # The l6470emu_campaign case, set by the spidev_board fixture; read through the properties.
+        self._campaign_case: Optional[CampaignCase] = None
+        self._campaign_fail_on: Optional[Tuple[str, ...]] = None
+        self._campaign_result = None
+        self._campaign_rerun = None
+
+    @property
+    def campaign_case(self) -> Optional[CampaignCase]:
+        """The l6470emu_campaign case this test is, a CampaignCase (fault, chip, point), or None."""
+        return self._campaign_case
+
+    @property
+    def campaign_fail_on(self) -> Optional[Tuple[str, ...]]:
+        """The verdicts that fail this campaign case, from the marker's fail_on (None: the default
+        silent_failure, hang, deadlock, crash)."""
+        return self._campaign_fail_on
+
+    @property
+    def campaign_json_path(self) -> Path:
+        """Where a campaign case's JSON report goes (its reproducing scenario is written beside it,
+        in the test's tmp_path)."""
+        return self._directory / "spidev_board.campaign.json"
+
+    @property
+    def campaign_result(self):
+        """The last run()'s l6470emu.CampaignResult in a campaign case, else None."""
+        return self._campaign_result
+
+    @property
+    def campaign_rerun(self):
+        """The last run()'s l6470emu.Rerun in a campaign case (the case's one rerun), else None."""
+        return self._campaign_rerun
 
     @property
     def preload(self) -> str:
@@ -288,7 +324,19 @@ class SpidevBoard:
 
         A trace left by an earlier run is removed first. With check (the default), a
         non-zero exit fails the test with the program's output and the board's log; an exit by
-        the driver sanitizer (status l6470emu.SANITIZER_EXIT_STATUS) fails it with the report."""
+        the driver sanitizer (status l6470emu.SANITIZER_EXIT_STATUS) fails it with the report.
+
+        In an l6470emu_campaign case (campaign_case is (fault, chip, point)), the program first
+        runs as above — the campaign's clean run; what run() returns, and what trace(), decode()
+        and log() read, is that run's — and then `l6470emu campaign --chain DESCRIPTION --faults
+        FAULT --chips CHIP --at POINT --json campaign_json_path -- args` runs (in cwd, with env; the
+        rerun's wall-clock limit is timeout; input is not given to it). Its result and the rerun
+        are campaign_result and campaign_rerun. The case fails (pytest.fail) when the rerun's
+        verdict is one of campaign_fail_on (default silent_failure, hang, deadlock, crash), with the
+        verdict, how the program ended, the first failed expectation and the command that
+        reproduces it; when the campaign's clean run does not pass; and when the campaign refuses
+        the marker's faults or chips. It is skipped when the clean run has no such point for that
+        chip. Otherwise run() returns as usual."""
         if self.trace_path is not None and self.trace_path.exists():
             self.trace_path.unlink()
         argv = [os.fspath(a) for a in args]
@@ -306,7 +354,33 @@ class SpidevBoard:
                 f"{' '.join(argv)} exited with {result.returncode} on board '{self.description}'\n"
                 f"--- stdout\n{result.stdout}--- stderr\n{result.stderr}--- board log\n{self.log()}",
                 pytrace=False)
+        if self.campaign_case is not None:
+            self._campaign(argv, timeout=timeout, cwd=cwd, env=env)
         return result
+
+    def _campaign(self, argv: List[str], *, timeout: float, cwd, env) -> None:
+        """The campaign of campaign_case for argv: fails or skips the test as run() says."""
+        import l6470emu
+
+        fault, chip, point = self.campaign_case
+        self._campaign_result = self._campaign_rerun = None
+        try:
+            result = l6470emu.campaign(argv, chain=self.description, faults=fault, chips=chip, at=point,
+                                       fail_on=self.campaign_fail_on, json_path=self.campaign_json_path, jobs=1,
+                                       wall_timeout=timeout, cwd=cwd, env=env)
+        except ValueError as refused:
+            pytest.fail(f"@pytest.mark.{_CAMPAIGN_MARKER}: {refused}", pytrace=False)
+        except l6470emu.CampaignError as clean:
+            pytest.fail(f"{' '.join(argv)}: the campaign's clean run on board '{self.description}' did not pass "
+                        f"(exit status {clean.status}); no fault was injected\n--- campaign output\n{clean.output}",
+                        pytrace=False)
+        self._campaign_result = result
+        if not result.reruns:
+            pytest.skip(f"the clean run of {' '.join(argv)} has no {point} point for chip {chip}: no {fault} rerun")
+        rerun = self._campaign_rerun = result.reruns[0]
+        if rerun.fails(self.campaign_fail_on):
+            pytest.fail(f"{' '.join(argv)} on board '{self.description}' with {fault} on chip {chip} at {point}:\n"
+                        f"{rerun.describe()}", pytrace=False)
 
     def python(self, script: Union[str, os.PathLike], *args: str, **kwargs) -> subprocess.CompletedProcess:
         """run() of a Python script with this interpreter (sys.executable)."""
@@ -341,7 +415,19 @@ class SpidevBoard:
 
 
 @pytest.fixture
-def spidev_board(request, tmp_path):
-    """A SpidevBoard of the marker's chips (default one L6470) for running programs under the preload."""
+def l6470emu_campaign_case(request) -> Optional[CampaignCase]:
+    """The l6470emu_campaign case of this test, a CampaignCase (fault, chip, point), or None for a
+    test without the marker (pytest_generate_tests parametrizes it)."""
+    return getattr(request, "param", None)
+
+
+@pytest.fixture
+def spidev_board(request, tmp_path, l6470emu_campaign_case):
+    """A SpidevBoard of the marker's chips (default one L6470) for running programs under the preload;
+    in an l6470emu_campaign case, its campaign_case and campaign_fail_on are the case's."""
     check, allow = _check(request)
-    return SpidevBoard(_chips(request), tmp_path, check=check, check_allow=allow)
+    board = SpidevBoard(_chips(request), tmp_path, check=check, check_allow=allow)
+    if l6470emu_campaign_case is not None:
+        board._campaign_case = l6470emu_campaign_case
+        board._campaign_fail_on = _campaign_options(request.node.get_closest_marker(_CAMPAIGN_MARKER))[3]
+    return board

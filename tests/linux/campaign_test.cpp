@@ -104,6 +104,23 @@ TEST_F(Campaign, ADriverThatWaitsForAFlagThatNeverClearsHangsAndOneThatAbortsCra
   EXPECT_EQ(rerun(Json::parse(read(path("dead.json"))), "ocd", "during_motion")["verdict"], "deadlock");
 }
 
+TEST_F(Campaign, ABrownOutAndALostFrameAreSeenByACarefulDriverAndMissedByACarelessOne) {
+  // A reset right after configuring goes unseen even so: the driver's settings are lost.
+  ASSERT_EQ(campaign({"--faults", "reset,lost_frame,miso_flip", "--json", path("careful.json")}, "careful").status, 1);
+  const Json careful = Json::parse(read(path("careful.json")));
+  EXPECT_EQ(rerun(careful, "reset", "during_motion")["verdict"], "detected");
+  EXPECT_EQ(rerun(careful, "reset", "during_motion")["flag_read"], true);
+  EXPECT_EQ(rerun(careful, "reset", "after_config")["verdict"], "silent_failure");
+  // The GetStatus opcode after the Move never reaches the chip: the driver reads 0x0000, OCD.
+  EXPECT_EQ(rerun(careful, "lost_frame", "at_Move")["verdict"], "detected");
+  EXPECT_TRUE(rerun(careful, "lost_frame", "at_Move")["flag_read"].is_null());
+  EXPECT_EQ(rerun(careful, "miso_flip", "during_motion")["verdict"], "survived");
+  EXPECT_EQ(campaign({"--faults", "reset", "--json", path("careless.json")}, "careless").status, 1);
+  const Json careless = Json::parse(read(path("careless.json")));
+  EXPECT_EQ(rerun(careless, "reset", "during_motion")["verdict"], "silent_failure");
+  EXPECT_EQ(rerun(careless, "reset", "during_motion")["first_failure"]["what"], "ABS_POS");
+}
+
 TEST_F(Campaign, TheSameCampaignTwiceGivesTheSameJsonAndThreeShardsMergeIntoIt) {
   const std::vector<std::string> args{"--faults", "ocd,uvlo,sw_close", "--json", path("c.json")};
   const int status = campaign(args, "careful").status;

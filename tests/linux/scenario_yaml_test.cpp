@@ -54,6 +54,12 @@ steps:
     do: {supply_mV: 7000}
   - at: 3s
     do: {fault: stall_b}
+  - at: 3s
+    do: {fault: reset}
+  - at: 3s
+    do: {fault: miso_flip, bit: 2}
+  - at: 3s
+    do: {fault: lost_frame}
   - at: end
     chip: 1
     expect: {register: ABS_POS, value: -5, tolerance: 3}
@@ -78,7 +84,7 @@ steps:
   - at: end
     expect: {sanitizer: clean}
 )");
-  ASSERT_EQ(original.steps.size(), 23u);
+  ASSERT_EQ(original.steps.size(), 26u);
   const std::string written = scenario_yaml(original, "made by a test\nsecond line");
   EXPECT_EQ(written.rfind("# made by a test\n# second line\n", 0), 0u) << written;
   expect_same_steps(original, read(written));
