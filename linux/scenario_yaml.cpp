@@ -80,7 +80,7 @@ std::string expectation_text(const ScenarioExpectation& e) {
   o << "{";
   switch (e.kind) {
     case ScenarioExpectation::Kind::reg:
-      o << "register: " << e.name << ", value: " << e.value;
+      o << "register: " << quoted(e.name) << ", value: " << e.value;
       if (e.tolerance) o << ", tolerance: " << e.tolerance;
       break;
     case ScenarioExpectation::Kind::true_position:
@@ -91,7 +91,7 @@ std::string expectation_text(const ScenarioExpectation& e) {
       o << "status: {";
       bool first = true;
       for (const auto& [flag, bit] : e.flags) {
-        o << (first ? "" : ", ") << flag << ": " << (bit ? 1 : 0);
+        o << (first ? "" : ", ") << quoted(flag) << ": " << (bit ? 1 : 0);
         first = false;
       }
       o << "}";
@@ -104,7 +104,7 @@ std::string expectation_text(const ScenarioExpectation& e) {
       o << "}";
       break;
     case ScenarioExpectation::Kind::command:
-      o << "command: " << e.name << ", ";
+      o << "command: " << quoted(e.name) << ", ";
       if (e.count == ScenarioExpectation::kAtLeastOnce) o << "sent: true";
       else o << "count: " << e.count;
       break;
@@ -157,7 +157,7 @@ std::string scenario_yaml(const Scenario& s, std::string_view comments) {
           case ScenarioTrigger::Kind::true_position: o << "true_position: " << w.position; break;
           case ScenarioTrigger::Kind::busy_fall: o << "busy: fall"; break;
           case ScenarioTrigger::Kind::busy_rise: o << "busy: rise"; break;
-          case ScenarioTrigger::Kind::command: o << "command: " << w.command; break;
+          case ScenarioTrigger::Kind::command: o << "command: " << quoted(w.command); break;
           default: break;
         }
         o << ", count: " << w.count << ", " << chip_keys(w.chip) << "}\n";

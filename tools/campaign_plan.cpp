@@ -260,22 +260,14 @@ std::vector<InjectionPoint> injection_points(const ChipRun& chip, PointSelection
 std::vector<ScenarioStep> fault_steps(CampaignFault fault, const ChipRun& chip, Tick tick, std::int64_t rotor) {
   std::vector<ScenarioStep> steps;
   const Tick clear = tick + kFaultHoldTicks;
-  auto condition = [&](TraceFault f) {
+  // A backdoor condition raised (value `on`) and, kFaultHoldTicks later, ended (value `off`).
+  auto condition = [&](TraceFault f, std::uint8_t on = 1, std::uint8_t off = 0) {
     ScenarioAction a;
     a.kind = ScenarioAction::Kind::fault;
     a.fault = f;
-    a.value = 1;
+    a.value = on;
     steps.push_back(at_step(tick, chip, a));
-    a.value = 0;
-    steps.push_back(at_step(clear, chip, a));
-  };
-  auto thermal = [&](std::uint8_t cls) {
-    ScenarioAction a;
-    a.kind = ScenarioAction::Kind::fault;
-    a.fault = TraceFault::THERMAL;
-    a.value = cls;
-    steps.push_back(at_step(tick, chip, a));
-    a.value = 0;
+    a.value = off;
     steps.push_back(at_step(clear, chip, a));
   };
   auto pin = [&](ScenarioAction::Kind kind) {
@@ -288,9 +280,9 @@ std::vector<ScenarioStep> fault_steps(CampaignFault fault, const ChipRun& chip, 
   };
   switch (fault) {
     case CampaignFault::ocd: condition(TraceFault::OCD); break;
-    case CampaignFault::thermal_warning: thermal(1); break;
-    case CampaignFault::thermal_bridge_shutdown: thermal(2); break;
-    case CampaignFault::thermal_device_shutdown: thermal(3); break;
+    case CampaignFault::thermal_warning: condition(TraceFault::THERMAL, 1); break;
+    case CampaignFault::thermal_bridge_shutdown: condition(TraceFault::THERMAL, 2); break;
+    case CampaignFault::thermal_device_shutdown: condition(TraceFault::THERMAL, 3); break;
     case CampaignFault::uvlo: condition(TraceFault::UVLO); break;
     case CampaignFault::uvlo_adc: condition(TraceFault::UVLO_ADC); break;
     case CampaignFault::stall_a: condition(TraceFault::STALL_A); break;
@@ -321,30 +313,28 @@ std::vector<ScenarioStep> fault_steps(CampaignFault fault, const ChipRun& chip, 
 
 std::vector<ScenarioStep> clean_run_oracle(const std::vector<ChipRun>& chips) {
   std::vector<ScenarioStep> steps;
-  for (const ChipRun& c : chips) {
-    if (c.commands.empty()) continue;  // a chip the driver never spoke to is left out
-    const ScenarioChip who{c.chain_name, c.number};
-    for (const auto& [name, value] : c.final_registers) {
-      ScenarioStep s;
-      s.where = "the clean run's end";
-      s.when.kind = ScenarioTrigger::Kind::end;
-      ScenarioExpectation e;
-      e.kind = ScenarioExpectation::Kind::reg;
-      e.chip = who;
-      e.name = name;
-      e.value = value;
-      s.expect = e;
-      steps.push_back(s);
-    }
+  auto at_end = [&](ScenarioExpectation e) {
     ScenarioStep s;
     s.where = "the clean run's end";
     s.when.kind = ScenarioTrigger::Kind::end;
+    s.expect = std::move(e);
+    steps.push_back(std::move(s));
+  };
+  for (const ChipRun& c : chips) {
+    if (c.commands.empty()) continue;  // a chip the driver never spoke to is left out
     ScenarioExpectation e;
+    e.chip = ScenarioChip{c.chain_name, c.number};
+    e.kind = ScenarioExpectation::Kind::reg;
+    for (const auto& [name, value] : c.final_registers) {
+      e.name = name;
+      e.value = value;
+      at_end(e);
+    }
     e.kind = ScenarioExpectation::Kind::status;
-    e.chip = who;
+    e.name.clear();
+    e.value = 0;
     e.flags = c.final_status;
-    s.expect = e;
-    steps.push_back(s);
+    at_end(e);
   }
   return steps;
 }

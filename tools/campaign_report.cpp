@@ -9,6 +9,7 @@
 
 #include "core/near_miss.hpp"
 #include "linux/run_report.hpp"
+#include "tools/xml_text.hpp"
 
 namespace l6470emu {
 namespace {
@@ -16,36 +17,7 @@ namespace {
 using Json = nlohmann::ordered_json;
 constexpr const char* kFormat = "l6470emu-campaign/1";
 
-// Text for XML: markup escaped, control characters dropped, bytes that are not UTF-8 replaced.
-std::string xml(std::string_view s) {
-  std::string out;
-  for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    std::size_t len = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
-    bool ok = len > 0 && i + len <= s.size();
-    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(s[i + k]) & 0xC0) == 0x80;
-    if (!ok) {
-      out += "\xEF\xBF\xBD";
-      ++i;
-      continue;
-    }
-    if (len == 1) {
-      switch (c) {
-        case '&': out += "&amp;"; break;
-        case '<': out += "&lt;"; break;
-        case '>': out += "&gt;"; break;
-        case '"': out += "&quot;"; break;
-        case '\'': out += "&apos;"; break;
-        default:
-          if (c >= 0x20 || c == '\n' || c == '\t') out += static_cast<char>(c);
-      }
-    } else {
-      out.append(s.substr(i, len));
-    }
-    i += len;
-  }
-  return out;
-}
+std::string xml(std::string_view s) { return xml_text(s); }
 
 std::string seconds(Tick t) {
   char buf[40];

@@ -29,6 +29,7 @@
 #include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"
 #include "tools/kernel_nodes.hpp"
+#include "tools/xml_text.hpp"
 
 extern char** environ;
 
@@ -86,22 +87,7 @@ std::string read_all(const std::string& path) {
   return s.str();
 }
 
-std::string xml(std::string_view s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
-        else out += c;
-    }
-  }
-  return out;
-}
+std::string xml(std::string_view s) { return xml_text(s); }
 
 std::string seconds_number(Tick t) {
   char buf[40];

@@ -15,7 +15,7 @@
 
 static int dspin_fd = -1;
 
-static void dspin_open(const char* path) {
+static inline void dspin_open(const char* path) {
   dspin_fd = open(path, O_RDWR);
   if (dspin_fd < 0) {
     perror(path);
@@ -30,7 +30,7 @@ static void dspin_open(const char* path) {
 }
 
 /* One byte in its own frame; returns the byte the chip shifted out. */
-static uint8_t dspin_byte(uint8_t out) {
+static inline uint8_t dspin_byte(uint8_t out) {
   uint8_t in = 0;
   struct spi_ioc_transfer t;
   memset(&t, 0, sizeof t);
@@ -45,27 +45,27 @@ static uint8_t dspin_byte(uint8_t out) {
 }
 
 /* A command with `n` argument bytes (MSB first); returns the last `n` answer bytes. */
-static uint32_t dspin_cmd(uint8_t op, uint32_t arg, int n) {
+static inline uint32_t dspin_cmd(uint8_t op, uint32_t arg, int n) {
   uint32_t answer = 0;
   dspin_byte(op);
   for (int i = n - 1; i >= 0; --i) answer = answer << 8 | dspin_byte((uint8_t)(arg >> (8 * i)));
   return answer;
 }
 
-static uint16_t dspin_status(void) { return (uint16_t)dspin_cmd(0xD0, 0, 2); } /* GetStatus */
+static inline uint16_t dspin_status(void) { return (uint16_t)dspin_cmd(0xD0, 0, 2); } /* GetStatus */
 
-static int32_t dspin_abs_pos(void) { /* GetParam(ABS_POS), 22 bits signed */
+static inline int32_t dspin_abs_pos(void) { /* GetParam(ABS_POS), 22 bits signed */
   uint32_t v = dspin_cmd(0x21, 0, 3) & 0x3FFFFF;
   return (v & 0x200000) ? (int32_t)v - (1 << 22) : (int32_t)v;
 }
 
-static void sleep_ms(long ms) {
+static inline void sleep_ms(long ms) {
   struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
   nanosleep(&ts, NULL);
 }
 
 /* Polls GetStatus until BUSY (bit 1, active low) is high again; 0 when it did within `limit_ms`. */
-static int dspin_wait_idle(long limit_ms) {
+static inline int dspin_wait_idle(long limit_ms) {
   for (long t = 0; t < limit_ms; t += 1) {
     if (dspin_status() & 0x0002) return 0;
     sleep_ms(1);

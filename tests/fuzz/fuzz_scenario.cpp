@@ -1,11 +1,14 @@
 // libFuzzer harness of scenario files (linux/scenario_file.hpp parse_scenario_yaml): any text
 // gives a scenario or one error line naming the file, never a crash; an accepted scenario goes
-// through run's exchange form (board/scenario.hpp) and reads back the same.
+// through run's exchange form (board/scenario.hpp) and reads back the same, and is written back
+// as a scenario file (linux/scenario_yaml.hpp, what a campaign's reruns are made of) that reads
+// back to the same steps.
 #include <string_view>
 
 #include "board/scenario.hpp"
 #include "fuzz_support.hpp"
 #include "linux/scenario_file.hpp"
+#include "linux/scenario_yaml.hpp"
 
 using namespace l6470emu;
 
@@ -23,5 +26,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto back = deserialize_scenario(serialize_scenario(*r.scenario), error);
   FUZZ_CHECK(back.has_value(), "an accepted scenario does not read back: %.200s", error.c_str());
   FUZZ_CHECK(*back == *r.scenario, "a scenario reads back differently from its exchange form");
+  const std::string written = scenario_yaml(*r.scenario, "written back");
+  const ScenarioParse again = parse_scenario_yaml(written, "fuzz.yaml");
+  FUZZ_CHECK(again.scenario.has_value(), "a written scenario does not read: %.200s", again.error.c_str());
+  Scenario a = *r.scenario, b = *again.scenario;
+  for (auto& s : a.steps) s.where.clear();
+  for (auto& s : b.steps) s.where.clear();
+  FUZZ_CHECK(a == b, "a scenario written back reads differently");
   return 0;
 }
