@@ -7,21 +7,14 @@
 namespace l6470emu {
 namespace {
 
-// A YAML double-quoted scalar: any UTF-8 text, escaped so that the reader gets it back as it was
-// (the characters YAML may take for line breaks or a byte order mark as \u escapes). Bytes that
-// are not UTF-8 cannot be said in YAML at all: they are written as they are and read back as the
-// YAML library reads them.
+// A YAML double-quoted scalar: any UTF-8 text, escaped so that the reader gets it back as it was.
+// Bytes that are not UTF-8 cannot be said in YAML at all: they are written as they are, and the
+// file may not read.
 std::string quoted(std::string_view s) {
   std::string out = "\"";
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const char ch = s[i];
+  for (const char ch : s) {
     const auto c = static_cast<unsigned char>(ch);
-    const std::string_view rest = s.substr(i);
-    if (rest.starts_with("\xC2\x85") || rest.starts_with("\xE2\x80\xA8") || rest.starts_with("\xE2\x80\xA9") ||
-        rest.starts_with("\xEF\xBB\xBF")) {
-      out += rest[0] == '\xC2' ? "\\u0085" : rest[0] == '\xEF' ? "\\uFEFF" : rest[2] == '\xA8' ? "\\u2028" : "\\u2029";
-      i += rest[0] == '\xC2' ? 1 : 2;
-    } else if (c == '"' || c == '\\') {
+    if (c == '"' || c == '\\') {
       out += '\\';
       out += ch;
     } else if (c < 0x20 || c == 0x7f) {

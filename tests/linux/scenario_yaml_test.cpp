@@ -102,7 +102,7 @@ TEST(ScenarioYaml, DurationsAreWrittenToTheTick) {
 
 TEST(ScenarioYaml, ANameWithQuotesNewlinesAndColonsReadsBack) {
   Scenario s;
-  s.name = "a \"name\": with\\ a\nnewline # and a comment sign";
+  s.name = "a \"name\": with\\ a\nnewline # and a comment sign, \xC2\x85 NEL, \xE2\x80\xA8 LS, \xEF\xBB\xBF BOM, \x7f";
   const Scenario back = read(scenario_yaml(s));
   EXPECT_EQ(back.name, s.name);
   EXPECT_TRUE(back.steps.empty());
