@@ -314,6 +314,9 @@ int CampaignCommand::run_campaign() {
     ScenarioParse sp = load_scenario_file(scenario_file_);
     if (!sp.scenario) return usage(sp.error);
     user = std::move(*sp.scenario);
+    // Every rerun's scenario is this one written back with the fault's steps added.
+    if (const ScenarioParse back = parse_scenario_yaml(scenario_yaml(user), scenario_file_); !back.scenario)
+      return usage("the scenario cannot be written into the reruns' scenarios (its text is not UTF-8?): " + back.error);
   }
   std::optional<Tick> user_timeout = user.timeout_ticks;
   if (!timeout_.empty()) {
@@ -464,6 +467,19 @@ int CampaignCommand::run_campaign() {
   std::vector<std::vector<std::pair<Tick, std::uint64_t>>> clean_frames(config.chains.size());
   try {
     for (std::size_t c = 0; c < config.chains.size(); ++c) {
+      if (!fs::exists(trace_of(clean_trace, c))) {  // the program never opened this chain: nothing to inject
+        for (std::size_t k = 0; k < probe.chip_count(c); ++k) {
+          ChipRun idle;
+          idle.chain = c;
+          idle.index = k;
+          idle.number = probe.chip_numbering(c).number_of(k);
+          idle.chain_name = probe.chain_name(c);
+          idle.variant = &probe.chain(c).chip(k).variant();
+          idle.has_axis = probe.chain(c).chip(k).has_axis();
+          chips.push_back(idle);
+        }
+        continue;
+      }
       std::vector<ChipRun> on_chain = read_clean_run(trace_of(clean_trace, c), c, config, clean->end_tick);
       std::vector<std::vector<Tick>> ticks(on_chain.size());
       for (std::size_t k = 0; k < on_chain.size(); ++k)
@@ -513,6 +529,11 @@ int CampaignCommand::run_campaign() {
   const bool user_oracle = has_expectations(user);
   const Tick rerun_timeout =
       user_timeout ? *user_timeout : std::max(2 * clean->end_tick, clean->end_tick + 10 * kTicksPerSecond);
+  // A campaign with nothing to rerun must not read as a pass: the program never spoke to a chip.
+  const bool nothing = plan.empty() && only_chips_.empty() && only_points_.empty();
+  if (nothing)
+    std::cerr << "l6470emu campaign: the clean run sent no command to any chip that could take a fault: nothing was "
+                 "injected\n";
   if (list_) {
     std::cout << "clean run: " << clean->ended << " at " << seconds_text(clean->end_tick) << "\n";
     for (std::size_t s = 0; s < chips.size(); ++s) {
@@ -667,7 +688,7 @@ int CampaignCommand::run_campaign() {
   report.complete = report.reruns.size() == mine.size();
   std::cout << campaign_matrix(report, fail_on);
   std::cout << "l6470emu campaign: " << campaign_summary(report) << "\n";
-  int status = 0;
+  int status = nothing ? 1 : 0;
   for (const RerunResult& r : report.reruns)
     if (r.fails(fail_on)) status = 1;
   if (!json_.empty() && !write_file(json_, campaign_json(report))) {

@@ -177,6 +177,12 @@ TEST_F(Campaign, ACleanRunThatFailsEndsTheCampaignWithRunsOwnStatus) {
   EXPECT_FALSE(fs::exists(path("c.json")));
 }
 
+TEST_F(Campaign, AProgramThatNeverSpeaksToTheChipIsNoPass) {
+  const RunResult r = run_program({l6470emu_program(), "campaign", "--chain", "chips=L6470", "--", "/bin/true"}, {}, 60);
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("sent no command to any chip"), std::string::npos) << r.err;
+}
+
 TEST_F(Campaign, BadInputIsOneLineAndStatusTwoAndNothingRuns) {
   std::ofstream(path("board")) << "chips=L6470\n";
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
