@@ -1,5 +1,5 @@
 // The preload's side of `l6470emu run`: the scenario bound to the in-process board, the
-// simulated time limit, and the report of why the program ended (linux/run_report.hpp), written
+// simulated time limit, and the report of why the program ended (board/run_report.hpp), written
 // once per process. Inactive (every call a no-op) outside a run.
 #pragma once
 
@@ -7,7 +7,7 @@
 
 #include "core/tick.hpp"
 #include "linux/device_board.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 
 namespace l6470emu::preload {
 
