@@ -241,7 +241,9 @@ class FirmwareRuntime {
 /// L6470EMU_CONFIG (a file), else the description the program was built with
 /// (l6470emu_default_board / l6470emu_default_board_file, set by l6470emu_add_sketch's BOARD),
 /// else one L6470 (docs/firmware.md); L6470EMU_TRACE, L6470EMU_LOG, L6470EMU_CHECK and
-/// L6470EMU_CHECK_ALLOW override trace=, log=, check= and check.allow=.
+/// L6470EMU_CHECK_ALLOW override trace=, log=, check= and check.allow=. Under `l6470emu run`
+/// (its L6470EMU_RUN_REPORT or L6470EMU_SCENARIO set) run's L6470EMU_CHAIN comes first, over a
+/// description the program gives too, and the runtime joins the run (firmware/run.hpp).
 /// A description that cannot run ends the program with one line on stderr and status 2. The
 /// first use decides the front; the runtime lives until the program ends and closes its
 /// recordings at exit.
