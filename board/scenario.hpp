@@ -121,6 +121,14 @@ struct ScenarioFailure {
   std::string seen;
 };
 
+/// What a scenario came to when the program ended (ScenarioRunner::outcome).
+struct ScenarioOutcome {
+  std::size_t judged = 0;                  ///< expectations judged
+  std::vector<ScenarioFailure> failures;   ///< those that failed
+  std::vector<std::string> passed;         ///< "WHERE: what" of those that held
+  std::vector<std::string> log;            ///< what the world did, one line each
+};
+
 /// The exchange form (JSON, one object) `run` hands the program's preload library.
 std::string serialize_scenario(const Scenario& s);
 /// Reads serialize_scenario's form back; nullopt and `error` (one line) when it is not that.

@@ -51,6 +51,8 @@ class ScenarioRunner {
   /// Expectations that held, as "WHERE: what" (for the JUnit report).
   const std::vector<std::string>& passed() const { return passed_; }
   const Scenario& scenario() const { return scenario_; }
+  /// What it came to so far (after finish(): at the program's end).
+  ScenarioOutcome outcome() const { return {judged_, failures_, passed_, log_}; }
 
  private:
   struct Resolved {

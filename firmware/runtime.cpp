@@ -8,7 +8,9 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "board/scenario_runner.hpp"
 #include "daisychain/chip_numbering.hpp"
+#include "firmware/run.hpp"
 
 namespace l6470emu {
 
@@ -42,7 +44,7 @@ class FixedHostClock final : public HostClock {
 };
 
 /// A time as "12.5 s" (whole microseconds at most).
-std::string seconds_text(Tick ticks) {
+std::string short_seconds_text(Tick ticks) {
   const std::uint64_t us = ticks / kTicksPerMicrosecond;
   std::string frac = std::to_string(us % 1'000'000);
   frac.insert(0, 6 - frac.size(), '0');
@@ -76,7 +78,7 @@ void apply_default_pins(BoardConfig& config, FirmwareFront front) {
 }  // namespace
 
 FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log)
-    : front_(front), config_(config), timing_(config.firmware), log_(std::move(log)) {
+    : front_(front), config_(config), timing_(config.firmware), log_(std::move(log)), limit_ticks_(timing_.limit_ticks) {
   if (!config_.socket.empty())
     throw std::invalid_argument("socket= forwards to an l6470emu serve daemon; a firmware run has its board in itself");
   if (!config_.time.virtual_time && config_.time.scale != 1.0)
@@ -91,7 +93,10 @@ FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front,
   wire(config_);
 }
 
-FirmwareRuntime::~FirmwareRuntime() { finish(); }
+FirmwareRuntime::~FirmwareRuntime() {
+  finish();
+  scenario_.reset();  // gives the board's sinks back before the board goes
+}
 
 // ---------------------------------------------------------------- wiring
 
@@ -195,14 +200,21 @@ bool FirmwareRuntime::pin_wired(int key) const {
 
 void FirmwareRuntime::set_now(Tick tick) {
   now_ = tick;
-  board_->time().set_now(tick);
+  if (!scenario_) {
+    board_->time().set_now(tick);
+    return;
+  }
+  // `run`'s scenario moves the board, acting at each step's own tick on the way.
+  const std::size_t before = scenario_->log().size();
+  scenario_->advance_to(tick);
+  if (scenario_->log().size() != before) world_acted();
 }
 
 void FirmwareRuntime::call() { spend(timing_.call_ticks); }
 
 void FirmwareRuntime::spend(Tick ticks) {
-  if (now_ + ticks >= timing_.limit_ticks) {
-    set_now(std::max(now_, timing_.limit_ticks));  // the run ends at the limit itself
+  if (now_ + ticks >= limit_ticks_) {
+    set_now(std::max(now_, limit_ticks_));  // the run ends at the limit itself
     stop_at_limit();
   }
   set_now(now_ + ticks);
@@ -220,10 +232,11 @@ void FirmwareRuntime::catch_up() {
 }
 
 void FirmwareRuntime::sleep_until(Tick tick) {
-  const Tick target = std::min(tick, timing_.limit_ticks);
+  const Tick target = std::min(tick, limit_ticks_);
   constexpr Tick kPollTicks = ticks_from_ms(1);
   while (now_ < target) {
     Tick step = target;
+    if (scenario_) step = std::min(step, std::max(scenario_->next_tick(), now_ + 1));  // a step acts then: wake for it
     if (board_watches_) {
       catch_up();
       step = std::min(step, next_edge_);
@@ -234,7 +247,7 @@ void FirmwareRuntime::sleep_until(Tick tick) {
     if (!polled_.empty()) poll_levels();
     if (any_pending_) deliver();
   }
-  if (now_ >= timing_.limit_ticks) stop_at_limit();
+  if (now_ >= limit_ticks_) stop_at_limit();
 }
 
 // ---------------------------------------------------------------- pins
@@ -246,6 +259,7 @@ void FirmwareRuntime::set_pin_mode(int key, McuPinMode mode) {
   if (front_ == FirmwareFront::arduino && mode == McuPinMode::input_pullup) l.latch = true;
   if (front_ == FirmwareFront::arduino && mode == McuPinMode::input) l.latch = false;
   apply_drive(l);
+  after_change();
   line_changed(l);
   process_edges();
   if (any_pending_) deliver();
@@ -260,6 +274,7 @@ void FirmwareRuntime::write_pin(int key, bool level) {
   Line& l = make_line(key);
   l.latch = level;
   apply_drive(l);
+  after_change();
   line_changed(l);
   process_edges();
   if (any_pending_) deliver();
@@ -526,11 +541,13 @@ void FirmwareRuntime::transfer(int controller, const BusSettings& settings, std:
     report_once(ctl.name + " two", ctl.name + ": bytes clocked with " + std::to_string(selected) +
                                         " chip selects low: every selected chain takes them and they drive MISO together");
   const Tick end = board_->clock_bytes(ctl.chains, tx, rx, settings);
+  clocked_ = clocked_ || !tx.empty();
   check_rules();
   set_now(std::max(now_, end));
+  after_change();
   if (board_watches_) dirty();
   process_edges();
-  if (now_ >= timing_.limit_ticks) stop_at_limit();
+  if (now_ >= limit_ticks_) stop_at_limit();
   if (any_pending_) deliver();
 }
 
@@ -568,14 +585,56 @@ void FirmwareRuntime::check_rules() {
     log(first.substr(std::min(first.size(), first.find("driver sanitizer"))) + " (the run ends with exit status " +
         std::to_string(kSanitizerExitStatus) + ")");
   }
+  // Under `l6470emu run`: the report says why the program ended (run's own exit status for it).
+  if (end_hook_) end_hook_(RunEnd::sanitizer, report->substr(0, report->find('\n')));
   stop(kSanitizerExitStatus, "");
 }
 
 void FirmwareRuntime::stop_at_limit() {
-  std::string why = "firmware run stopped at its time limit: " + seconds_text(now_) + " of virtual time (limit=" +
+  if (now_ >= run_limit_ && run_limit_ <= timing_.limit_ticks) {
+    // `l6470emu run`'s limit, before the program's own: the report says so, as the preload's does.
+    if (end_hook_) end_hook_(RunEnd::timeout, "");
+    stop(kTimeoutExitStatus, "");
+  }
+  std::string why = "firmware run stopped at its time limit: " + short_seconds_text(now_) + " of virtual time (limit=" +
                     limit_text(timing_.limit_ticks) + ")";
   if (front_ == FirmwareFront::arduino) why += "; loop() had run " + counted(loops, "time");
   stop(0, why);
+}
+
+// ---------------------------------------------------------------- under `l6470emu run`
+
+void FirmwareRuntime::bind_scenario(const Scenario& scenario) {
+  scenario_.reset();
+  scenario_ = std::make_unique<ScenarioRunner>(*board_, scenario);
+  scenario_->advance_to(now_);  // steps at tick 0 act before the program's first call
+  world_acted();
+}
+
+bool FirmwareRuntime::finish_scenario(ScenarioOutcome& out) {
+  if (!scenario_) return false;
+  scenario_->finish();
+  out = scenario_->outcome();
+  return true;
+}
+
+void FirmwareRuntime::set_run_limit(Tick limit) {
+  run_limit_ = limit;
+  limit_ticks_ = std::min(timing_.limit_ticks, run_limit_);
+}
+
+void FirmwareRuntime::set_end_hook(std::function<void(RunEnd, std::string_view)> hook) { end_hook_ = std::move(hook); }
+
+void FirmwareRuntime::after_change() {
+  if (!scenario_) return;
+  const std::size_t before = scenario_->log().size();
+  scenario_->after_transfer();
+  if (scenario_->log().size() != before) world_acted();
+}
+
+void FirmwareRuntime::world_acted() {
+  if (board_watches_) dirty();
+  process_edges();
 }
 
 // ---------------------------------------------------------------- the program's runtime
@@ -644,7 +703,10 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
   ParseResult parsed;
   const char* chain = std::getenv("L6470EMU_CHAIN");
   const char* file = std::getenv("L6470EMU_CONFIG");
-  if (description) {
+  // Under `l6470emu run` the run's board (its L6470EMU_CHAIN) is the program's, even over a
+  // description the program gives: run checked its scenario against it and judges by it.
+  const bool run_board = chain && *chain && (std::getenv(kRunReportEnv) || std::getenv(kRunScenarioEnv));
+  if (description && !run_board) {
     parsed = parse_board_config(description, "the program's description");
   } else if (chain && *chain) {
     parsed = parse_board_config(chain, "L6470EMU_CHAIN");
@@ -699,6 +761,8 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
   }
   g_runtime = runtime.release();  // lives until the program ends
   std::atexit(finish_at_exit);
+  // Under `l6470emu run`: its scenario, its time limit, its report (at exit, before finish_at_exit).
+  if (const std::string why = join_run(*g_runtime); !why.empty()) fail_to_start(why);
   return g_runtime;
 }
 

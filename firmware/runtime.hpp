@@ -17,8 +17,12 @@
 #include "board/board.hpp"
 #include "board/board_config.hpp"
 #include "board/pin_map.hpp"
+#include "board/run_report.hpp"
+#include "board/scenario.hpp"
 
 namespace l6470emu {
+
+class ScenarioRunner;
 
 /// Which API a program uses: decides the default pin map and how SPI controllers are named
 /// after their bus (docs/firmware.md, "The pin map").
@@ -143,6 +147,26 @@ class FirmwareRuntime {
   /// How many loop() iterations the Arduino runtime has begun (for the end-of-run line).
   std::uint64_t loops = 0;
 
+  // ---- under `l6470emu run` (firmware/run.hpp) ----------------------------------------------
+
+  /// Binds `scenario` to the board (board/scenario_runner.hpp): from then on time moves through
+  /// it (its steps act at their own ticks; a delay wakes for them) and it sees every SPI use and
+  /// pin change. Throws std::invalid_argument (one line naming the step) when it does not fit.
+  void bind_scenario(const Scenario& scenario);
+  /// Ends the bound scenario at the time now (its `end` expectations judged) into `out`; false
+  /// when none is bound. Idempotent.
+  bool finish_scenario(ScenarioOutcome& out);
+  /// The run's simulated time limit (kNever: none). Whichever of it and limit= comes first ends
+  /// the program: limit= as always (status 0), the run's with the end hook told RunEnd::timeout
+  /// and exit status kTimeoutExitStatus.
+  void set_run_limit(Tick limit);
+  /// Told the cause before the runtime ends the program itself for the run's time limit
+  /// (RunEnd::timeout, no words) or for a broken rule at check=error (RunEnd::sanitizer, the
+  /// report's first line). Any other end is the program's exit.
+  void set_end_hook(std::function<void(RunEnd cause, std::string_view detail)> hook);
+  /// Whether the program has clocked SPI bytes on the board.
+  bool clocked_bytes() const { return clocked_; }
+
  private:
   struct Line;
   struct ChipRef {
@@ -179,6 +203,10 @@ class FirmwareRuntime {
   /// Under check=error, after the board has seen a broken rule: the sanitizer's report on
   /// stderr, recordings finished, exit status kSanitizerExitStatus (86), as under the preload.
   void check_rules();
+  /// The bound scenario's steps fired by the SPI use or pin change just made.
+  void after_change();
+  /// A scenario step acted on the board: edges are taken and the next edge asked again.
+  void world_acted();
 
   FirmwareFront front_;
   BoardConfig config_;
@@ -202,13 +230,20 @@ class FirmwareRuntime {
   bool finished_ = false;
   std::vector<Controller> controllers_;
   std::vector<std::string> reported_;
+  std::unique_ptr<ScenarioRunner> scenario_;
+  Tick run_limit_ = kNever;
+  Tick limit_ticks_ = 0;   // the earlier of limit= and the run's limit
+  std::function<void(RunEnd, std::string_view)> end_hook_;
+  bool clocked_ = false;
 };
 
 /// The program's runtime, made at its first use: from L6470EMU_CHAIN (a description), else
 /// L6470EMU_CONFIG (a file), else the description the program was built with
 /// (l6470emu_default_board / l6470emu_default_board_file, set by l6470emu_add_sketch's BOARD),
 /// else one L6470 (docs/firmware.md); L6470EMU_TRACE, L6470EMU_LOG, L6470EMU_CHECK and
-/// L6470EMU_CHECK_ALLOW override trace=, log=, check= and check.allow=.
+/// L6470EMU_CHECK_ALLOW override trace=, log=, check= and check.allow=. Under `l6470emu run`
+/// (its L6470EMU_RUN_REPORT or L6470EMU_SCENARIO set) run's L6470EMU_CHAIN comes first, over a
+/// description the program gives too, and the runtime joins the run (firmware/run.hpp).
 /// A description that cannot run ends the program with one line on stderr and status 2. The
 /// first use decides the front; the runtime lives until the program ends and closes its
 /// recordings at exit.

@@ -487,10 +487,7 @@ bool DeviceBoard::finish_scenario(ScenarioOutcome& out) {
   std::lock_guard lock(m_);
   if (!scenario_) return false;
   scenario_->finish();
-  out.judged = scenario_->judged();
-  out.failures = scenario_->failures();
-  out.passed = scenario_->passed();
-  out.log = scenario_->log();
+  out = scenario_->outcome();
   return true;
 }
 

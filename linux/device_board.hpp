@@ -37,14 +37,6 @@ namespace l6470emu {
 
 class ScenarioRunner;
 
-/// What a scenario came to when the program ended (DeviceBoard::finish_scenario).
-struct ScenarioOutcome {
-  std::size_t judged = 0;                  ///< expectations judged
-  std::vector<ScenarioFailure> failures;   ///< those that failed
-  std::vector<std::string> passed;         ///< "WHERE: what" of those that held
-  std::vector<std::string> log;            ///< what the world did, one line each
-};
-
 /// What kind of open file a handle is.
 enum class HandleKind : std::uint8_t {
   spidev = 1,           ///< an open /dev/spidevB.C

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "core/near_miss.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 #include "tools/xml_text.hpp"
 
 namespace l6470emu {

@@ -30,7 +30,7 @@
 #include "core/near_miss.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
 #include "linux/scenario_yaml.hpp"
 #include "spi/trace.hpp"

@@ -24,7 +24,7 @@
 #include "linux/clock.hpp"
 #include "linux/device_board.hpp"
 #include "tools/run_outcome.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
 #include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"

@@ -1,7 +1,7 @@
 // `l6470emu run`: builds a board, runs an unmodified program against it through the preload
 // library (virtual time by default) or the kernel's own device nodes (CUSE, UHID; wall time),
 // applies a scenario, and ends with a report, a JUnit file and an exit status a CI reads
-// (linux/run_report.hpp's RunStatus; docs/scenarios.md).
+// (board/run_report.hpp's RunStatus; docs/scenarios.md).
 #pragma once
 
 #include <CLI/CLI.hpp>

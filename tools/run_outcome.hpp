@@ -12,7 +12,7 @@ namespace l6470emu {
 
 /// What a run came to.
 struct RunOutcome {
-  int status = 0;            ///< run's exit status (linux/run_report.hpp's RunStatus)
+  int status = 0;            ///< run's exit status (board/run_report.hpp's RunStatus)
   bool exited = false;       ///< the program exited (else it was killed by `signal`)
   int code = 0;              ///< its exit code when it exited
   int signal = 0;            ///< the signal that killed it, 0 when none

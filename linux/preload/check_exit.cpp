@@ -14,7 +14,7 @@
 #include "board/check_rules.hpp"
 #include "core/near_miss.hpp"
 #include "linux/log.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 #include "linux/preload/state.hpp"
 
 namespace l6470emu::preload {
@@ -23,7 +23,7 @@ namespace {
 constexpr const char* kKnown[] = {
     "L6470EMU_CHAIN", "L6470EMU_CONFIG", "L6470EMU_SOCKET", "L6470EMU_LOG",         "L6470EMU_TRACE",
     "L6470EMU_SHM",   "L6470EMU_CHECK",  "L6470EMU_CHECK_ALLOW",
-    // set by `l6470emu run` for the program it runs (linux/run_report.hpp)
+    // set by `l6470emu run` for the program it runs (board/run_report.hpp)
     kRunReportEnv, kRunScenarioEnv, kRunTimeoutEnv,
     // read by the l6470emu program, the Python package, the benchmarks and the test suite, not
     // by the preload: known all the same

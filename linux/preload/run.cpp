@@ -123,4 +123,14 @@ void run_after_fork_child() {
   g_devices.store(false);
 }
 
+void leave_run() {
+  Guard guard;
+  g_board = nullptr;  // no report at exit, no time limit: the program's own board has them
+}
+
 }  // namespace l6470emu::preload
+
+extern "C" __attribute__((visibility("default"))) long l6470emu_preload_leave_run(void) {
+  l6470emu::preload::leave_run();
+  return static_cast<long>(getpid());
+}

@@ -1,5 +1,5 @@
 // The preload's side of `l6470emu run`: the scenario bound to the in-process board, the
-// simulated time limit, and the report of why the program ended (linux/run_report.hpp), written
+// simulated time limit, and the report of why the program ended (board/run_report.hpp), written
 // once per process. Inactive (every call a no-op) outside a run.
 #pragma once
 
@@ -7,7 +7,7 @@
 
 #include "core/tick.hpp"
 #include "linux/device_board.hpp"
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 
 namespace l6470emu::preload {
 
@@ -35,5 +35,15 @@ void run_device_opened();
 void end_run(RunEnd cause, std::string_view detail);
 /// fork(): the child reports for itself (it has opened nothing yet).
 void run_after_fork_child();
+/// The program has a board of its own that takes part in the run and reports for the process
+/// (a firmware program, firmware/run.hpp): the preload's board leaves the run (no report, no time
+/// limit of its own). Reached from the program through l6470emu_preload_leave_run().
+void leave_run();
 
 }  // namespace l6470emu::preload
+
+/// The one function the preload exports besides the C library's it replaces (exports.map): a
+/// firmware program under `l6470emu run` calls it, through a weak reference, when its own
+/// runtime takes the run over (preload::leave_run; firmware/run.hpp). Returns the process's id
+/// (getpid()) for the firmware's report block. Harmless outside a run.
+extern "C" long l6470emu_preload_leave_run(void);

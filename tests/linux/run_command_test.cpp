@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "linux/run_report.hpp"
+#include "board/run_report.hpp"
 #include "linux/virtual_scheduler.hpp"
 #include "run_program.hpp"
 

@@ -1,5 +1,5 @@
-// The run report's blocks: written by the preload, read by `l6470emu run`.
-#include "linux/run_report.hpp"
+// The run report's blocks: written by the fronts (preload, firmware), read by `l6470emu run`.
+#include "board/run_report.hpp"
 
 #include <charconv>
 

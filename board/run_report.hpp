@@ -1,10 +1,10 @@
 // What a program run by `l6470emu run` tells `run` when it ends: why it ended (its exit, the
 // run's time limit, a virtual-time deadlock, a sanitizer error) and what its scenario came to.
-// The preload writes one block per process to the file run names in L6470EMU_RUN_REPORT; this
-// file is the block's format and run's exit statuses (docs/scenarios.md), nothing else.
+// Each front that runs programs (the preload, linux/preload/run.cpp; the firmware runtime,
+// firmware/run.cpp) appends one block per process to the file run names in L6470EMU_RUN_REPORT;
+// this file is the block's text and run's exit statuses (docs/scenarios.md), nothing else: the
+// fronts write the file themselves.
 #pragma once
-
-#include <sys/types.h>
 
 #include <cstdint>
 #include <string>
@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "board/scenario.hpp"
-#include "linux/device_board.hpp"
 
 namespace l6470emu {
 
@@ -43,7 +42,7 @@ std::string_view to_string(RunEnd end);
 
 /// One process's block.
 struct RunReport {
-  pid_t pid = 0;
+  std::int64_t pid = 0;               ///< the process (a pid_t)
   RunEnd end = RunEnd::exit;
   Tick tick = 0;                      ///< the board's time at the end
   bool devices = false;               ///< the process exchanged SPI bytes with the board
