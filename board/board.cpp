@@ -32,6 +32,18 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     }
     chains_.push_back(std::move(cs));
   }
+  output_reads_.resize(chains_.size());
+  for (std::size_t c = 0; c < chains_.size(); ++c) output_reads_[c].assign(chip_count(c), {kNever, kNever});
+}
+
+void Board::note_output_read(std::size_t chain, std::size_t chip, Pin pin) {
+  if (chain >= output_reads_.size() || chip >= output_reads_[chain].size() || (pin != Pin::BUSY && pin != Pin::FLAG)) return;
+  output_reads_[chain][chip][pin == Pin::FLAG ? 1 : 0] = time_.now();
+}
+
+Tick Board::last_output_read(std::size_t chain, std::size_t chip, Pin pin) const {
+  if (chain >= output_reads_.size() || chip >= output_reads_[chain].size() || (pin != Pin::BUSY && pin != Pin::FLAG)) return kNever;
+  return output_reads_[chain][chip][pin == Pin::FLAG ? 1 : 0];
 }
 
 Board::~Board() = default;

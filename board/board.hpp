@@ -4,6 +4,7 @@
 // DeviceBoard puts spidev and gpiochip semantics and a lock around it; a firmware front, HAL calls).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -181,6 +182,12 @@ class Board {
   void report_changes(std::size_t chain);
   /// Where edges of watched pins go (an empty function drops them).
   void set_edge_sink(EdgeSink sink) { edge_sink_ = std::move(sink); }
+  /// The host read output `pin` (BUSY or FLAG) of chip `chip` now: a gpio value read, a
+  /// digitalRead, an edge event handed to it. Fronts call it for their host's reads only (not for
+  /// their own looks), so that a run can say whether the driver looked at the pin after a fault.
+  void note_output_read(std::size_t chain, std::size_t chip, Pin pin);
+  /// The board's time at the host's last read of output `pin` of chip `chip` (kNever: never read).
+  Tick last_output_read(std::size_t chain, std::size_t chip, Pin pin) const;
 
   // ---- time ---------------------------------------------------------------------
 
@@ -283,6 +290,8 @@ class Board {
   BoardConfig config_;  // the description (board-wide keys) a recording's header carries
   TraceOutputOpener open_output_;
   std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last use ends
+  // Per chain and chip: the host's last read of BUSY ([0]) and FLAG ([1]), kNever when none.
+  std::vector<std::vector<std::array<Tick, 2>>> output_reads_;
   std::vector<std::unique_ptr<ChainState>> chains_;
 };
 

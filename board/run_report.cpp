@@ -52,6 +52,8 @@ std::string format_run_report(const RunReport& r) {
   for (const ScenarioFailure& f : r.outcome.failures)
     out += "fail " + field(f.where) + "\t" + field(f.what) + "\t" + std::to_string(f.tick) + "\t" + field(f.chip) + "\t" +
            field(f.expected) + "\t" + field(f.seen) + "\n";
+  for (const auto& p : r.outcome.pin_reads)
+    out += "pinread " + field(p.chain) + "\t" + std::to_string(p.chip) + "\t" + field(p.pin) + "\t" + std::to_string(p.tick) + "\n";
   return out + ".\n";
 }
 
@@ -112,6 +114,16 @@ std::vector<RunReport> parse_run_reports(std::string_view text) {
       sf.expected = f[4];
       sf.seen = f[5];
       cur.outcome.failures.push_back(std::move(sf));
+    } else if (key == "pinread") {
+      const auto f = split(value, '\t');
+      ScenarioOutcome::PinRead p;
+      if (f.size() != 4 || !number(f[1], p.chip) || !number(f[3], p.tick)) {
+        ok = false;
+        continue;
+      }
+      p.chain = f[0];
+      p.pin = f[2];
+      cur.outcome.pin_reads.push_back(std::move(p));
     }
   }
   return out;

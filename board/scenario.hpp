@@ -123,10 +123,18 @@ struct ScenarioFailure {
 
 /// What a scenario came to when the program ended (ScenarioRunner::outcome).
 struct ScenarioOutcome {
+  /// The host's last read of a chip's BUSY or FLAG pin (Board::last_output_read).
+  struct PinRead {
+    std::string chain;     ///< "spidev0.0"
+    std::size_t chip = 0;  ///< as users number it
+    std::string pin;       ///< "BUSY" or "FLAG"
+    Tick tick = 0;
+  };
   std::size_t judged = 0;                  ///< expectations judged
   std::vector<ScenarioFailure> failures;   ///< those that failed
   std::vector<std::string> passed;         ///< "WHERE: what" of those that held
   std::vector<std::string> log;            ///< what the world did, one line each
+  std::vector<PinRead> pin_reads;          ///< every chip's pins the host read, at its last read
 };
 
 /// The exchange form (JSON, one object) `run` hands the program's preload library.

@@ -555,4 +555,18 @@ void ScenarioRunner::finish() {
   }
 }
 
+ScenarioOutcome ScenarioRunner::outcome() const {
+  ScenarioOutcome o;
+  o.judged = judged_;
+  o.failures = failures_;
+  o.passed = passed_;
+  o.log = log_;
+  for (std::size_t c = 0; c < board_.chain_count(); ++c)
+    for (std::size_t k = 0; k < board_.chip_count(c); ++k)
+      for (const Pin p : {Pin::BUSY, Pin::FLAG})
+        if (const Tick t = board_.last_output_read(c, k, p); t != kNever)
+          o.pin_reads.push_back({board_.chain_name(c), board_.chip_numbering(c).number_of(k), p == Pin::BUSY ? "BUSY" : "FLAG", t});
+  return o;
+}
+
 }  // namespace l6470emu

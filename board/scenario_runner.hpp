@@ -52,7 +52,8 @@ class ScenarioRunner {
   const std::vector<std::string>& passed() const { return passed_; }
   const Scenario& scenario() const { return scenario_; }
   /// What it came to so far (after finish(): at the program's end).
-  ScenarioOutcome outcome() const { return {judged_, failures_, passed_, log_}; }
+  /// What the scenario came to so far, with the host's last reads of every BUSY and FLAG pin.
+  ScenarioOutcome outcome() const;
 
  private:
   struct Resolved {

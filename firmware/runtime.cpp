@@ -288,6 +288,7 @@ bool FirmwareRuntime::pin_latch(int key) const {
 bool FirmwareRuntime::read_pin(int key) {
   Line* l = line(key);
   if (!l) return false;
+  for (const ChipRef& r : l->outputs) board_->note_output_read(r.chain, r.chip, r.pin);  // the program looks (BUSY, FLAG)
   const bool level = line_level(*l, false);
   process_edges();
   return level;

@@ -394,6 +394,7 @@ void DeviceBoard::send_line_event(Handle& h, unsigned index, bool rising, Tick t
   } else {
     return;
   }
+  if (n >= 0) board_.note_output_read(g.chain, chip_of_line(off), pin_of_line(off));  // handed to the host
   if (n < 0 && ++h.dropped == 1)
     log_.line(g.name + ": " + g.lines[off].name + ": event queue full, edge events dropped (the host does not read them)");
 }

@@ -285,6 +285,7 @@ long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>&
 bool DeviceBoard::logical_value(Handle& h, unsigned index) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned off = h.offsets[index];
+  board_.note_output_read(g.chain, chip_of_line(off), pin_of_line(off));  // the host looks (BUSY, FLAG)
   return physical_level(g, off) != ((g.lines[off].flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
 }
 

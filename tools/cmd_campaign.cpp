@@ -635,6 +635,10 @@ int CampaignCommand::run_campaign() {
               read = read || (d.end > p.point.tick &&
                               (d.command == Command::GetStatus ||
                                (d.command == Command::GetParam && status_reg && d.param == status_reg->address)));
+        // ... or looked at its FLAG or BUSY pin at or after the fault's tick.
+        if (outcome)
+          for (const auto& pr : outcome->pin_reads)
+            read = read || (pr.chain == chip.chain_name && pr.chip == chip.number && pr.tick >= p.point.tick);
         r.flag_read = read;
       }
       r.traffic_differs = traffic_differs_after(clean_frames[chip.chain], frame_hashes(rerun_trace), p.point.tick);

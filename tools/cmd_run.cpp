@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -489,6 +490,13 @@ std::optional<int> RunCommand::run() {
     o.ended = ended;
     o.failures = failures;
     if (cause_block) o.detail = cause_block->detail;
+    for (const RunReport* b : judged)
+      for (const auto& p : b->outcome.pin_reads) {
+        auto same = [&](const ScenarioOutcome::PinRead& q) { return q.chain == p.chain && q.chip == p.chip && q.pin == p.pin; };
+        const auto it = std::find_if(o.pin_reads.begin(), o.pin_reads.end(), same);
+        if (it == o.pin_reads.end()) o.pin_reads.push_back(p);
+        else it->tick = std::max(it->tick, p.tick);
+      }
     if (!write_run_outcome(outcome_, o)) std::cerr << "l6470emu run: cannot write " << outcome_ << "\n";
   }
   if (!junit_.empty()) {

@@ -20,6 +20,9 @@ bool write_run_outcome(const std::string& path, const RunOutcome& o) {
   for (const ScenarioFailure& f : o.failures)
     j["failures"].push_back({{"where", f.where}, {"what", f.what}, {"tick", f.tick}, {"chip", f.chip},
                              {"expected", f.expected}, {"seen", f.seen}});
+  j["pin_reads"] = nlohmann::json::array();
+  for (const auto& p : o.pin_reads)
+    j["pin_reads"].push_back({{"chain", p.chain}, {"chip", p.chip}, {"pin", p.pin}, {"tick", p.tick}});
   std::ofstream out(path, std::ios::trunc);
   out << j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   out.close();
@@ -43,6 +46,9 @@ std::optional<RunOutcome> read_run_outcome(const std::string& path) {
       o.failures.push_back(ScenarioFailure{f.at("where").get<std::string>(), f.at("what").get<std::string>(),
                                            f.at("tick").get<Tick>(), f.at("chip").get<std::string>(),
                                            f.at("expected").get<std::string>(), f.at("seen").get<std::string>()});
+    for (const auto& p : j.at("pin_reads"))
+      o.pin_reads.push_back(ScenarioOutcome::PinRead{p.at("chain").get<std::string>(), p.at("chip").get<std::size_t>(),
+                                                     p.at("pin").get<std::string>(), p.at("tick").get<Tick>()});
     return o;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;

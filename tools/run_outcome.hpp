@@ -20,6 +20,8 @@ struct RunOutcome {
   std::string ended;         ///< "exited with status 0", "deadlocked in virtual time", ...
   std::vector<std::string> detail;  ///< the cause in words (the deadlock report, the sanitizer's finding)
   std::vector<ScenarioFailure> failures;
+  /// The program's last read of each chip's BUSY and FLAG pins it read (the latest over its processes).
+  std::vector<ScenarioOutcome::PinRead> pin_reads;
 };
 
 /// Writes `o` to `path` as JSON; false when the file cannot be written.

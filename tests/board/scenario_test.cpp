@@ -82,6 +82,28 @@ ScenarioExpectation reg(std::string name, std::int64_t value, std::int64_t toler
   return e;
 }
 
+TEST(ScenarioRunner, TheOutcomeSaysWhenTheHostLastLookedAtEachChipsBusyAndFlagPins) {
+  VirtualBoard v("chips=2xL6470 time=virtual");
+  ScenarioRunner runner(v.board, Scenario{});
+  EXPECT_TRUE(runner.outcome().pin_reads.empty());
+  runner.advance_to(1000);
+  v.board.note_output_read(0, 1, Pin::FLAG);
+  runner.advance_to(2500);
+  v.board.note_output_read(0, 1, Pin::FLAG);
+  v.board.note_output_read(0, 0, Pin::BUSY);
+  v.board.note_output_read(0, 0, Pin::SW);  // an input: the host drives it, nothing to say
+  const auto reads = runner.outcome().pin_reads;
+  ASSERT_EQ(reads.size(), 2u);
+  EXPECT_EQ(reads[0].chain, "spidev0.0");
+  EXPECT_EQ(reads[0].chip, 0u);
+  EXPECT_EQ(reads[0].pin, "BUSY");
+  EXPECT_EQ(reads[0].tick, 2500u);
+  EXPECT_EQ(reads[1].chip, 1u);
+  EXPECT_EQ(reads[1].pin, "FLAG");
+  EXPECT_EQ(reads[1].tick, 2500u);
+  EXPECT_EQ(v.board.last_output_read(0, 1, Pin::BUSY), kNever);
+}
+
 TEST(ScenarioRunner, ATimedSwitchClosureReachesTheChipAtItsTickWhateverTheHostWaitsFor) {
   VirtualBoard v("chips=L6470; time=virtual");
   ScenarioAction close;

@@ -122,6 +122,38 @@ TEST_F(Campaign, ABrownOutAndALostFrameAreSeenByACarefulDriverAndMissedByACarele
   EXPECT_EQ(rerun(careless, "reset", "during_motion")["first_failure"]["what"], "ACC");
 }
 
+TEST_F(Campaign, ADriverThatWatchesTheFlagPinReadsTheFaultWithoutAskingForStatus) {
+  // python3-libgpiod: BUSY and FLAG as lines; STATUS is read once, before the fault can come.
+  // Move out, watch the pins while it runs, GoTo back (its last command: the points lie before it).
+  std::ofstream(path("pins.py")) << R"(import sys, time
+import gpiod, spidev
+chip = gpiod.Chip("gpiochip0")
+busy, flag = chip.get_line(0), chip.get_line(1)
+for line in (busy, flag):
+    line.request(consumer="campaign", type=gpiod.LINE_REQ_DIR_IN)
+s = spidev.SpiDev(); s.open(0, 0); s.mode = 3
+x = lambda *bs: [s.xfer2([b])[0] for b in bs]
+x(0xD0, 0, 0)
+x(0x41, 0x00, 0x10, 0x00)
+while busy.get_value() == 0:
+    if flag.get_value() == 0:
+        sys.exit(1)
+    time.sleep(0.005)
+x(0x60, 0, 0, 0)
+)";
+  const RunResult r = run_program({l6470emu_program(), "campaign", "--chain", "bus=0 cs=0 chips=L6470 check=warn", "--faults",
+                                   "thermal_warning,ocd", "--json", path("c.json"), "--", system_python(), path("pins.py")},
+                                  {}, 120);
+  const Json j = Json::parse(read(path("c.json")));
+  const Json warned = rerun(j, "thermal_warning", "during_motion");
+  EXPECT_EQ(warned["verdict"], "detected") << r.err;
+  EXPECT_EQ(warned["flag_read"], true) << warned;
+  // An overcurrent stops the motor: BUSY rises and the loop ends before it looks at FLAG again.
+  const Json stopped = rerun(j, "ocd", "during_motion");
+  EXPECT_EQ(stopped["verdict"], "silent_failure") << stopped;
+  EXPECT_EQ(r.status, 1) << r.err;
+}
+
 TEST_F(Campaign, TheSameCampaignTwiceGivesTheSameJsonAndThreeShardsMergeIntoIt) {
   const std::vector<std::string> args{"--faults", "ocd,uvlo,sw_close", "--json", path("c.json")};
   const int status = campaign(args, "careful").status;

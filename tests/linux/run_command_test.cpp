@@ -305,6 +305,7 @@ TEST(RunReport, BlocksReadBackAndACutBlockIsSkipped) {
   a.outcome.judged = 2;
   a.outcome.failures.push_back(ScenarioFailure{"s.yaml:3", "ABS_POS", 7, "spidev0.0 chip 1", "0", "12"});
   a.outcome.passed = {"s.yaml:4: frames = 3"};
+  a.outcome.pin_reads.push_back({"spidev0.1", 2, "FLAG", 123456});
   const std::string text = format_run_report(a) + "l6470emu-run-report 1\npid 43\nend exit\n";
   const auto blocks = parse_run_reports(text);
   ASSERT_EQ(blocks.size(), 1u);
@@ -314,6 +315,11 @@ TEST(RunReport, BlocksReadBackAndACutBlockIsSkipped) {
   ASSERT_EQ(blocks[0].outcome.failures.size(), 1u);
   EXPECT_EQ(blocks[0].outcome.failures[0].seen, "12");
   EXPECT_EQ(blocks[0].outcome.failures[0].tick, 7u);
+  ASSERT_EQ(blocks[0].outcome.pin_reads.size(), 1u);
+  EXPECT_EQ(blocks[0].outcome.pin_reads[0].chain, "spidev0.1");
+  EXPECT_EQ(blocks[0].outcome.pin_reads[0].chip, 2u);
+  EXPECT_EQ(blocks[0].outcome.pin_reads[0].pin, "FLAG");
+  EXPECT_EQ(blocks[0].outcome.pin_reads[0].tick, 123456u);
 }
 
 }  // namespace
