@@ -405,7 +405,8 @@ TEST(ScenarioRunner, TheOneShotFaultsActAtTheirTicksAndTheRecordingReplaysThemEx
   EXPECT_NE(text.str().find(" fault 0 POWER_CYCLE\n"), std::string::npos) << text.str();
   EXPECT_NE(text.str().find(" fault 1 MISO_FLIP 7\n"), std::string::npos);
   EXPECT_NE(text.str().find(" fault 0 LOST_FRAME\n"), std::string::npos);
-  NativeTraceReader reader(text.str(), "one-shot.trace");
+  const std::string recorded = text.str();  // the reader keeps a view of it
+  NativeTraceReader reader(recorded, "one-shot.trace");
   Chain fresh(3);
   const ReplayResult r = replay_trace(reader, fresh);
   EXPECT_TRUE(r.matched()) << (r.divergences.empty() ? "" : r.divergences[0].report);
