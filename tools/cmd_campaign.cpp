@@ -36,6 +36,7 @@
 #include "spi/trace.hpp"
 #include "tools/campaign_plan.hpp"
 #include "tools/cli_errors.hpp"
+#include "tools/output_check.hpp"
 #include "tools/campaign_report.hpp"
 #include "tools/run_outcome.hpp"
 #include "tools/trace_input.hpp"
@@ -71,25 +72,6 @@ std::string file_word(const std::string& s) {
   std::string out;
   for (const char c : s) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
   return out;
-}
-
-// One line saying why `path` cannot be a report (""=it can): checked before anything runs.
-std::string output_problem(const std::string& path, const std::vector<std::string>& inputs) {
-  if (path.empty()) return "an empty path";
-  struct stat st {};
-  const bool exists = stat(path.c_str(), &st) == 0;
-  if (exists && !S_ISREG(st.st_mode)) return "not a regular file";
-  if (exists && (st.st_mode & 0222) == 0) return "a read-only file";
-  for (const std::string& in : inputs) {
-    struct stat is {};
-    if (exists && !in.empty() && stat(in.c_str(), &is) == 0 && is.st_dev == st.st_dev && is.st_ino == st.st_ino)
-      return "it is one of the campaign's inputs (" + in + "): an output never overwrites an input";
-  }
-  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  if (fd < 0) return std::strerror(errno);
-  close(fd);
-  if (!exists) unlink(path.c_str());
-  return "";
 }
 
 bool write_file(const std::string& path, const std::string& text) {

@@ -30,6 +30,7 @@
 #include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"
 #include "tools/kernel_nodes.hpp"
+#include "tools/output_check.hpp"
 #include "tools/xml_text.hpp"
 
 extern char** environ;
@@ -377,6 +378,20 @@ std::optional<int> RunCommand::run() {
   }
   if (text.find("check=") == std::string::npos) config.check.level = CheckLevel::error;
   if (!record_.empty()) config.trace = record_;
+  // The reports, checked before the program starts: one that cannot be written, or that is an
+  // input, ends the run here (an output never overwrites an input).
+  {
+    const std::vector<std::string> inputs{board_file_, scenario_file_, program_.front()};
+    for (const auto& [option, path] : {std::pair<const char*, const std::string*>{"--junit", &junit_},
+                                       {"--outcome", &outcome_}})
+      if (cmd_->count(option) > 0)
+        if (const std::string why = output_problem(*path, inputs); !why.empty())
+          return usage("l6470emu run: cannot write " + std::string(option) + " " + quoted_text(*path) + ": " + why);
+    if (cmd_->count("--record") > 0 && config.chains.size() == 1)
+      if (const std::string why = output_problem(record_, inputs); !why.empty())
+        return usage("l6470emu run: cannot write --record " + quoted_text(record_) + ": " + why);
+    if (!junit_.empty() && junit_ == record_) return usage("l6470emu run: --junit and --record name the same file");
+  }
 
   // 2. The scenario, read and checked against the board.
   Scenario scenario;
@@ -536,7 +551,11 @@ std::optional<int> RunCommand::run() {
     x << "  </testsuite>\n</testsuites>\n";
     std::ofstream j(junit_, std::ios::trunc);
     j << x.str();
-    if (!j) std::cerr << "l6470emu run: cannot write the JUnit report " << junit_ << "\n";
+    j.close();
+    if (!j) {  // the report CI reads is lost: the run cannot pass
+      std::cerr << "l6470emu run: cannot write the JUnit report " << junit_ << "; exit 2\n";
+      return kRunUsage;
+    }
   }
   return status;
 }

@@ -77,6 +77,32 @@ TEST_F(RunCommand, AFailedExpectationIsStatusOneAndSaysWhatWhenWhichChipExpected
   EXPECT_NE(r.err.find("2 expectations, 1 failed; exit 1: an expectation failed"), std::string::npos) << r.err;
 }
 
+TEST_F(RunCommand, AReportThatCannotBeWrittenOrWouldOverwriteAnInputEndsTheRunBeforeTheProgramStarts) {
+  const std::string scenario = file("s.yaml", kSwitchScenario);
+  const std::string marker = path("started");
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+      {{"--junit", "/dev/full"}, "cannot write --junit '/dev/full': not a regular file"},
+      {{"--junit", "/proc/version"}, "cannot write --junit '/proc/version': a read-only file"},
+      {{"--junit", ""}, "cannot write --junit '': an empty path"},
+      {{"--junit", path("no/such/folder/r.xml")}, "No such file or directory"},
+      {{"--junit", scenario}, "an output never overwrites an input"},
+      {{"--record", scenario}, "an output never overwrites an input"},
+      {{"--junit", path("x"), "--record", path("x")}, "--junit and --record name the same file"},
+  };
+  for (const auto& [extra, said] : cases) {
+    std::vector<std::string> args{"--chain", "chips=L6470", "--scenario", scenario};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = run(args, {"/bin/sh", "-c", "touch " + marker});
+    EXPECT_EQ(r.status, kRunUsage) << r.err;
+    EXPECT_NE(r.err.find(said), std::string::npos) << said << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(marker)) << "the program ran";
+  }
+  std::ifstream in(scenario);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), kSwitchScenario) << "the scenario was overwritten";
+}
+
 TEST_F(RunCommand, AllExpectationsHeldIsStatusZeroAndTheJUnitReportIsWellFormed) {
   const std::string scenario = file("s.yaml", R"(steps:
   - at: 100ms
