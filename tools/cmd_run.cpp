@@ -97,6 +97,21 @@ std::string seconds_number(Tick t) {
   return buf;
 }
 
+// What an expectation looks at, in words that do not depend on what was seen ("ABS_POS",
+// "STATUS", "command GoUntil", "BUSY pulse 2"): its JUnit testcase's name after its step.
+std::string expectation_label(const ScenarioExpectation& e) {
+  switch (e.kind) {
+    case ScenarioExpectation::Kind::reg: return e.name;
+    case ScenarioExpectation::Kind::true_position: return "true position";
+    case ScenarioExpectation::Kind::status: return "STATUS";
+    case ScenarioExpectation::Kind::busy_pulse: return e.pulse ? "BUSY pulse " + std::to_string(e.pulse) : "BUSY pulses";
+    case ScenarioExpectation::Kind::command: return "command " + e.name;
+    case ScenarioExpectation::Kind::frames: return "frames";
+    case ScenarioExpectation::Kind::sanitizer: return "sanitizer";
+  }
+  return "?";
+}
+
 const char* status_words(int status) {
   switch (status) {
     case kRunPassed: return "passed";
@@ -515,17 +530,43 @@ std::optional<int> RunCommand::run() {
     if (!write_run_outcome(outcome_, o)) std::cerr << "l6470emu run: cannot write " << outcome_ << "\n";
   }
   if (!junit_.empty()) {
+    // One testcase per expectation, in the scenario's order and named by its step and what it
+    // looks at, the same whether it held or not (CI keeps a history per name); a failure
+    // element where it failed, a skipped one where it was never judged (the program ended first).
+    struct Case {
+      std::string name;
+      const ScenarioFailure* failure = nullptr;
+      bool judged = false;
+    };
+    std::vector<Case> cases;
+    for (const ScenarioStep& st : scenario.steps) {
+      if (!st.expect) continue;
+      Case c;
+      c.name = st.where + ": " + expectation_label(*st.expect);
+      for (const ScenarioFailure& f : failures)
+        if (!c.failure && f.where == st.where) c.failure = &f;
+      for (const std::string& p : passed) c.judged = c.judged || p.rfind(st.where + ": ", 0) == 0;
+      cases.push_back(std::move(c));
+    }
+    for (const ScenarioFailure& f : failures)  // (every failure is a step's; kept whatever comes)
+      if (std::none_of(cases.begin(), cases.end(), [&](const Case& c) { return c.failure == &f || (c.failure && c.failure->where == f.where); }))
+        cases.push_back(Case{f.where + ": " + f.what, &f, true});
+    std::size_t failed = 0, skipped = 0;
+    for (const Case& c : cases) {
+      failed += c.failure ? 1 : 0;
+      skipped += !c.failure && !c.judged ? 1 : 0;
+    }
     std::ostringstream x;
     const std::string suite = scenario.name.empty() ? "run" : scenario.name;
     const bool program_failed = status == kRunTimedOut || status == kRunDeadlocked || status == kRunSanitizerError ||
                                 status == kRunProgramFailed || status == kRunNotStarted;
-    const std::size_t tests = 1 + passed.size() + failures.size();
+    const std::size_t tests = 1 + cases.size();
     const std::string time = seconds_number(end_tick);
     x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-    x << "<testsuites name=\"l6470emu run\" tests=\"" << tests << "\" failures=\"" << failures.size() << "\" errors=\""
+    x << "<testsuites name=\"l6470emu run\" tests=\"" << tests << "\" failures=\"" << failed << "\" errors=\""
       << (program_failed ? 1 : 0) << "\" time=\"" << time << "\">\n";
-    x << "  <testsuite name=\"" << xml(suite) << "\" tests=\"" << tests << "\" failures=\"" << failures.size()
-      << "\" errors=\"" << (program_failed ? 1 : 0) << "\" skipped=\"0\" time=\"" << time << "\">\n";
+    x << "  <testsuite name=\"" << xml(suite) << "\" tests=\"" << tests << "\" failures=\"" << failed
+      << "\" errors=\"" << (program_failed ? 1 : 0) << "\" skipped=\"" << skipped << "\" time=\"" << time << "\">\n";
     const std::string cls = "l6470emu.run." + xml(suite);
     x << "    <testcase classname=\"" << cls << "\" name=\"" << xml("program " + program_[0]) << "\" time=\"" << time << "\">";
     if (program_failed) {
@@ -536,12 +577,17 @@ std::optional<int> RunCommand::run() {
       x << "</error>\n    ";
     }
     x << "</testcase>\n";
-    for (const auto& p : passed) x << "    <testcase classname=\"" << cls << "\" name=\"" << xml(p) << "\" time=\"0\"/>\n";
-    for (const ScenarioFailure& f : failures) {
-      x << "    <testcase classname=\"" << cls << "\" name=\"" << xml(f.where + ": " + f.what) << "\" time=\"0\">\n";
-      x << "      <failure type=\"expectation\" message=\"" << xml("expected " + f.expected + ", seen " + f.seen) << "\">"
-        << xml(f.chip + " at " + seconds_text(f.tick) + ": " + f.what + ": expected " + f.expected + ", seen " + f.seen)
-        << "</failure>\n    </testcase>\n";
+    for (const Case& c : cases) {
+      x << "    <testcase classname=\"" << cls << "\" name=\"" << xml(c.name) << "\" time=\"0\"";
+      if (const ScenarioFailure* f = c.failure) {
+        x << ">\n      <failure type=\"expectation\" message=\"" << xml("expected " + f->expected + ", seen " + f->seen) << "\">"
+          << xml(f->chip + " at " + seconds_text(f->tick) + ": " + f->what + ": expected " + f->expected + ", seen " + f->seen)
+          << "</failure>\n    </testcase>\n";
+      } else if (!c.judged) {
+        x << ">\n      <skipped message=\"never judged: the program ended before its trigger\"/>\n    </testcase>\n";
+      } else {
+        x << "/>\n";
+      }
     }
     if (verbose_ || !world.empty()) {
       x << "    <system-out>";

@@ -152,6 +152,22 @@ TEST_F(RunCommand, AFailedExpectationIsAFailureElementInTheJUnitReport) {
   EXPECT_EQ(check.out, path("s.yaml") + ":7: ABS_POS | expected 5 ± 1, seen 0\n") << check.err;
 }
 
+TEST_F(RunCommand, AnExpectationsJUnitTestcaseHasTheSameNameAndPlaceWhetherItHoldsOrNot) {
+  const std::string scenario = file("s.yaml", kSwitchScenario);
+  const std::string names =
+      "import sys, xml.etree.ElementTree as ET\n"
+      "s = ET.parse(sys.argv[1]).getroot().find('testsuite')\n"
+      "print([(c.get('name').rsplit('/', 1)[-1], c.find('failure') is not None) for c in s.findall('testcase')[1:]])\n";
+  run({"--chain", "chips=L6470", "--scenario", scenario, "--junit", path("a.xml")}, python("time.sleep(0.5)\nstatus()\n"));
+  // Move forward 5 microsteps: ABS_POS holds this time.
+  run({"--chain", "chips=L6470", "--scenario", scenario, "--junit", path("b.xml")},
+      python("[s.xfer2([b]) for b in (0x41, 0, 0, 5)]\ntime.sleep(0.5)\nstatus()\n"));
+  const RunResult a = run_program({system_python(), "-c", names, path("a.xml")});
+  const RunResult b = run_program({system_python(), "-c", names, path("b.xml")});
+  EXPECT_EQ(a.out, "[('s.yaml:5: STATUS', False), ('s.yaml:7: ABS_POS', True)]\n") << a.err;
+  EXPECT_EQ(b.out, "[('s.yaml:5: STATUS', False), ('s.yaml:7: ABS_POS', False)]\n") << b.err;
+}
+
 TEST_F(RunCommand, TheSimulatedTimeLimitEndsTheRunWithItsOwnStatus) {
   const RunResult r = run({"--chain", "chips=L6470", "--timeout", "2s"}, python("time.sleep(3600)\n"));
   EXPECT_EQ(r.status, kRunTimedOut) << r.err;
