@@ -185,10 +185,13 @@ void NativeTraceReader::read_header() {
     const std::string_view word = next_token(rest);
     if (word.empty() || word[0] == '#') continue;
     if (word == "chain" || word == "board") {
+      // The value without the blanks around it (a carriage return among them: the line's own
+      // was taken off, and one more would not survive being written and read again).
+      const auto blank = [](char c) { return is_space(c) || c == '\r'; };
       std::size_t i = 0;
-      while (i < rest.size() && is_space(rest[i])) ++i;
+      while (i < rest.size() && blank(rest[i])) ++i;
       std::string_view value = rest.substr(i);
-      while (!value.empty() && is_space(value.back())) value.remove_suffix(1);
+      while (!value.empty() && blank(value.back())) value.remove_suffix(1);
       if (word == "chain") {
         if (!header_.chain.empty()) fail("a second 'chain' line (the first is line " + std::to_string(header_.chain_line) + ")");
         header_.chain = std::string(value);

@@ -101,6 +101,14 @@ TEST(NativeTrace, RoundTripsEveryKindOfEventExactly) {
   EXPECT_EQ(back[0].line, 4u);  // header, chain line, the numbering comment, then the first event
 }
 
+TEST(NativeTrace, AChainLineOfBlanksAndCarriageReturnsNamesNoChips) {
+  // Found by the fuzzer: "chain \r" read as a chain called "\r", written back as a line that
+  // no longer read ("chain " once its line end was taken off).
+  EXPECT_EQ(error_of("l6470emu-trace 2\r\nchain \r\r\n"), "t.trace:2: 'chain' needs the chips, e.g. 'chain 3*L6470'");
+  EXPECT_EQ(error_of("l6470emu-trace 2\nboard \r \r\n"),
+            "t.trace:2: 'board' needs a clause of the board description, e.g. 'board chips=L6470 axis.0=default'");
+}
+
 TEST(NativeTrace, RoundsHandWrittenTimesToTheNearestTick) {
   const Trace t = read_native_trace("l6470emu-trace 1\n0.0000001 frame D0\n0.00000013 frame 0.3us 00\n1 frame 00\n", "h");
   EXPECT_EQ(t[0].tick, 0u);   // 100 ns -> 0.4 tick
