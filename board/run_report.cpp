@@ -1,6 +1,7 @@
 // The run report's blocks: written by the fronts (preload, firmware), read by `l6470emu run`.
 #include "board/run_report.hpp"
 
+#include <algorithm>
 #include <charconv>
 
 namespace l6470emu {
@@ -36,6 +37,16 @@ std::vector<std::string_view> split(std::string_view s, char sep) {
 std::string_view to_string(RunEnd end) {
   constexpr std::string_view n[] = {"exit", "timeout", "deadlock", "sanitizer"};
   return n[static_cast<unsigned>(end)];
+}
+
+std::vector<std::string> detail_lines(std::string_view text) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t nl = std::min(text.find('\n', at), text.size());
+    if (nl > at) out.emplace_back(text.substr(at, nl - at));
+    at = nl + 1;
+  }
+  return out;
 }
 
 std::string format_run_report(const RunReport& r) {

@@ -51,6 +51,9 @@ struct RunReport {
   ScenarioOutcome outcome;
 };
 
+/// The non-empty lines of `text` (a deadlock report, a sanitizer's finding), as RunReport::detail holds them.
+std::vector<std::string> detail_lines(std::string_view text);
+
 /// The block's text (lines "key value", fields of a failure separated by tabs, ending in ".").
 std::string format_run_report(const RunReport& r);
 /// The complete blocks of `text` (a block cut short by a killed process is skipped).

@@ -51,12 +51,7 @@ void report(RunEnd cause, std::string_view detail) {
     r.tick = g_runtime->now();
     if (cause == RunEnd::timeout && detail.empty())
       r.detail.push_back("the simulated time limit " + seconds_text(g_timeout) + " was reached");
-    std::size_t at = 0;
-    while (at < detail.size()) {
-      const std::size_t nl = std::min(detail.find('\n', at), detail.size());
-      if (nl > at) r.detail.emplace_back(detail.substr(at, nl - at));
-      at = nl + 1;
-    }
+    for (std::string& line : detail_lines(detail)) r.detail.push_back(std::move(line));
   } catch (...) {
   }
   if (!g_report_path) return;

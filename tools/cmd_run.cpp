@@ -325,11 +325,7 @@ int run_on_kernel_nodes(const BoardConfig& config, const Scenario& scenario, boo
     r.tick = board->time().now();
     if (const auto report = board->first_unended_check_failure()) {
       r.end = RunEnd::sanitizer;
-      for (std::size_t at = 0; at < report->size();) {
-        const std::size_t nl = std::min(report->find('\n', at), report->size());
-        if (nl > at) r.detail.emplace_back(report->substr(at, nl - at));
-        at = nl + 1;
-      }
+      r.detail = detail_lines(*report);
     }
     run.blocks.push_back(std::move(r));
   }

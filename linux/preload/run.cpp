@@ -98,12 +98,7 @@ void end_run(RunEnd cause, std::string_view detail) {
   try {
     r.scenario = g_board->finish_scenario(r.outcome);
     r.tick = g_board->time().now();
-    std::size_t at = 0;
-    while (at < detail.size()) {
-      const std::size_t nl = std::min(detail.find('\n', at), detail.size());
-      if (nl > at) r.detail.emplace_back(detail.substr(at, nl - at));
-      at = nl + 1;
-    }
+    r.detail = detail_lines(detail);
   } catch (...) {
   }
   if (!g_report_path) return;
