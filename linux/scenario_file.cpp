@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <set>
@@ -72,7 +74,10 @@ class Reader {
     if (!root.IsMap()) fail(root, "", "a scenario is a map with steps: (and optionally name:, timeout:)");
     check_keys(root, "", {"name", "timeout", "steps"});
     if (const YAML::Node n = root["name"]) s.name = scalar(n, "name");
-    if (const YAML::Node t = root["timeout"]) s.timeout_ticks = duration(t, "timeout");
+    if (const YAML::Node t = root["timeout"]) {
+      s.timeout_ticks = duration(t, "timeout");
+      if (*s.timeout_ticks == 0) fail(t, "timeout", "0 is no time limit a run can have (leave timeout: out for none)");
+    }
     const YAML::Node steps = root["steps"];
     if (!steps) fail(root, "steps", "missing: a scenario needs a list of steps");
     if (!steps.IsSequence()) fail(steps, "steps", "expects a list of steps (each line starting with '- ')");
@@ -469,7 +474,14 @@ ScenarioParse parse_scenario_yaml(std::string_view text, std::string_view file) 
     return out;
   }
   try {
-    const YAML::Node root = YAML::Load(std::string(text));
+    // Every document is read: a second one would otherwise be left out without a word.
+    const std::vector<YAML::Node> documents = YAML::LoadAll(std::string(text));
+    if (documents.size() > 1 && !(documents.size() == 2 && documents[1].IsNull())) {  // (a closing '---' is none)
+      const YAML::Mark m = documents[1].Mark();
+      throw Bad("l6470emu: scenario " + name + (m.line >= 0 ? ":" + std::to_string(m.line + 1) : std::string()) +
+                ": a second YAML document (after '---'): a scenario file holds one");
+    }
+    const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
     out.scenario = Reader(name).read(root);
     if (out.scenario->name.empty()) {
       const std::string f(file);
@@ -490,7 +502,7 @@ ScenarioParse load_scenario_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     ScenarioParse out;
-    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": cannot be read";
+    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": cannot be read (" + std::strerror(errno) + ")";
     return out;
   }
   std::string text;

@@ -15,6 +15,19 @@ std::string error_of(const std::string& text) {
   return p.error;
 }
 
+TEST(ScenarioFile, ASecondDocumentOrATimeoutOfZeroIsAnErrorNotLeftOut) {
+  EXPECT_EQ(error_of("steps: []\n---\nsteps:\n  - at: end\n    expect: {frames: 99}\n"),
+            "l6470emu: scenario s.yaml:3: a second YAML document (after '---'): a scenario file holds one");
+  EXPECT_EQ(error_of("timeout: 0\nsteps: []\n"),
+            "l6470emu: scenario s.yaml:1: key 'timeout': 0 is no time limit a run can have (leave timeout: out for none)");
+  EXPECT_TRUE(parse_scenario_yaml("---\nsteps: []\n", "s.yaml").scenario);
+}
+
+TEST(ScenarioFile, AMissingFileIsOneLineSayingWhy) {
+  EXPECT_EQ(load_scenario_file("/no/such/scenario.yaml").error,
+            "l6470emu: scenario /no/such/scenario.yaml: cannot be read (No such file or directory)");
+}
+
 TEST(ScenarioFile, AHomingScenarioReadsIntoStepsWithTheirLines) {
   const ScenarioParse p = parse_scenario_yaml(R"(name: homing
 timeout: 30s
@@ -151,9 +164,6 @@ TEST(ScenarioFile, DurationsAreWholeTicksOfTheChip) {
   EXPECT_FALSE(parse_scenario_duration("99999999999999999999s"));
 }
 
-TEST(ScenarioFile, AMissingFileIsOneLine) {
-  EXPECT_EQ(load_scenario_file("/nonexistent/s.yaml").error, "l6470emu: scenario /nonexistent/s.yaml: cannot be read");
-}
 
 }  // namespace
 }  // namespace l6470emu::test
