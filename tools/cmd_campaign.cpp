@@ -49,7 +49,7 @@ namespace {
 namespace fs = std::filesystem;
 
 std::atomic<int> g_stop{0};  // the signal that asked the campaign to stop (0: none)
-extern "C" void on_stop_signal(int sig) { g_stop.store(sig); }
+extern "C" void on_campaign_stop_signal(int sig) { g_stop.store(sig); }
 
 std::string self_exe() {
   char buf[4096];
@@ -404,7 +404,7 @@ int CampaignCommand::run_campaign() {
     }
   } remove_work{work};
   struct sigaction sa {};
-  sa.sa_handler = on_stop_signal;
+  sa.sa_handler = on_campaign_stop_signal;
   sigemptyset(&sa.sa_mask);
   struct sigaction old_int {}, old_term {};
   sigaction(SIGINT, &sa, &old_int);

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -124,11 +125,16 @@ const char* status_words(int status) {
   }
 }
 
+// The signal (SIGINT, SIGTERM) that asked run to stop while it waited for a preload program.
+std::atomic<int> g_stop_signal{0};
+extern "C" void on_run_stop_signal(int sig) { g_stop_signal.store(sig); }
+
 // How the program ended, and the report blocks of the processes that used the board.
 struct ProgramEnd {
   pid_t pid = 0;
   int wstatus = 0;
   bool wall_timeout = false;  // killed at the wall-clock limit by run itself
+  int stopped_by = 0;         // the signal run was stopped by and passed on to the program (0: none)
   std::vector<RunReport> blocks;
 };
 
@@ -180,7 +186,22 @@ void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardC
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
   }
-  while (waitpid(run.pid, &run.wstatus, 0) < 0 && errno == EINTR) {
+  // A SIGINT or SIGTERM to run is passed on to the program, which gets 5 s to end before SIGKILL;
+  // run then writes its reports with the program marked as stopped.
+  std::optional<std::chrono::steady_clock::time_point> kill_at;
+  while (true) {
+    const pid_t r = waitpid(run.pid, &run.wstatus, kill_at ? WNOHANG : 0);
+    if (r == run.pid || (r < 0 && errno != EINTR)) return;
+    if (const int sig = g_stop_signal.load(); sig && !run.stopped_by) {
+      run.stopped_by = sig;
+      kill(run.pid, sig);
+      kill_at = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    }
+    if (kill_at && std::chrono::steady_clock::now() >= *kill_at) {
+      kill(run.pid, SIGKILL);
+      kill_at.reset();
+    }
+    if (kill_at) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
 
@@ -209,11 +230,19 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   env.push_back(std::string(kRunScenarioEnv) + "=" + scenario_path);
   env.push_back(std::string(kRunReportEnv) + "=" + report_path);
   if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
+  // SIGINT and SIGTERM interrupt the wait (no SA_RESTART) and are passed on to the program.
+  struct sigaction stop {}, old_int {}, old_term {};
+  stop.sa_handler = on_run_stop_signal;
+  sigemptyset(&stop.sa_mask);
+  sigaction(SIGINT, &stop, &old_int);
+  sigaction(SIGTERM, &stop, &old_term);
   const bool started = spawn_program(program, std::move(env), nullptr, run.pid);
   if (started) {
     wait_for_program(run, timeout, config);
     run.blocks = parse_run_reports(read_all(report_path));
   }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
   unlink(scenario_path.c_str());
   unlink(report_path.c_str());
   return started ? -1 : kRunNotStarted;
@@ -338,7 +367,7 @@ int run_on_kernel_nodes(const BoardConfig& config, const Scenario& scenario, boo
 RunCommand::RunCommand(CLI::App& app) {
   cmd_ = app.add_subcommand("run", "run a program against an emulated board with a scenario, and judge it");
   cmd_->footer(
-      "Exit status: 0 passed, 1 an expectation failed, 2 usage/board/scenario error (the program never started), "
+      "Exit status: 0 passed, 1 an expectation failed, 2 usage/board/scenario/output error (the program never started), "
       "3 simulated time limit reached, 4 deadlock in virtual time, 5 driver sanitizer error, 6 the program exited "
       "non-zero or was killed, 7 the program could not be started or left no report. docs/scenarios.md");
   auto* board = cmd_->add_option("--board", board_file_, "board description file (as L6470EMU_CONFIG)");
@@ -474,6 +503,9 @@ std::optional<int> RunCommand::run() {
     ended = "deadlocked in virtual time";
   else if (cause == RunEnd::sanitizer)
     ended = "stopped by the driver sanitizer";
+  else if (run.stopped_by)
+    ended = std::string("was stopped: l6470emu run got signal ") + std::to_string(run.stopped_by) + " (" +
+            strsignal(run.stopped_by) + ") and passed it on";
   else if (exited)
     ended = "exited with status " + std::to_string(code);
   else
@@ -490,6 +522,12 @@ std::optional<int> RunCommand::run() {
     status = kRunNotStarted;
     why = " (it left no report: it ended by _exit() or a signal before exit(), or the preload was not loaded)";
   }
+  // Stopped by a signal to run: whatever the program did, the run did not finish (128 + N).
+  if (run.stopped_by) {
+    status = 128 + run.stopped_by;
+    why.clear();
+  }
+  const std::string words = run.stopped_by ? "run was stopped by a signal" : status_words(status);
 
   std::ostream& out = std::cerr;
   out << "l6470emu run: " << program_[0] << " " << ended << " at " << seconds_text(end_tick)
@@ -504,7 +542,7 @@ std::optional<int> RunCommand::run() {
     out << "  FAILED " << f.where << ": " << f.chip << ": " << f.what << " at " << seconds_text(f.tick) << ": expected "
         << f.expected << ", seen " << f.seen << "\n";
   out << "l6470emu run: " << expectations << " expectation" << (expectations == 1 ? "" : "s") << ", "
-      << failures.size() << " failed; exit " << status << ": " << status_words(status) << why << "\n";
+      << failures.size() << " failed; exit " << status << ": " << words << why << "\n";
 
   if (!outcome_.empty()) {
     RunOutcome o;
@@ -554,7 +592,7 @@ std::optional<int> RunCommand::run() {
     }
     std::ostringstream x;
     const std::string suite = scenario.name.empty() ? "run" : scenario.name;
-    const bool program_failed = status == kRunTimedOut || status == kRunDeadlocked || status == kRunSanitizerError ||
+    const bool program_failed = run.stopped_by != 0 || status == kRunTimedOut || status == kRunDeadlocked || status == kRunSanitizerError ||
                                 status == kRunProgramFailed || status == kRunNotStarted;
     const std::size_t tests = 1 + cases.size();
     const std::string time = seconds_number(end_tick);
@@ -566,7 +604,7 @@ std::optional<int> RunCommand::run() {
     const std::string cls = "l6470emu.run." + xml(suite);
     x << "    <testcase classname=\"" << cls << "\" name=\"" << xml("program " + program_[0]) << "\" time=\"" << time << "\">";
     if (program_failed) {
-      x << "\n      <error type=\"" << xml(status_words(status)) << "\" message=\"" << xml(program_[0] + " " + ended + why)
+      x << "\n      <error type=\"" << xml(words) << "\" message=\"" << xml(program_[0] + " " + ended + why)
         << "\">";
       if (cause_block)
         for (const auto& d : cause_block->detail) x << xml(d) << "\n";

@@ -3,6 +3,7 @@
 // program's status), usage errors before the program starts, JUnit XML, and a recording of a
 // run that replays with the scenario's actions in it.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -101,6 +102,23 @@ TEST_F(RunCommand, AReportThatCannotBeWrittenOrWouldOverwriteAnInputEndsTheRunBe
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str(), kSwitchScenario) << "the scenario was overwritten";
+}
+
+TEST_F(RunCommand, StoppedBySigtermItPassesTheSignalOnAndWritesTheJUnitReportWithTheProgramStopped) {
+  // signal.pause() blocks where virtual time cannot see: only a signal ends it.
+  const std::string marker = path("paused");
+  Background b({l6470emu_program(), "run", "--chain", "chips=L6470", "--junit", path("r.xml"), "--", system_python(), "-c",
+                "import signal, spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n[s.xfer2([b]) for b in (0xD0, 0, 0)]\n"
+                "open('" + marker + "', 'w').close()\nsignal.pause()\n"});
+  for (int i = 0; i < 1000 && !fs::exists(marker); ++i) usleep(10'000);
+  ASSERT_TRUE(fs::exists(marker)) << "the program never reached its pause";
+  const RunResult r = b.stop(SIGTERM, 30);
+  EXPECT_EQ(r.status, 128 + SIGTERM) << r.err;
+  EXPECT_NE(r.err.find("was stopped: l6470emu run got signal 15"), std::string::npos) << r.err;
+  std::ifstream in(path("r.xml"));
+  std::stringstream xml;
+  xml << in.rdbuf();
+  EXPECT_NE(xml.str().find("<error type=\"run was stopped by a signal\""), std::string::npos) << xml.str();
 }
 
 TEST_F(RunCommand, AllExpectationsHeldIsStatusZeroAndTheJUnitReportIsWellFormed) {
