@@ -420,6 +420,40 @@ std::size_t too_deep(std::string_view text) {
   return 0;
 }
 
+// The line where a second YAML document starts, or 0. Document markers stand at the start of a
+// line ('---' or '...' followed by a blank or the line's end) and cannot occur inside a scalar; a
+// '---' before any content only opens the first document, and a '...' may end the last.
+std::size_t second_document(std::string_view text) {
+  bool content = false, opened = false, ended = false;
+  std::size_t line = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t nl = std::min(text.find('\n', at), text.size());
+    std::string_view l = text.substr(at, nl - at);
+    at = nl + 1;
+    ++line;
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    const auto marker = [&](std::string_view m) {
+      return l.substr(0, 3) == m && (l.size() == 3 || l[3] == ' ' || l[3] == '\t');
+    };
+    std::size_t first = 0;
+    while (first < l.size() && (l[first] == ' ' || l[first] == '\t')) ++first;
+    const bool blank = first == l.size() || l[first] == '#';
+    if (marker("---")) {
+      if (content || opened || ended) return line;
+      opened = true;
+      const std::string_view rest = l.substr(3);
+      if (rest.find_first_not_of(" \t") != std::string_view::npos && rest[rest.find_first_not_of(" \t")] != '#')
+        content = true;  // '--- value' on the marker's line
+    } else if (marker("...")) {
+      ended = true;
+    } else if (!blank && l[0] != '%') {
+      if (ended) return line;
+      content = true;
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 std::optional<Tick> parse_scenario_duration(std::string_view text) {
@@ -474,14 +508,12 @@ ScenarioParse parse_scenario_yaml(std::string_view text, std::string_view file) 
     return out;
   }
   try {
-    // Every document is read: a second one would otherwise be left out without a word.
-    const std::vector<YAML::Node> documents = YAML::LoadAll(std::string(text));
-    if (documents.size() > 1 && !(documents.size() == 2 && documents[1].IsNull())) {  // (a closing '---' is none)
-      const YAML::Mark m = documents[1].Mark();
-      throw Bad("l6470emu: scenario " + name + (m.line >= 0 ? ":" + std::to_string(m.line + 1) : std::string()) +
-                ": a second YAML document (after '---'): a scenario file holds one");
-    }
-    const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+    // A second document would be left out without a word by the YAML library's Load (and read
+    // whole, however large, by its LoadAll): it is found in the text and refused.
+    if (const std::size_t line = second_document(text))
+      throw Bad("l6470emu: scenario " + name + ":" + std::to_string(line) +
+                ": a second YAML document (after '---' or '...'): a scenario file holds one");
+    const YAML::Node root = YAML::Load(std::string(text));
     out.scenario = Reader(name).read(root);
     if (out.scenario->name.empty()) {
       const std::string f(file);

@@ -17,10 +17,14 @@ std::string error_of(const std::string& text) {
 
 TEST(ScenarioFile, ASecondDocumentOrATimeoutOfZeroIsAnErrorNotLeftOut) {
   EXPECT_EQ(error_of("steps: []\n---\nsteps:\n  - at: end\n    expect: {frames: 99}\n"),
-            "l6470emu: scenario s.yaml:3: a second YAML document (after '---'): a scenario file holds one");
+            "l6470emu: scenario s.yaml:2: a second YAML document (after '---' or '...'): a scenario file holds one");
+  EXPECT_EQ(error_of("steps: []\n...\nname: later\n"),
+            "l6470emu: scenario s.yaml:3: a second YAML document (after '---' or '...'): a scenario file holds one");
+  EXPECT_EQ(error_of("---\n---\nsteps: []\n"),
+            "l6470emu: scenario s.yaml:2: a second YAML document (after '---' or '...'): a scenario file holds one");
   EXPECT_EQ(error_of("timeout: 0\nsteps: []\n"),
             "l6470emu: scenario s.yaml:1: key 'timeout': 0 is no time limit a run can have (leave timeout: out for none)");
-  EXPECT_TRUE(parse_scenario_yaml("---\nsteps: []\n", "s.yaml").scenario);
+  EXPECT_TRUE(parse_scenario_yaml("# a comment\n--- # the one document\nsteps: []\n...\n", "s.yaml").scenario);
 }
 
 TEST(ScenarioFile, AMissingFileIsOneLineSayingWhy) {
