@@ -108,7 +108,9 @@ class Harness {
     if (c.bytes_in_frame() == 0) return d;
     for (std::size_t i = 0; i < size(); ++i) {
       const Chip& chip = c.chip(i);
-      d[i] = chip.spi_enabled() && !chip.collecting_arguments() && c.shift_register(i) == 0xD0;
+      // (A chip deaf to this frame decodes nothing; one power-cycled at its end latches UVLO anew.)
+      d[i] = chip.spi_enabled() && !chip.collecting_arguments() && c.shift_register(i) == 0xD0 && c.hears_frame(i) &&
+             !power_cycle_at_rise_[i];
     }
     return d;
   }
@@ -119,6 +121,7 @@ class Harness {
     FUZZ_CHECK(gs == get_status_decoders(*ref_), "the chains disagree on which chips decode GetStatus");
     fast_->deselect();
     ref_->deselect();
+    power_cycle_at_rise_.assign(size(), false);
     for (std::size_t i = 0; i < size(); ++i)
       if (gs[i]) {
         check_status_after_get_status(fast_->chip(i), i, "fast");
@@ -301,12 +304,16 @@ class Harness {
 
   void fault() {
     const std::size_t k = pick_chip();
-    const auto f = static_cast<TraceFault>(in_.ConsumeIntegralInRange<int>(0, 6));
-    const std::uint8_t value = f == TraceFault::ADCIN     ? in_.ConsumeIntegral<std::uint8_t>()
-                               : f == TraceFault::THERMAL ? in_.ConsumeIntegralInRange<std::uint8_t>(0, 3)
-                                                          : in_.ConsumeBool();
-    apply_fault(fast_->chip(k), f, value);
-    apply_fault(ref_->chip(k), f, value);
+    // Every backdoor event: the chip's own conditions, a brown-out and the wire's one-shot faults.
+    const auto f = static_cast<TraceFault>(in_.ConsumeIntegralInRange<int>(0, kTraceFaultCount - 1));
+    const std::uint8_t value = f == TraceFault::ADCIN       ? in_.ConsumeIntegral<std::uint8_t>()
+                               : f == TraceFault::THERMAL   ? in_.ConsumeIntegralInRange<std::uint8_t>(0, 3)
+                               : f == TraceFault::MISO_FLIP ? in_.ConsumeIntegralInRange<std::uint8_t>(0, 7)
+                               : f == TraceFault::POWER_CYCLE || f == TraceFault::LOST_FRAME ? std::uint8_t{0}
+                                                                                             : in_.ConsumeBool();
+    apply_fault(*fast_, k, f, value);
+    apply_fault(*ref_, k, f, value);
+    if (f == TraceFault::POWER_CYCLE && fast_->selected()) power_cycle_at_rise_.at(k) = true;  // it waits for CS to rise
     AlarmFlags& c = conditions_[k].flags;
     switch (f) {
       case TraceFault::UVLO: c.uvlo = value != 0; break;
@@ -320,7 +327,11 @@ class Harness {
         if (!(c.thermal >= Thermal::bridge_shutdown && t == Thermal::warning)) c.thermal = t;
         break;
       }
-      case TraceFault::ADCIN: break;
+      case TraceFault::ADCIN:
+      case TraceFault::POWER_CYCLE:  // the conditions outlast a brown-out
+      case TraceFault::MISO_FLIP:
+      case TraceFault::LOST_FRAME:
+        break;
     }
   }
 
@@ -355,6 +366,7 @@ class Harness {
 
   FuzzedDataProvider& in_;
   std::unique_ptr<Chain> fast_, ref_;
+  std::vector<bool> power_cycle_at_rise_ = std::vector<bool>(8, false);  // per chip (at most 8)
   std::vector<Conditions> conditions_;
   bool compare_every_step_ = false;
   Tick used_ = 0;
