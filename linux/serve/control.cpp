@@ -124,6 +124,8 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  sw open|closed --chip K             the limit switch on the SW pin (closed = pulled low)\n"
          "  pin SW|STCK|STBY_RST 0|1 --chip K   drive an input pin of a chip\n"
          "  fault uvlo|uvlo-adc|ocd|stall-a|stall-b on|off --chip K\n"
+         "  fault reset|lost-frame|miso-flip [BIT] --chip K   a brown-out; the chip deaf to, or one bit of its answer\n"
+         "                                 flipped in, the chain's next frame\n"
          "  fault thermal normal|warning|bridge-shutdown|device-shutdown --chip K\n"
          "  adc CODE --chip K                   ADCIN conversion result, 0..31\n"
          "  axis [--chip K]                     the mechanics: true position next to ABS_POS, lost steps, switches\n"
@@ -277,8 +279,24 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
   } else if (cmd == "fault") {
     std::size_t k = 0;
     if (!target_chip(k)) return 2;
+    // The one-shot events: a brown-out, and the wire's faults on the chain's next frame.
+    const std::string first = a.words.empty() ? std::string() : a.words[0];
+    if (first == "reset" || first == "lost-frame" || first == "miso-flip") {
+      char* end = nullptr;
+      const long bit = first == "miso-flip" && a.words.size() == 2 ? std::strtol(a.words[1].c_str(), &end, 10) : 7;
+      if (a.words.size() > (first == "miso-flip" ? 2u : 1u) || (end && (*end || bit < 0 || bit > 7))) {
+        out = "ctl: usage: fault reset|lost-frame --chip K, or fault miso-flip [BIT 0..7] --chip K\n";
+        return 2;
+      }
+      const TraceFault fault = first == "reset" ? TraceFault::POWER_CYCLE
+                               : first == "lost-frame" ? TraceFault::LOST_FRAME : TraceFault::MISO_FLIP;
+      board.inject_fault(ci, k, fault, first == "miso-flip" ? static_cast<std::uint8_t>(bit) : 0);
+      o << label(k) << ": " << first << (first == "miso-flip" ? " bit " + std::to_string(bit) : std::string()) << "\n";
+      out = o.str();
+      return 0;
+    }
     if (a.words.size() != 2) {
-      out = "ctl: usage: fault NAME on|off --chip K (or: fault thermal LEVEL)\n";
+      out = "ctl: usage: fault NAME on|off --chip K (or: fault thermal LEVEL; fault reset|lost-frame|miso-flip [BIT])\n";
       return 2;
     }
     const std::string& f = a.words[0];
@@ -310,7 +328,7 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       else known = false;
       if (known) board.inject_fault(ci, k, fault, on ? 1 : 0);
       if (!known) {
-        out = "ctl: unknown fault '" + f + "' (uvlo, uvlo-adc, ocd, stall-a, stall-b, thermal)\n";
+        out = "ctl: unknown fault '" + f + "' (uvlo, uvlo-adc, ocd, stall-a, stall-b, thermal, reset, lost-frame, miso-flip)\n";
         return 2;
       }
     }

@@ -139,6 +139,24 @@ TEST_F(Daemon, CtlDrivesTheSwitchAndInjectsFaultsThatHostProgramsSee) {
   EXPECT_EQ(ctl("fault thermal bogus").status, 2);
 }
 
+TEST_F(Daemon, CtlRaisesTheOneShotFaultsABrownOutALostFrameAndAFlippedBit) {
+  // A power cycle: registers at reset, UVLO latched (bit 9 low), bridges HiZ.
+  ASSERT_EQ(ctl("fault reset").status, 0);
+  EXPECT_NE(ctl("status").out.find("STATUS 0x7C03"), std::string::npos) << ctl("status").out;
+  const std::string status = "import spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n"
+                             "r = [s.xfer2([b])[0] for b in (0xD0, 0, 0)]\nprint(hex(r[1] << 8 | r[2]))\n";
+  // The GetStatus opcode's frame is lost: the chip never decodes it and answers nothing.
+  ASSERT_EQ(ctl("fault lost-frame").status, 0);
+  RunResult r = run_program({system_python(), "-c", status}, env());
+  EXPECT_EQ(r.out, "0x0\n") << r.err;
+  // The next frame's answer byte has bit 0 flipped on the wire: the opcode's own answer (0x00).
+  const RunResult flipped = ctl("fault miso-flip 0");
+  EXPECT_EQ(flipped.status, 0);
+  EXPECT_NE(flipped.out.find("miso-flip bit 0"), std::string::npos) << flipped.out;
+  EXPECT_EQ(ctl("fault miso-flip 8").status, 2);
+  EXPECT_EQ(ctl("fault reset now").status, 2);
+}
+
 TEST_F(Daemon, AClientKilledMidMessageLeavesTheDaemonServingTheOthers) {
   Background hammer({system_python(), script("hammer.py"), "0", "0"}, env());
   for (int i = 0; i < 300 && hammer.out().find("running") == std::string::npos; ++i)

@@ -244,7 +244,8 @@ Recorded daemon_ctl_faults(const fs::path& dir) {
   std::vector<std::vector<std::string>> steps{
       {"fault", "ocd", "on"},        {"fault", "thermal", "warning"}, {"fault", "stall-a", "on"},
       {"fault", "stall-b", "on"},    {"fault", "uvlo", "on"},         {"fault", "uvlo-adc", "on"},
-      {"adc", "17"},                 {"sw", "closed"}};
+      {"adc", "17"},                 {"sw", "closed"},                {"fault", "miso-flip", "3"},
+      {"fault", "lost-frame"},       {"fault", "reset"}};
   RunResult r = run_program({system_python(), script("spidev_sequence.py"), "0", "0"}, env);
   if (r.status != 0) return finish(r, false, "spidev_sequence.py failed", dir);
   // A move in flight while the faults come: the chip answers STATUS between them.
