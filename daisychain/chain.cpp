@@ -61,7 +61,10 @@ void Chain::take_armed_faults() {
 
 void Chain::arm_miso_flip(std::size_t i, std::uint8_t bit) {
   (void)chips_.at(i);
-  const auto mask = static_cast<std::uint8_t>(1u << (bit & 7u));
+  arm_flips(i, static_cast<std::uint8_t>(1u << (bit & 7u)));
+}
+
+void Chain::arm_flips(std::size_t i, std::uint8_t mask) {
   faults_armed_ = true;
   for (auto& f : flips_armed_)
     if (f.first == i) {
@@ -260,16 +263,7 @@ void Chain::end_odd_frame(bool clocked) {
       decode_shift_registers();
   } else {
     // A CS pulse without clocks: the wire faults wait for a frame that clocks a byte.
-    for (const auto& [k, mask] : flips_) {
-      faults_armed_ = true;
-      bool merged = false;
-      for (auto& f : flips_armed_)
-        if (f.first == k) {
-          f.second = static_cast<std::uint8_t>(f.second | mask);
-          merged = true;
-        }
-      if (!merged) flips_armed_.emplace_back(k, mask);
-    }
+    for (const auto& [k, mask] : flips_) arm_flips(k, mask);
     if (deaf_in_frame_)
       for (std::size_t k = 0; k < deaf_.size(); ++k)
         if (deaf_[k]) {

@@ -148,6 +148,8 @@ class Chain final : public SpiDevice {
   void exchange_odd(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
   /// The armed wire faults become this frame's (at the CS falling edge).
   void take_armed_faults();
+  /// Arms the bits of `mask` to be inverted in chip `i`'s MISO byte of the next frame.
+  void arm_flips(std::size_t i, std::uint8_t mask);
   /// Inverts the bits of this frame's MISO flips that fall in `rx`, the frame's bytes from `at` on.
   void apply_flips(std::uint64_t at, std::span<std::uint8_t> rx) const;
   /// The CS rising edge of a frame with a deaf chip or a power cycle waiting: the chips decode

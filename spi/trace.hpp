@@ -84,9 +84,6 @@ enum class TraceFault : std::uint8_t {
 };
 /// How many TraceFault values there are.
 inline constexpr unsigned kTraceFaultCount = static_cast<unsigned>(TraceFault::LOST_FRAME) + 1;
-/// Whether a fault is one of the wire's (MISO_FLIP, LOST_FRAME): it acts on the chain's next
-/// CS frame, not on the chip.
-constexpr bool is_wire_fault(TraceFault f) { return f == TraceFault::MISO_FLIP || f == TraceFault::LOST_FRAME; }
 
 /// Datasheet names used in the native format and in reports.
 std::string_view to_string(TracePin pin);

@@ -339,6 +339,16 @@ std::vector<ScenarioStep> clean_run_oracle(const std::vector<ChipRun>& chips) {
   return steps;
 }
 
+std::vector<std::string> comma_list(std::string_view list) {
+  std::vector<std::string> out;
+  for (std::size_t at = 0; at <= list.size();) {
+    const std::size_t comma = std::min(list.find(',', at), list.size());
+    out.emplace_back(list.substr(at, comma - at));
+    at = comma + 1;
+  }
+  return out;
+}
+
 bool has_expectations(const Scenario& scenario) {
   return std::any_of(scenario.steps.begin(), scenario.steps.end(), [](const ScenarioStep& s) { return s.expect.has_value(); });
 }

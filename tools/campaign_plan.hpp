@@ -104,6 +104,9 @@ std::vector<ScenarioStep> fault_steps(CampaignFault fault, const ChipRun& chip, 
 /// final_status as the clean run left them.
 std::vector<ScenarioStep> clean_run_oracle(const std::vector<ChipRun>& chips);
 
+/// The words of a comma-separated option value ("ocd,uvlo" -> ocd, uvlo; "" -> one empty word).
+std::vector<std::string> comma_list(std::string_view list);
+
 /// Whether `scenario` has an expectation of its own (then it is the oracle).
 bool has_expectations(const Scenario& scenario);
 

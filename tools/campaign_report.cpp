@@ -9,6 +9,7 @@
 
 #include "core/near_miss.hpp"
 #include "board/run_report.hpp"
+#include "tools/campaign_plan.hpp"
 #include "tools/xml_text.hpp"
 
 namespace l6470emu {
@@ -133,21 +134,17 @@ std::optional<FailOn> parse_fail_on(std::string_view list, std::string& error) {
   std::vector<std::string> names;
   for (const Verdict v : kVerdicts) names.emplace_back(to_string(v));
   names.emplace_back("survived-unread");
-  std::size_t at = 0;
-  while (at <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', at), list.size());
-    const std::string_view word = list.substr(at, comma - at);
+  for (const std::string& word : comma_list(list)) {
     if (word == "survived-unread") {
       on.survived_unread = true;
     } else if (const auto v = verdict_named(word)) {
       on.verdicts.insert(*v);
     } else {
       const std::string near = closest_names(word, names);
-      error = "--fail-on: '" + std::string(word) + "' is not a verdict" + (near.empty() ? "" : " (did you mean " + near + "?)") +
+      error = "--fail-on: '" + word + "' is not a verdict" + (near.empty() ? "" : " (did you mean " + near + "?)") +
               "; verdicts: detected, survived, survived-unread, silent_failure, hang, deadlock, crash";
       return std::nullopt;
     }
-    at = comma + 1;
   }
   return on;
 }

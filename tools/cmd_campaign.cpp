@@ -349,10 +349,7 @@ int CampaignCommand::run_campaign() {
   if (faults_ == "all") {
     for (const FaultSpec& f : campaign_faults()) asked.push_back(&f);
   } else {
-    for (std::size_t at = 0; at <= faults_.size();) {
-      const std::size_t comma = std::min(faults_.find(',', at), faults_.size());
-      const std::string word = faults_.substr(at, comma - at);
-      at = comma + 1;
+    for (const std::string& word : comma_list(faults_)) {
       const FaultSpec* f = find_campaign_fault(word);
       if (!f) {
         const std::string near = closest_names(word, fault_names);
@@ -381,10 +378,7 @@ int CampaignCommand::run_campaign() {
     else if (faults_ != "all") return usage("--faults: " + std::string(f->name) + " cannot be raised on this board: " + why);
   }
   if (selected.empty()) return usage("no fault to raise on this board");
-  for (std::size_t at = 0; !only_chips_.empty() && at <= only_chips_.size();) {
-    const std::size_t comma = std::min(only_chips_.find(',', at), only_chips_.size());
-    const std::string w = only_chips_.substr(at, comma - at);
-    at = comma + 1;
+  for (const std::string& w : only_chips_.empty() ? std::vector<std::string>{} : comma_list(only_chips_)) {
     bool found = false;
     for (std::size_t c = 0; c < probe.chain_count(); ++c)
       for (std::size_t k = 0; k < probe.chip_count(c); ++k)
@@ -480,17 +474,8 @@ int CampaignCommand::run_campaign() {
   // 3. The plan: fault by fault, chip by chip, point by point.
   std::vector<std::vector<InjectionPoint>> points(chips.size());
   for (std::size_t s = 0; s < chips.size(); ++s) points[s] = injection_points(chips[s], selection);
-  const auto words = [](const std::string& list) {
-    std::vector<std::string> out;
-    for (std::size_t at = 0; at <= list.size();) {
-      const std::size_t comma = std::min(list.find(',', at), list.size());
-      out.push_back(list.substr(at, comma - at));
-      at = comma + 1;
-    }
-    return out;
-  };
   std::vector<bool> chip_wanted(chips.size(), only_chips_.empty());
-  for (const std::string& w : only_chips_.empty() ? std::vector<std::string>{} : words(only_chips_)) {
+  for (const std::string& w : only_chips_.empty() ? std::vector<std::string>{} : comma_list(only_chips_)) {
     bool found = false;
     for (std::size_t s = 0; s < chips.size(); ++s)
       if (w == std::to_string(chips[s].number) || w == chips[s].chain_name + ":" + std::to_string(chips[s].number)) {
@@ -499,7 +484,7 @@ int CampaignCommand::run_campaign() {
       }
     if (!found) return usage("--chips: the board has no chip " + quoted_text(w));
   }
-  const std::vector<std::string> wanted_points = only_points_.empty() ? std::vector<std::string>{} : words(only_points_);
+  const std::vector<std::string> wanted_points = only_points_.empty() ? std::vector<std::string>{} : comma_list(only_points_);
   std::vector<PlannedRerun> plan;
   for (const FaultSpec* f : selected)
     for (std::size_t s = 0; s < chips.size(); ++s) {
