@@ -180,16 +180,8 @@ class Chain final : public SpiDevice {
   bool selected_ = false;
   bool standby_in_frame_ = false;  // some chip was in standby (or deaf) at the CS falling edge
   bool odd_frame_ = false;         // standby_in_frame_, or a MISO flip in this frame: not the plain byte path
-
-  // The wire faults (arm_miso_flip, arm_lost_frame) and power cycles waiting for a CS rising edge.
-  bool faults_armed_ = false;      // something is armed for the next frame
-  bool deaf_in_frame_ = false;     // a chip misses this frame (deaf_)
-  bool end_of_frame_work_ = false;  // deaf_in_frame_ or power cycles waiting: deselect takes the long way
-  std::vector<std::pair<std::size_t, std::uint8_t>> flips_armed_, flips_;  // (chip, mask): next frame's, this frame's
-  std::vector<std::size_t> deaf_armed_;     // chips to miss the next frame
-  std::vector<std::uint8_t> deaf_;          // per chip: misses this frame (sized on first use)
-  std::vector<std::uint8_t> deaf_held_;     // per chip: the byte its register held at the CS falling edge
-  std::vector<std::size_t> power_cycles_;   // chips to power-cycle at the CS rising edge
+  bool faults_armed_ = false;      // a wire fault is armed for the next frame
+  bool end_of_frame_work_ = false;  // a deaf chip or a power cycle waiting: deselect takes the long way
   mutable bool chips_touched_ = true;  // chip() handed out a chip since the last look at STBY pins
   // Every chip is ready for an opcode with no answer byte left (Chip::on_nop_at), as the last
   // frame of NOPs left them and nothing reached them since: the next frame of NOPs changes nothing.
@@ -217,6 +209,15 @@ class Chain final : public SpiDevice {
   std::uint8_t mosi_level_ = 0;  // MOSI as the last byte left it (a mode-1 chip samples it first)
   bool answers_loaded_ = false;  // the last deselect_wire decoded bytes and loaded answers
   Tick deselect_tick_ = 0;       // when it did
+
+  // ---- the wire faults (arm_miso_flip, arm_lost_frame) and power cycles waiting for a CS
+  // rising edge; last, so that the fields every byte touches keep their offsets ----
+  bool deaf_in_frame_ = false;     // a chip misses this frame (deaf_)
+  std::vector<std::pair<std::size_t, std::uint8_t>> flips_armed_, flips_;  // (chip, mask): next frame's, this frame's
+  std::vector<std::size_t> deaf_armed_;     // chips to miss the next frame
+  std::vector<std::uint8_t> deaf_;          // per chip: misses this frame (sized on first use)
+  std::vector<std::uint8_t> deaf_held_;     // per chip: the byte its register held at the CS falling edge
+  std::vector<std::size_t> power_cycles_;   // chips to power-cycle at the CS rising edge
 };
 
 }  // namespace l6470emu
