@@ -28,8 +28,12 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     // sanitizer names: logged (rate-limited) under check=warn, the run's end under check=error.
     for (std::size_t k = 0; k < cs->chain.size(); ++k) {
       ChainChecker* checker = cs->checker.get();
-      cs->chain.chip(k).set_diagnostic_sink([checker, k](const Diagnostic& d) { checker->chip_diagnostic(k, d); });
+      cs->chain.chip(k).set_diagnostic_sink([this, checker, chain = cs->index, k](const Diagnostic& d) {
+        checker->chip_diagnostic(k, d);
+        if (coverage_) coverage_->diagnostic(chain, k, d);
+      });
     }
+    cs->command_observers.resize(cs->chain.size());
     chains_.push_back(std::move(cs));
   }
   output_reads_.resize(chains_.size());
@@ -39,6 +43,54 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
 void Board::note_output_read(std::size_t chain, std::size_t chip, Pin pin) {
   if (chain >= output_reads_.size() || chip >= output_reads_[chain].size() || (pin != Pin::BUSY && pin != Pin::FLAG)) return;
   output_reads_[chain][chip][pin == Pin::FLAG ? 1 : 0] = time_.now();
+  if (coverage_) {
+    ChainState& c = state(chain);
+    coverage_->output_read(chain, chip, c.chain.chip(chip), pin, level_of(c, chip, pin));
+  }
+}
+
+void Board::note_output_edge(std::size_t chain, std::size_t chip, Pin pin, bool rising) {
+  if (chain >= output_reads_.size() || chip >= output_reads_[chain].size() || (pin != Pin::BUSY && pin != Pin::FLAG)) return;
+  output_reads_[chain][chip][pin == Pin::FLAG ? 1 : 0] = time_.now();
+  if (coverage_) coverage_->output_edge(chain, chip, pin, rising);
+}
+
+// ---------------------------------------------------------------- coverage
+
+void Board::enable_coverage() {
+  if (coverage_) return;
+  coverage_ = std::make_unique<CoverageCollector>();
+  for (auto& c : chains_) {
+    coverage_->add_chain(c->chain, numbering_);
+    for (std::size_t k = 0; k < c->chain.size(); ++k) install_command_sink(*c, k);
+    coverage_->look(c->index, c->chain);
+  }
+  sanitizer_.set_broken_sink([this](const Violation& v) {
+    const int chain = find_chain(v.chain);
+    if (chain < 0 || !coverage_) return;
+    std::optional<std::size_t> chip;
+    if (!v.chip_key.empty() && v.chip_key.find_first_not_of("0123456789") == std::string::npos)
+      chip = static_cast<std::size_t>(std::stoull(v.chip_key));
+    coverage_->rule_broken(static_cast<std::size_t>(chain), chip, v.rule);
+  });
+}
+
+CoverageData Board::coverage() const { return coverage_ ? coverage_->data() : CoverageData{}; }
+
+void Board::set_command_observer(std::size_t chain, std::size_t chip, Chip::CommandSink sink) {
+  ChainState& c = state(chain);
+  c.command_observers.at(chip) = std::move(sink);
+  install_command_sink(c, chip);
+}
+
+void Board::install_command_sink(ChainState& c, std::size_t k) {
+  // No sink at all when nobody listens: the chip then answers GetStatus polls from its cache.
+  Chip::CommandSink* observer = c.command_observers[k] ? &c.command_observers[k] : nullptr;
+  if (!observer && !coverage_) return c.chain.chip(k).set_command_sink({});
+  c.chain.chip(k).set_command_sink([this, observer, chain = &c.chain, index = c.index, k](const Opcode& op, std::uint32_t arg) {
+    if (coverage_) coverage_->command(index, k, chain->chip(k), op, arg);
+    if (observer) (*observer)(op, arg);
+  });
 }
 
 Tick Board::last_output_read(std::size_t chain, std::size_t chip, Pin pin) const {
@@ -112,7 +164,10 @@ SpiDevice& Board::begin_transfer(std::size_t chain, const WireSettings& wire) {
 Tick Board::end_transfer(std::size_t chain) {
   ChainState& c = state(chain);
   c.bus->end();
-  if (!c.watched.empty()) emit_changes(c, c.chain.now());
+  if (!c.watched.empty())
+    emit_changes(c, c.chain.now());
+  else if (coverage_)
+    coverage_->look(c.index, c.chain);
   return bus_free_[c.config.bus] = c.chain.now();
 }
 
@@ -256,6 +311,7 @@ void Board::report_changes(std::size_t chain) {
 
 void Board::emit_changes(ChainState& c, Tick tick) {
   record_outputs(c);
+  if (coverage_) coverage_->look(c.index, c.chain);
   for (const ChainState::WatchedPin& w : c.watched) {
     const bool level = level_of(c, w.chip, w.pin);
     bool& last = c.last[w.chip][static_cast<unsigned>(w.pin)];

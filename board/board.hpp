@@ -18,6 +18,7 @@
 #include "board/board_config.hpp"
 #include "board/board_time.hpp"
 #include "board/chain_bus.hpp"
+#include "board/coverage_collector.hpp"
 #include "board/sanitizer.hpp"
 #include "board/pins.hpp"
 #include "daisychain/chain.hpp"
@@ -188,6 +189,20 @@ class Board {
   void note_output_read(std::size_t chain, std::size_t chip, Pin pin);
   /// The board's time at the host's last read of output `pin` of chip `chip` (kNever: never read).
   Tick last_output_read(std::size_t chain, std::size_t chip, Pin pin) const;
+  /// An edge event of output `pin` (BUSY or FLAG) of chip `chip` was handed to the host (a
+  /// gpio line event read, an interrupt run): a read too, and an edge the program waited on.
+  void note_output_edge(std::size_t chain, std::size_t chip, Pin pin, bool rising);
+
+  // ---- interface coverage -----------------------------------------------------------
+
+  /// Starts collecting interface coverage (docs/coverage.md) on every chain, from now on.
+  void enable_coverage();
+  bool coverage_enabled() const { return static_cast<bool>(coverage_); }
+  /// What the run has met since enable_coverage() (empty data when it is off).
+  CoverageData coverage() const;
+  /// Who else hears of every command chip `chip` of chain `chain` decodes (a scenario's
+  /// "command seen"), besides coverage; an empty function: nobody. An observer only.
+  void set_command_observer(std::size_t chain, std::size_t chip, Chip::CommandSink sink);
 
   // ---- time ---------------------------------------------------------------------
 
@@ -280,6 +295,7 @@ class Board {
   void emit_changes(ChainState& c, Tick tick);
   bool level_of(const ChainState& c, std::size_t chip, Pin pin) const;
   void set_watch(std::size_t chain, std::size_t chip, Pin pin, bool on, bool observer);
+  void install_command_sink(ChainState& c, std::size_t chip);
 
   LineSink log_;
   Sanitizer sanitizer_;
@@ -292,6 +308,7 @@ class Board {
   std::unordered_map<unsigned, Tick> bus_free_;  // bus number -> tick its last use ends
   // Per chain and chip: the host's last read of BUSY ([0]) and FLAG ([1]), kNever when none.
   std::vector<std::vector<std::array<Tick, 2>>> output_reads_;
+  std::unique_ptr<CoverageCollector> coverage_;  // while coverage is collected
   std::vector<std::unique_ptr<ChainState>> chains_;
 };
 

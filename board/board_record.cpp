@@ -15,6 +15,7 @@ SpiDevice& Board::spi_of(ChainState& c) {
 void Board::apply_input(ChainState& c, std::size_t chip, Pin pin, bool level) {
   c.touched = true;
   c.prediction_valid = false;
+  if (coverage_) coverage_->input(c.index, chip, pin, level);
   if (c.recorder) {
     c.recorder->set_input(chip, pin, level);
     return;
@@ -42,6 +43,7 @@ bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, 
   catch_up(c);
   c.touched = true;
   c.prediction_valid = false;
+  if (coverage_) coverage_->event(c.index, chip, fault, value);
   if (c.recorder)
     c.recorder->fault(chip, fault, value);
   else

@@ -83,6 +83,7 @@ Sanitizer::Sanitizer(CheckConfig config, LineSink log) : config_(config), log_(s
 void Sanitizer::report(const Violation& v) {
   if (config_.level == CheckLevel::off || config_.allowed.contains(v.rule)) return;
   if (broken_++ == 0) first_broken_ = v;
+  if (broken_sink_) broken_sink_(v);
   if (config_.level == CheckLevel::error) {
     if (failure_) return;  // one report: the first
     failure_ = v;  // the front ends the run with it (and says so in its log)

@@ -68,6 +68,8 @@ class Sanitizer {
   /// first of them (a scenario's `expect: {sanitizer: clean}`).
   std::uint64_t broken() const { return broken_; }
   const std::optional<Violation>& first_broken() const { return first_broken_; }
+  /// Who hears of every broken rule counted by broken() (interface coverage); empty: nobody.
+  void set_broken_sink(std::function<void(const Violation&)> sink) { broken_sink_ = std::move(sink); }
 
  private:
   CheckConfig config_;
@@ -75,6 +77,7 @@ class Sanitizer {
   std::optional<Violation> failure_;
   std::uint64_t broken_ = 0;
   std::optional<Violation> first_broken_;
+  std::function<void(const Violation&)> broken_sink_;
   std::unordered_map<std::string, std::uint64_t> seen_;  // chain/chip/rule -> times reported
 };
 

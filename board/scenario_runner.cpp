@@ -139,10 +139,8 @@ ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
   }
   for (std::size_t c = 0; c < board_.chain_count(); ++c)
     for (std::size_t k = 0; k < board_.chip_count(c); ++k)
-      board_.with_chain(c, [&](Chain& chain) {
-        chain.chip(k).set_command_sink([this, c, k](const Opcode& op, std::uint32_t) {
-          seen_.push_back(Seen{c, k, false, false, std::string(to_string(op.command)), board_.chain(c).chip(k).now()});
-        });
+      board_.set_command_observer(c, k, [this, c, k](const Opcode& op, std::uint32_t) {
+        seen_.push_back(Seen{c, k, false, false, std::string(to_string(op.command)), board_.chain(c).chip(k).now()});
       });
   std::sort(busy_watch.begin(), busy_watch.end());
   busy_watch.erase(std::unique(busy_watch.begin(), busy_watch.end()), busy_watch.end());
@@ -161,7 +159,7 @@ ScenarioRunner::~ScenarioRunner() {
   for (std::size_t c = 0; c < board_.chain_count(); ++c)
     for (std::size_t k = 0; k < board_.chip_count(c); ++k) {
       board_.observe_pin(c, k, Pin::BUSY, false);
-      board_.with_chain(c, [&](Chain& chain) { chain.chip(k).set_command_sink({}); });
+      board_.set_command_observer(c, k, {});
     }
 }
 

@@ -149,11 +149,11 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       }
       return;
     case Command::StepClock:
-      if (!motor_stopped(motion_)) return not_performable("StepClock while the motor runs");
+      if (!motor_stopped(motion_)) return not_performable("StepClock while the motor runs", DiagnosticDetail::refused_running);
       if (motion_command_allowed("StepClock")) start_step_clock(motion_, op.dir);
       return;
     case Command::Move: {
-      if (!motor_stopped(motion_)) return not_performable("Move while the motor runs");
+      if (!motor_stopped(motion_)) return not_performable("Move while the motor runs", DiagnosticDetail::refused_running);
       if (!motion_command_allowed("Move")) return;
       const std::uint32_t n = arg & kPosMask;
       const std::int32_t target =
@@ -165,7 +165,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
     case Command::GoTo_DIR:
     case Command::GoHome:
     case Command::GoMark: {
-      if (motion_busy(motion_, profile_)) return not_performable("positioning command while BUSY");
+      if (motion_busy(motion_, profile_)) return not_performable("positioning command while BUSY", DiagnosticDetail::refused_busy);
       if (!motion_command_allowed(to_string(op.command).data())) return;
       std::int32_t target = 0;
       if (op.command == Command::GoTo || op.command == Command::GoTo_DIR)
@@ -185,7 +185,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       return;
     case Command::ResetDevice:
       if (!motion_.hiz && reset_device_refused_when_enabled())
-        return not_performable("ResetDevice while the bridges are enabled");
+        return not_performable("ResetDevice while the bridges are enabled", DiagnosticDetail::refused_bridges_on);
       reset_logic();
       come_out_of_reset();
       return;
@@ -226,7 +226,7 @@ bool Chip::motion_command_allowed(const char* what) {
   if (!hiz_forced()) return true;
   std::string why = what;
   why += " while a fault holds the bridges in HiZ";
-  not_performable(why.c_str());
+  not_performable(why.c_str(), DiagnosticDetail::refused_fault_hiz);
   return false;
 }
 
@@ -244,13 +244,13 @@ void Chip::exec_set_param(std::uint8_t address, std::uint32_t value) {
     std::string why = "SetParam of ";
     why += r.name;
     why += " while the motor runs";
-    return not_performable(why.c_str());
+    return not_performable(why.c_str(), DiagnosticDetail::refused_running);
   }
   if (access == Access::WH && !motion_.hiz) {
     std::string why = "SetParam of ";
     why += r.name;
     why += " while the bridges are enabled";
-    return not_performable(why.c_str());
+    return not_performable(why.c_str(), DiagnosticDetail::refused_bridges_on);
   }
   write_register(r, value);
 }

@@ -20,7 +20,11 @@ enum class DiagnosticKind : std::uint8_t {
 /// More about a wrong_cmd or notperf_cmd diagnostic.
 enum class DiagnosticDetail : std::uint8_t {
   none,
-  read_only_write,  ///< SetParam of a read-only register
+  read_only_write,    ///< SetParam of a read-only register
+  refused_running,    ///< a command or a WS write refused while the motor runs
+  refused_busy,       ///< a positioning command refused while BUSY
+  refused_bridges_on, ///< a WH write, or ResetDevice on some parts, refused while the bridges are enabled
+  refused_fault_hiz,  ///< a motion command refused while a fault holds the bridges in HiZ
 };
 
 /// One diagnostic, stamped with the tick at which the chip noticed it.

@@ -394,7 +394,7 @@ void DeviceBoard::send_line_event(Handle& h, unsigned index, bool rising, Tick t
   } else {
     return;
   }
-  if (n >= 0) board_.note_output_read(g.chain, chip_of_line(off), pin_of_line(off));  // handed to the host
+  if (n >= 0) board_.note_output_edge(g.chain, chip_of_line(off), pin_of_line(off), rising);  // handed to the host
   if (n < 0 && ++h.dropped == 1)
     log_.line(g.name + ": " + g.lines[off].name + ": event queue full, edge events dropped (the host does not read them)");
 }
@@ -490,6 +490,21 @@ bool DeviceBoard::finish_scenario(ScenarioOutcome& out) {
   scenario_->finish();
   out = scenario_->outcome();
   return true;
+}
+
+void DeviceBoard::enable_coverage() {
+  std::lock_guard lock(m_);
+  board_.enable_coverage();
+}
+
+std::optional<CoverageData> DeviceBoard::coverage(bool try_only) {
+  std::unique_lock lock(m_, std::defer_lock);
+  if (try_only) {
+    if (!lock.try_lock()) return std::nullopt;
+  } else {
+    lock.lock();
+  }
+  return board_.coverage();
 }
 
 std::optional<std::string> DeviceBoard::first_unended_check_failure() {

@@ -213,6 +213,12 @@ class DeviceBoard {
   Tick scenario_next_tick();
   /// Ends the scenario at the board's time now (its `end` expectations judged). False: none.
   bool finish_scenario(ScenarioOutcome& out);
+  /// Starts collecting interface coverage on every chain (Board::enable_coverage).
+  void enable_coverage();
+  /// What the run has met so far (empty data when coverage is off); nullopt when `try_only` and
+  /// another thread holds the board (a program exiting with a thread inside a transfer).
+  std::optional<CoverageData> coverage(bool try_only = false);
+
   /// The driver sanitizer's first report for a caller that could not be ended (a kernel node's:
   /// its call failed with EIO and the report went to the log); nullopt while none. `run
   /// --nodes kernel` ends with it.

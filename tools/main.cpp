@@ -8,6 +8,7 @@
 #include "tools/cmd_plot.hpp"
 #include "tools/cmd_units.hpp"
 #include "tools/cmd_campaign.hpp"
+#include "tools/cmd_coverage.hpp"
 #include "tools/cmd_run.hpp"
 #include "tools/cmd_serve.hpp"
 #include "tools/demo.hpp"
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::RunCommand run_command(app);         // run
   l6470emu::CampaignCommand campaign_command(app);  // campaign, campaign merge
+  l6470emu::CoverageCommand coverage_command(app);  // coverage report, coverage merge
   l6470emu::add_trace_commands(app);             // replay, decode, convert
   l6470emu::add_plot_command(app);               // plot (python3 -m l6470emu.plot)
   l6470emu::add_units_command(app);              // units (register values <-> step/s, mA, ...)
@@ -69,6 +71,7 @@ int main(int argc, char** argv) {
   if (auto status = serve_commands.run()) return *status;
   if (auto status = run_command.run()) return *status;
   if (auto status = campaign_command.run()) return *status;
+  if (auto status = coverage_command.run()) return *status;
   if (*demo) return l6470emu::run_demo(chips, seconds, std::cout);
   if (*tables) {
     if (!readme.empty()) return update_readme(readme);

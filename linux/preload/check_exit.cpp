@@ -1,6 +1,7 @@
 // The preload's side of the driver sanitizer and of mistyped names: the run's end under
 // check=error, unknown L6470EMU_* variables, device nodes the board does not have.
 #include "linux/preload/check_exit.hpp"
+#include "linux/preload/coverage.hpp"
 #include "linux/preload/run.hpp"
 
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include "board/check_rules.hpp"
 #include "core/near_miss.hpp"
 #include "linux/log.hpp"
+#include "board/coverage_file.hpp"
 #include "board/run_report.hpp"
 #include "linux/preload/state.hpp"
 
@@ -22,7 +24,7 @@ namespace {
 
 constexpr const char* kKnown[] = {
     "L6470EMU_CHAIN", "L6470EMU_CONFIG", "L6470EMU_SOCKET", "L6470EMU_LOG",         "L6470EMU_TRACE",
-    "L6470EMU_SHM",   "L6470EMU_CHECK",  "L6470EMU_CHECK_ALLOW",
+    "L6470EMU_SHM",   "L6470EMU_CHECK",  "L6470EMU_CHECK_ALLOW", kCoverageEnv,
     // set by `l6470emu run` for the program it runs (board/run_report.hpp)
     kRunReportEnv, kRunScenarioEnv, kRunTimeoutEnv,
     // read by the l6470emu program, the Python package, the benchmarks and the test suite, not
@@ -38,6 +40,7 @@ void end_run_for_check(const std::string& report) {
     Guard guard;
     // Under `l6470emu run`: the report says why the program ended (run's own exit status for it).
     if (in_run()) end_run(RunEnd::sanitizer, report.substr(0, report.find('\n')));
+    finish_coverage();
     raw_write_all(2, report.data(), report.size());
     if (!log_is_stderr()) {
       const std::string first = report.substr(0, report.find('\n'));

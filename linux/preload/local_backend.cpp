@@ -5,6 +5,7 @@
 
 #include "linux/preload/backend.hpp"
 #include "linux/preload/check_exit.hpp"
+#include "linux/preload/coverage.hpp"
 #include "linux/preload/run.hpp"
 #include "linux/preload/virtual_time.hpp"
 
@@ -15,6 +16,7 @@ class LocalBackend final : public Backend {
  public:
   explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_), trace_(config.trace) {
     start_run(board_);  // `l6470emu run`: the scenario, the time limit, the report at exit
+    start_coverage(board_);  // L6470EMU_COVERAGE: merged into its file at exit
     if (config.time.virtual_time) {
       // Made when the program starts (its clock is the board's from then on): the trace starts
       // with the first open of a device, so that a child that never opens one (a shell, a
@@ -66,6 +68,7 @@ class LocalBackend final : public Backend {
     board_.forget_pump_after_fork();
     board_.forget_recordings_after_fork();
     run_after_fork_child();
+    coverage_after_fork_child();
     // The child goes on with its own copy of the board and of its virtual clock.
     if (virtual_time_) virtual_time_->after_fork_child();
   }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "linux/log.hpp"
+#include "linux/preload/coverage.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 
@@ -78,6 +79,7 @@ void run_time_reached(Tick now) {
   if (!g_board || now < g_timeout) return;
   end_run(RunEnd::timeout, "the simulated time limit " + seconds_text(g_timeout) + " was reached");
   for (std::size_t c = 0; c < g_board->chain_count(); ++c) g_board->stop_recording(c);
+  finish_coverage();
   for (FILE* f : {stdout, stderr})
     if (ftrylockfile(f) == 0) {
       fflush_unlocked(f);

@@ -11,10 +11,12 @@
 #include <string>
 #include <unordered_map>
 
+#include "board/coverage_file.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/device_paths.hpp"
 #include "linux/log.hpp"
 #include "linux/preload/check_exit.hpp"
+#include "linux/preload/coverage.hpp"
 #include "linux/preload/real.hpp"
 
 namespace l6470emu::preload {
@@ -80,6 +82,7 @@ __attribute__((constructor)) void load_config() {
   } else {
     return;  // nothing configured: the library stays out of the way
   }
+  if (const std::string why = check_coverage_environment(); !why.empty()) config_error(why);
   // A node path this machine already uses for something else would be taken over: refused too.
   if (parsed.config) parsed.error.message = check_device_paths(*parsed.config, origin);
   if (!parsed.config || !parsed.error.message.empty()) config_error(parsed.error.message);
@@ -139,6 +142,8 @@ Backend* backend() {
                                                              : make_remote_backend(g_config->socket, g_config->log);
     if (!g_config->socket.empty() && !g_config->trace.empty())
       log_line("trace= / L6470EMU_TRACE is ignored with a daemon: record with `serve --record` or `ctl trace start`");
+    if (!g_config->socket.empty() && std::getenv(kCoverageEnv))
+      log_line("L6470EMU_COVERAGE is ignored with a daemon: the daemon collects coverage (serve --coverage FILE)");
     if (!g_config->socket.empty() && (std::getenv("L6470EMU_CHECK") || std::getenv("L6470EMU_CHECK_ALLOW")))
       log_line("L6470EMU_CHECK / L6470EMU_CHECK_ALLOW are ignored with a daemon: its board checks as its description "
                "says (serve --chain \"... check=error\")");

@@ -1,6 +1,7 @@
 // Virtual host time in the preload library: clock conversions, covered waits, the busy-wait
 // rule, the board's bus-time waiter, fork hooks.
 #include "linux/preload/virtual_time.hpp"
+#include "linux/preload/coverage.hpp"
 #include "linux/preload/run.hpp"
 
 #include <dirent.h>
@@ -218,6 +219,7 @@ void VirtualHostTime::end_deadlocked(const std::string& report) {
   // Nothing recorded is lost: traces are finished (a gzip trace gets its end), the program's
   // standard output and error buffers written.
   for (std::size_t c = 0; c < board_.chain_count(); ++c) board_.stop_recording(c);
+  finish_coverage();
   for (FILE* f : {stdout, stderr})  // (a stream another thread holds locked is left as it is)
     if (ftrylockfile(f) == 0) {
       fflush_unlocked(f);
