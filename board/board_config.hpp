@@ -61,6 +61,9 @@ struct BoardConfig {
   std::string log = "stderr";  ///< where diagnostics go: "stderr", "off" or a file path
   std::string socket;          ///< daemon socket (preload: forward to it instead of emulating in process)
   std::string trace;           ///< record every chain into this native trace file ("" = no recording)
+  /// Merge interface coverage into this file when the board's run ends ("" = none; serve
+  /// --coverage, run --coverage: not a key of the description).
+  std::string coverage;
   NumberFrom numbering = NumberFrom::miso;  ///< how diagnostics and `ctl` number the chips (numbering=)
   CheckConfig check;                        ///< the driver sanitizer: check= and check.allow=
   FirmwareTiming firmware;                  ///< call_time=, loop_time=, limit=, apb_clock= (firmware runs)

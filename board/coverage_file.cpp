@@ -1,56 +1,17 @@
-// Coverage files: read, check, and merged into under flock(2), replaced by rename(2).
+// Coverage files: read whole, checked, and merged into through spi/file_update (a lock and a rename).
 #include "board/coverage_file.hpp"
 
-#include <fcntl.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
+#include <system_error>
+#include <filesystem>
+
+#include "spi/file_update.hpp"
 
 namespace l6470emu {
 
 namespace {
-
-std::string errno_text(int e) { return std::strerror(e); }
-
-/// Reads the whole of `fd` from its start.
-bool read_all(int fd, std::string& out) {
-  out.clear();
-  char buf[65536];
-  off_t at = 0;
-  for (;;) {
-    const ssize_t n = pread(fd, buf, sizeof buf, at);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    if (n == 0) return true;
-    out.append(buf, static_cast<std::size_t>(n));
-    at += n;
-  }
-}
-
-bool write_all(int fd, const std::string& text) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = write(fd, text.data() + done, text.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
-std::string directory_of(const std::string& path) {
-  const auto slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  return slash == 0 ? "/" : path.substr(0, slash);
-}
 
 CoverageData parse(const std::string& path, const std::string& text) {
   try {
@@ -63,86 +24,42 @@ CoverageData parse(const std::string& path, const std::string& text) {
 }  // namespace
 
 CoverageData read_coverage_file(const std::string& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw std::runtime_error(path + ": " + errno_text(errno));
-  struct stat st {};
-  std::string text;
-  const bool ok = fstat(fd, &st) == 0 && !S_ISDIR(st.st_mode) && read_all(fd, text);
-  const int e = errno;
-  close(fd);
-  if (!ok) throw std::runtime_error(path + ": " + (S_ISDIR(st.st_mode) ? std::string("a directory") : errno_text(e)));
-  if (text.empty()) throw std::runtime_error(path + ": empty, not a coverage file");
-  return parse(path, text);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error(path + ": a directory, not a coverage file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": " + (std::filesystem::exists(path, ec) ? "cannot be read" : "no such file"));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(path + ": cannot be read");
+  if (text.str().empty()) throw std::runtime_error(path + ": empty, not a coverage file");
+  return parse(path, text.str());
 }
 
 std::string merge_into_coverage_file(const std::string& path, const CoverageData& data) {
-  if (path.empty()) return "no coverage file named";
-  // Lock the file itself; once locked, make sure it is still the one at `path` (another
-  // process may have renamed a new one over it while this one waited).
-  int fd = -1;
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    fd = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) return path + ": " + errno_text(errno);
-    while (flock(fd, LOCK_EX) != 0)
-      if (errno != EINTR) {
-        const int e = errno;
-        close(fd);
-        return path + ": cannot lock: " + errno_text(e);
-      }
-    struct stat held {}, now {};
-    if (fstat(fd, &held) == 0 && stat(path.c_str(), &now) == 0 && held.st_ino == now.st_ino && held.st_dev == now.st_dev)
-      break;
-    close(fd);
-    fd = -1;
-  }
-  if (fd < 0) return path + ": replaced too often while waiting for its lock";
-  std::string text;
-  if (!read_all(fd, text)) {
-    const int e = errno;
-    close(fd);
-    return path + ": " + errno_text(e);
-  }
-  CoverageData merged;
-  try {
-    if (!text.empty()) merged = parse(path, text);
-  } catch (const std::exception& e) {
-    close(fd);
-    return std::string(e.what()) + " (left as it is)";
-  }
-  merged.merge(data);
-  const std::string out = merged.to_json();
-  const std::string temp = path + ".tmp." + std::to_string(getpid());
-  const int t = open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  std::string error;
-  if (t < 0) {
-    error = temp + ": " + errno_text(errno);
-  } else {
-    if (!write_all(t, out) || fsync(t) != 0) error = temp + ": " + errno_text(errno);
-    close(t);
-    if (error.empty() && rename(temp.c_str(), path.c_str()) != 0) error = path + ": " + errno_text(errno);
-    if (!error.empty()) unlink(temp.c_str());
-  }
-  close(fd);  // the lock goes with it
-  return error;
+  return update_file_locked(path, [&](const std::string& old, std::string& error) -> std::string {
+    CoverageData merged;
+    try {
+      if (!old.empty()) merged = parse(path, old);
+    } catch (const std::exception& e) {
+      error = std::string(e.what()) + " (left as it is)";
+      return "";
+    }
+    merged.merge(data);
+    return merged.to_json();
+  });
 }
 
 std::string check_coverage_output(const std::string& path) {
   if (path.empty()) return "the coverage file name is empty";
-  struct stat st {};
-  if (stat(path.c_str(), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) return path + ": a directory, not a coverage file";
-    if (!S_ISREG(st.st_mode)) return path + ": not a regular file";
-    if (access(path.c_str(), R_OK | W_OK) != 0) return path + ": " + errno_text(errno);
-    if (st.st_size > 0) {
-      try {
-        read_coverage_file(path);
-      } catch (const std::exception& e) {
-        return std::string(e.what()) + " (coverage is merged into it: name a new file, or remove this one)";
-      }
+  if (const std::string why = file_writable(path); !why.empty()) return why;
+  std::error_code ec;
+  if (std::filesystem::file_size(path, ec) > 0 && !ec) {
+    try {
+      read_coverage_file(path);
+    } catch (const std::exception& e) {
+      return std::string(e.what()) + " (coverage is merged into it: name a new file, or remove this one)";
     }
   }
-  const std::string dir = directory_of(path);
-  if (access(dir.c_str(), W_OK | X_OK) != 0) return path + ": cannot write in " + dir + ": " + errno_text(errno);
   return "";
 }
 

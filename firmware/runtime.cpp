@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "board/coverage_file.hpp"
 #include "board/scenario_runner.hpp"
 #include "daisychain/chip_numbering.hpp"
 #include "firmware/run.hpp"
@@ -346,7 +347,9 @@ void FirmwareRuntime::line_changed(Line& l) {
   const bool level = line_level(l, true);
   if (level == l.seen) return;
   l.seen = level;
-  if (l.edges & (level ? kEdgeRising : kEdgeFalling)) l.on_edge(level);
+  if (!(l.edges & (level ? kEdgeRising : kEdgeFalling))) return;
+  for (const ChipRef& r : l.outputs) board_->note_output_edge(r.chain, r.chip, r.pin, level);  // the program's interrupt
+  l.on_edge(level);
 }
 
 void FirmwareRuntime::process_edges() {
@@ -562,6 +565,10 @@ void FirmwareRuntime::finish() {
   if (finished_) return;
   finished_ = true;
   for (std::size_t i = 0; i < board_->chain_count(); ++i) board_->stop_recording(i);
+  // L6470EMU_COVERAGE: what the program met, merged into the file (other processes' too).
+  if (!config_.coverage.empty())
+    if (const std::string error = merge_into_coverage_file(config_.coverage, board_->coverage()); !error.empty())
+      log("coverage not written: " + error);
 }
 
 void FirmwareRuntime::stop(int status, const std::string& why) {
@@ -728,6 +735,13 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
   BoardConfig config = std::move(*parsed.config);
   if (const char* log = std::getenv("L6470EMU_LOG"); log && *log) config.log = log;
   if (const char* trace = std::getenv("L6470EMU_TRACE"); trace && *trace) config.trace = trace;
+  if (const char* coverage = std::getenv(kCoverageEnv); coverage && *coverage) {
+    if (const std::string why = check_coverage_output(coverage); !why.empty()) {
+      error = std::string("l6470emu: ") + kCoverageEnv + ": " + why;
+      return nullptr;
+    }
+    config.coverage = coverage;
+  }
   // The driver sanitizer, as the preload reads it.
   if (const char* check = std::getenv("L6470EMU_CHECK"); check && *check) {
     std::string why;
@@ -760,6 +774,7 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
       return nullptr;
     }
   }
+  if (!config.coverage.empty()) runtime->board().enable_coverage();
   g_runtime = runtime.release();  // lives until the program ends
   std::atexit(finish_at_exit);
   // Under `l6470emu run`: its scenario, its time limit, its report (at exit, before finish_at_exit).

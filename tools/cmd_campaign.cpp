@@ -24,6 +24,7 @@
 #include <sstream>
 #include <thread>
 
+#include "board/coverage_file.hpp"
 #include "board/board.hpp"
 #include "board/scenario_runner.hpp"
 #include "board/trace_recorder.hpp"
@@ -224,6 +225,8 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
   cmd_->add_option("--chips", only_chips_, "only these chips, comma separated, as numbered (1, 0,2, spidev0.1:0)");
   cmd_->add_option("--at", only_points_, "only the injection points of these names, comma separated (during_motion,at_Move_2)");
   cmd_->add_option("-j,--jobs", jobs_, "reruns at once (default: the number of CPUs)");
+  cmd_->add_option("--coverage", coverage_,
+                   "merge the clean run's interface coverage into this file (docs/coverage.md); reruns collect none");
   cmd_->add_option("--shard", shard_, "run only shard K of N (K/N): reruns K-1, K-1+N, ...; join with campaign merge");
   cmd_->add_option("--json", json_, "write the report as JSON (reproducing scenarios are written beside it)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report: one testcase per fault and chip");
@@ -333,6 +336,14 @@ int CampaignCommand::run_campaign() {
       if (const std::string why = output_problem(*out, inputs); !why.empty())
         return usage("cannot write " + quoted_text(*out) + ": " + why);
   if (!json_.empty() && json_ == junit_) return usage("--json and --junit name the same file");
+  // Coverage: the clean run's only (L6470EMU_COVERAGE asks the same); the faulted reruns collect none.
+  if (const char* env = std::getenv(kCoverageEnv); env && *env && cmd_->count("--coverage") == 0) coverage_ = env;
+  unsetenv(kCoverageEnv);
+  if (!coverage_.empty() || cmd_->count("--coverage") > 0) {
+    if (const std::string why = check_coverage_output(coverage_); !why.empty()) return usage("--coverage: " + why);
+    if (coverage_ == json_ || coverage_ == junit_) return usage("--coverage names the same file as another output");
+    coverage_ = fs::absolute(coverage_).lexically_normal().string();
+  }
 
   // The chips, and the faults asked for.
   Board probe(config, [](std::string_view) {}, real_host_clock());
@@ -419,6 +430,7 @@ int CampaignCommand::run_campaign() {
   clean_argv.insert(clean_argv.end(), board_args.begin(), board_args.end());
   if (!scenario_file_.empty()) clean_argv.insert(clean_argv.end(), {"--scenario", scenario_file_});
   if (user_timeout) clean_argv.insert(clean_argv.end(), {"--timeout", scenario_duration_text(*user_timeout)});
+  if (!coverage_.empty()) clean_argv.insert(clean_argv.end(), {"--coverage", coverage_});
   const std::string clean_trace = work + "/clean.trace", clean_outcome = work + "/clean.json";
   clean_argv.insert(clean_argv.end(), {"--record", clean_trace, "--outcome", clean_outcome, "--"});
   clean_argv.insert(clean_argv.end(), program_.begin(), program_.end());

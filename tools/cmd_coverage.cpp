@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <climits>
+#include <filesystem>
 #include <cstring>
 #include <cstdlib>
 #include <fstream>
@@ -27,12 +28,7 @@ bool write_text(const std::string& path, const std::string& text) {
   return static_cast<bool>(out);
 }
 
-std::string absolute(const std::string& path) {
-  char buf[PATH_MAX];
-  if (!path.empty() && path[0] == '/') return path;
-  if (!getcwd(buf, sizeof buf)) return path;
-  return std::string(buf) + "/" + path;
-}
+std::string absolute(const std::string& path) { return std::filesystem::absolute(path).lexically_normal().string(); }
 
 std::string directory_of(const std::string& path) {
   const auto slash = path.rfind('/');

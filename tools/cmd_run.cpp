@@ -14,6 +14,7 @@
 #include <condition_variable>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <mutex>
@@ -21,6 +22,7 @@
 #include <thread>
 
 #include "board/board.hpp"
+#include "board/coverage_file.hpp"
 #include "board/scenario_runner.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
@@ -145,7 +147,7 @@ std::vector<std::string> program_environment(bool keep_ld_preload) {
     const std::string_view v(*e);
     bool drop = !keep_ld_preload && v.starts_with("LD_PRELOAD=");
     for (const char* name : {"L6470EMU_CONFIG=", "L6470EMU_SOCKET=", "L6470EMU_TRACE=", "L6470EMU_CHAIN=",
-                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS="})
+                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS=", "L6470EMU_COVERAGE="})
       drop = drop || v.starts_with(name);
     if (!drop) env.emplace_back(v);
   }
@@ -229,6 +231,7 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   env.push_back("L6470EMU_CHAIN=" + describe_board_config(config));
   env.push_back(std::string(kRunScenarioEnv) + "=" + scenario_path);
   env.push_back(std::string(kRunReportEnv) + "=" + report_path);
+  if (!config.coverage.empty()) env.push_back(std::string(kCoverageEnv) + "=" + config.coverage);
   if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
   // SIGINT and SIGTERM interrupt the wait (no SA_RESTART) and are passed on to the program.
   struct sigaction stop {}, old_int {}, old_term {};
@@ -379,6 +382,8 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
+  cmd_->add_option("--coverage", coverage_,
+                   "collect interface coverage and merge it into this file (every process of the program; docs/coverage.md)");
   cmd_->add_option("--nodes", nodes_,
                    "how the program reaches the board: preload (default: LD_PRELOAD, in this program's process) or "
                    "kernel (the kernel's own /dev/spidevB.C and /dev/gpiochipN through CUSE and UHID, wall time; root, "
@@ -431,6 +436,21 @@ std::optional<int> RunCommand::run() {
       if (const std::string why = output_problem(record_, inputs); !why.empty())
         return usage("l6470emu run: cannot write --record " + quoted_text(record_) + ": " + why);
     if (!junit_.empty() && junit_ == record_) return usage("l6470emu run: --junit and --record name the same file");
+    // L6470EMU_COVERAGE in run's own environment asks the same as --coverage (a suite run with it set).
+    const char* env_coverage = std::getenv(kCoverageEnv);
+    if (cmd_->count("--coverage") == 0 && env_coverage && *env_coverage) coverage_ = env_coverage;
+    if (!coverage_.empty() || cmd_->count("--coverage") > 0) {
+      std::string why = check_coverage_output(coverage_);
+      if (why.empty() && (coverage_ == junit_ || coverage_ == record_ || coverage_ == outcome_))
+        why = "the same file as another of the run's outputs";
+      if (why.empty())
+        for (const std::string& input : inputs)
+          if (!input.empty() && std::filesystem::exists(input) && std::filesystem::exists(coverage_) &&
+              std::filesystem::equivalent(input, coverage_))
+            why = "the same file as an input";
+      if (!why.empty()) return usage("l6470emu run: --coverage: " + why);
+      config.coverage = std::filesystem::absolute(coverage_).lexically_normal().string();
+    }
   }
 
   // 2. The scenario, read and checked against the board.

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "board/coverage_file.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/device_paths.hpp"
 #include "linux/serve/control.hpp"
@@ -28,6 +29,8 @@ ServeCommands::ServeCommands(CLI::App& app) {
   serve_->add_flag("--virtual-time", virtual_time_,
                    "time moves only with bus traffic and `ctl advance` (deterministic runs)");
   serve_->add_option("--log", log_, "diagnostics: stderr (default), off, or a file");
+  serve_->add_option("--coverage", coverage_,
+                     "collect interface coverage and merge it into this file when the daemon stops (docs/coverage.md)");
   serve_->add_option("--record", record_,
                      "record every chain into this native trace, flushed frame by frame "
                      "(several chains: the chain's name goes before the extension)");
@@ -87,6 +90,13 @@ std::optional<int> ServeCommands::run() {
     if (virtual_time_) config.time.virtual_time = true;
     if (!log_.empty()) config.log = log_;
     if (!record_.empty()) config.trace = record_;
+    if (serve_->count("--coverage") > 0) {
+      if (const std::string why = check_coverage_output(coverage_); !why.empty()) {
+        std::cerr << "l6470emu serve: --coverage: " << why << "\n";
+        return 2;
+      }
+      config.coverage = std::filesystem::absolute(coverage_).lexically_normal().string();
+    }
     if (!serve_number_from_.empty()) {
       const auto from = number_from_named(serve_number_from_);
       if (!from) {

@@ -27,6 +27,7 @@ class ServeCommands {
   bool virtual_time_ = false;
   std::string log_;
   std::string record_;
+  std::string coverage_;
   bool cuse_ = false;
   bool uhid_ = false;
   std::string node_owner_ = "root";

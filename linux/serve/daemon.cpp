@@ -1,5 +1,6 @@
 // The serve daemon: socket set-up, accept loop, one thread per connection (its requests from the
 // socket or from a shared region), clean shutdown.
+#include "board/coverage_file.hpp"
 #include "linux/serve/daemon.hpp"
 
 #include <poll.h>
@@ -274,6 +275,7 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
       return 1;
     }
   }
+  if (!config.coverage.empty()) board.enable_coverage();
   board.start_pump();
   std::shared_ptr<void> kept;
   if (front_ends) {
@@ -436,6 +438,14 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   for (std::size_t i = 0; i < board.chain_count(); ++i) {
     std::string summary;
     if (board.stop_recording(i, &summary)) out << "l6470emu serve: recorded " << summary << "\n";
+  }
+  if (!config.coverage.empty()) {
+    const auto data = board.coverage(stuck > 0);
+    const std::string error = data ? merge_into_coverage_file(config.coverage, *data) : "a client still holds the board";
+    if (error.empty())
+      out << "l6470emu serve: interface coverage merged into " << config.coverage << "\n";
+    else
+      err << "l6470emu serve: coverage not written: " << error << "\n";
   }
   if (stuck > 0) {
     // Threads still use the board: end the process here rather than destroy it under them.

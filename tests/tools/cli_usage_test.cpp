@@ -26,9 +26,9 @@ TEST(UsageErrors, AMisspeltSubcommandIsNamedWithTheNearestOne) {
   expect_usage_error("replya x", "l6470emu: unknown subcommand 'replya'; did you mean 'replay'?");
   expect_usage_error("dcode x", "l6470emu: unknown subcommand 'dcode'; did you mean 'decode'?");
   expect_usage_error("frobnicate",
-                     "l6470emu: unknown subcommand 'frobnicate' (demo, tables, serve, ctl, run, campaign, replay, decode, convert, "
+                     "l6470emu: unknown subcommand 'frobnicate' (demo, tables, serve, ctl, run, campaign, coverage, replay, decode, convert, "
                      "plot, units; l6470emu --help)");
-  expect_usage_error("", "l6470emu: a subcommand is required: demo, tables, serve, ctl, run, campaign, replay, decode, convert, "
+  expect_usage_error("", "l6470emu: a subcommand is required: demo, tables, serve, ctl, run, campaign, coverage, replay, decode, convert, "
                          "plot, units (l6470emu --help)");
   expect_usage_error("--verison", "l6470emu: unknown option '--verison'; did you mean '--version'?");
   expect_usage_error("--decode x", "l6470emu: unknown option '--decode'; did you mean 'decode'?");
