@@ -75,7 +75,11 @@ void Board::enable_coverage() {
   });
 }
 
-CoverageData Board::coverage() const { return coverage_ ? coverage_->data() : CoverageData{}; }
+CoverageData Board::coverage() const {
+  if (!coverage_) return {};
+  for (const auto& c : chains_) coverage_->look(c->index, c->chain, true);  // the flags as the run ends
+  return coverage_->data();
+}
 
 void Board::set_command_observer(std::size_t chain, std::size_t chip, Chip::CommandSink sink) {
   ChainState& c = state(chain);

@@ -38,6 +38,7 @@ void CoverageCollector::add_chain(const Chain& chain, NumberFrom numbering) {
     s.get_status_index = s.universe->find(CoverageCategory::commands, "GetStatus");
   }
   chains_.push_back(std::move(chips));
+  looks_.push_back(ChainLook{false, 0, std::vector<std::uint64_t>(chain.size(), 0)});
 }
 
 CoverageCollector::ChipState& CoverageCollector::chip(std::size_t chain, std::size_t chip) {
@@ -159,8 +160,18 @@ void CoverageCollector::diagnostic(std::size_t chain, std::size_t k, const Diagn
   }
 }
 
-void CoverageCollector::look(std::size_t chain, const Chain& ch) {
+void CoverageCollector::look(std::size_t chain, const Chain& ch, bool force) {
   auto& chips = chains_.at(chain);
+  ChainLook& last = looks_[chain];
+  bool changed = force || !last.looked || ch.now() - last.at >= kLookInterval;
+  for (std::size_t k = 0; k < chips.size() && k < ch.size(); ++k) {
+    const std::uint64_t decoded = ch.chip(k).decoded_bytes();
+    changed = changed || decoded != last.decoded[k] || chips[k].has_pending;
+    last.decoded[k] = decoded;
+  }
+  if (!changed) return;
+  last.looked = true;
+  last.at = ch.now();
   for (std::size_t k = 0; k < chips.size() && k < ch.size(); ++k) {
     ChipState& s = chips[k];
     settle(s);
@@ -178,6 +189,7 @@ void CoverageCollector::look(std::size_t chain, const Chain& ch) {
 
 void CoverageCollector::event(std::size_t chain, std::size_t k, TraceFault fault, std::uint8_t value) {
   ChipState& s = chip(chain, k);
+  looks_[chain].looked = false;  // the next look looks
   switch (fault) {
     case TraceFault::THERMAL:
       if (value >= 1 && value <= 3) mark(s, CoverageCategory::events, "THERMAL " + std::string(thermal_name(value)));
@@ -192,6 +204,7 @@ void CoverageCollector::event(std::size_t chain, std::size_t k, TraceFault fault
 
 void CoverageCollector::input(std::size_t chain, std::size_t k, Pin pin, bool level) {
   ChipState& s = chip(chain, k);
+  looks_[chain].looked = false;  // the next look looks
   if (pin == Pin::SW) {
     if (!level && !s.sw_low) mark(s, CoverageCategory::events, "SW closed");
     if (level && s.sw_low) mark(s, CoverageCategory::events, "SW opened");

@@ -34,7 +34,13 @@ class CoverageCollector {
   /// Chip `chip` noticed a host mistake (Chip's DiagnosticSink): a refusal or a wrong command.
   void diagnostic(std::size_t chain, std::size_t chip, const Diagnostic& d);
   /// After a step of the run (a frame, a pin, a fault, a wait): the flags every chip shows now.
-  void look(std::size_t chain, const Chain& ch);
+  /// Cheap when nothing reached the chips' decoders since the last look and less than
+  /// kLookInterval ticks have passed: flags that rise with time alone (the motion's phases) are
+  /// looked at that often, or at the next command, pin or fault.
+  /// `force`: look whatever happened (the run's end).
+  void look(std::size_t chain, const Chain& ch, bool force = false);
+  /// How often time alone makes a look: 1 ms.
+  static constexpr Tick kLookInterval = 4000;
   /// A backdoor event applied to chip `chip` (value as Board::inject_fault takes it).
   void event(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value);
   /// An input pin of chip `chip` was driven to `level` (SW, STBY_RST, STCK).
@@ -79,6 +85,12 @@ class CoverageCollector {
   static void saw_status(ChipState& s, std::uint16_t status, bool observed);
 
   std::vector<std::vector<ChipState>> chains_;
+  struct ChainLook {
+    bool looked = false;
+    Tick at = 0;
+    std::vector<std::uint64_t> decoded;  // each chip's decoded_bytes() then
+  };
+  std::vector<ChainLook> looks_;
 };
 
 }  // namespace l6470emu
