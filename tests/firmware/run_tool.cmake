@@ -2,9 +2,9 @@
 # its arguments, --, the program) runs in WORK (made empty first); it must exit with STATUS, its
 # standard error must contain every string of STDERR_HAS and none of STDERR_LACKS, its standard
 # output every string of STDOUT_HAS, and the file FILE (in WORK), when given, every string of
-# FILE_HAS. Lists are joined by | (strings with | in them cannot be checked).
+# FILE_HAS and none of FILE_LACKS. Lists are joined by | (strings with | in them cannot be checked).
 # Usage: cmake "-DCOMMAND=l6470emu|run|--chain|L6470|--|prog" -DSTATUS=0 -DWORK=dir "-DSTDERR_HAS=a|b" -P run_tool.cmake
-foreach(v COMMAND STDERR_HAS STDERR_LACKS STDOUT_HAS STDOUT_LACKS FILE_HAS)
+foreach(v COMMAND STDERR_HAS STDERR_LACKS STDOUT_HAS STDOUT_LACKS FILE_HAS FILE_LACKS)
   string(REPLACE "|" ";" ${v} "${${v}}")
 endforeach()
 file(REMOVE_RECURSE "${WORK}")
@@ -19,6 +19,12 @@ if(FILE)
     string(FIND "${text}" "${s}" at)
     if(at LESS 0)
       message(FATAL_ERROR "${FILE} lacks '${s}': ${shown}\n--- ${FILE}:\n${text}")
+    endif()
+  endforeach()
+  foreach(s IN LISTS FILE_LACKS)
+    string(FIND "${text}" "${s}" at)
+    if(NOT at LESS 0)
+      message(FATAL_ERROR "${FILE} has '${s}': ${shown}\n--- ${FILE}:\n${text}")
     endif()
   endforeach()
 endif()
