@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A bounded fuzz pass: sets up (Debian packages and a clang build in build-fuzz, through
 # scripts/setup.sh), replays tests/fuzz/regressions/<harness>/ (inputs that once crashed),
-# then runs every libFuzzer harness of tests/fuzz for SECONDS_PER_HARNESS seconds (default 60)
+# then runs every libFuzzer harness of tests/fuzz for SECONDS_PER_HARNESS seconds (default 60), as
+# many at a time as there are cores (L6470EMU_FUZZ_JOBS),
 # from its seed corpus tests/fuzz/corpus/<harness>/, new inputs going to a scratch directory.
 # Prints each harness's executions, coverage and time. Exits non-zero when any input crashed,
 # hung or ran out of memory; that input is kept in tests/fuzz/regressions/<harness>/.
@@ -42,10 +43,10 @@ for h in "${harnesses[@]}"; do
   fi
 done
 
-# 2. The bounded pass.
-printf '%-10s %12s %8s %8s %10s %6s  %s\n' harness executions cov ft input_MB time result
-for h in "${harnesses[@]}"; do
-  extra=()
+# 2. The bounded pass: as many harnesses at a time as there are cores (L6470EMU_FUZZ_JOBS), each
+# for SECONDS_PER_HARNESS; the rows are printed in the harnesses' order once all have run.
+fuzz_one() {  # fuzz_one HARNESS: writes $logs/HARNESS.row (the table row) and .rc (its exit status)
+  local h=$1 extra=() start rc=0 elapsed execs bytes cov result
   case $h in
     spi_chain) extra=(-max_len=2048) ;;  # long command sequences
     ftrace) extra=(-max_len=4096) ;;     # the seeds are 20 KB; mutants that size are slow
@@ -54,7 +55,6 @@ for h in "${harnesses[@]}"; do
   rm -rf "${scratch:?}/$h"
   mkdir -p "$scratch/$h" "tests/fuzz/regressions/$h"
   start=$(date +%s)
-  rc=0
   "$build/tests/fuzz/fuzz_$h" -max_total_time="$seconds" -seed="${L6470EMU_FUZZ_SEED:-1}" -timeout=25 -print_final_stats=1 "${extra[@]}" \
     -artifact_prefix="tests/fuzz/regressions/$h/" "$scratch/$h" "tests/fuzz/corpus/$h" >"$logs/$h.log" 2>&1 || rc=$?
   elapsed=$(($(date +%s) - start))
@@ -62,15 +62,31 @@ for h in "${harnesses[@]}"; do
   bytes=$(sed -n 's/^stat::input_bytes: *//p' "$logs/$h.log" | tail -1)
   cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$logs/$h.log" | tail -1 || true)
   result=ok
-  if [ "$rc" -ne 0 ]; then
-    result="FAILED (exit $rc)"
-    failed+=("$h")
+  [ "$rc" -ne 0 ] && result="FAILED (exit $rc)"
+  {
+    printf '%-10s %12s %8s %8s %10s %5ss  %s\n' "$h" "${execs:-?}" "$(echo "$cov" | awk '{print $2}')" \
+      "$(echo "$cov" | awk '{print $4}')" "$(awk -v b="${bytes:-0}" 'BEGIN{printf "%.1f", b/1e6}')" "$elapsed" "$result"
+    if [ "$rc" -ne 0 ]; then
+      grep -E "ERROR|INVARIANT|runtime error|SUMMARY|Test unit written" "$logs/$h.log" | tail -8 | sed 's/^/    /' || true
+    fi
+  } >"$logs/$h.row"
+  echo "$rc" >"$logs/$h.rc"
+}
+jobs_at_once=${L6470EMU_FUZZ_JOBS:-$(nproc)}
+running=0
+for h in "${harnesses[@]}"; do
+  if [ "$running" -ge "$jobs_at_once" ]; then
+    wait -n || true
+    running=$((running - 1))
   fi
-  printf '%-10s %12s %8s %8s %10s %5ss  %s\n' "$h" "${execs:-?}" "$(echo "$cov" | awk '{print $2}')" \
-    "$(echo "$cov" | awk '{print $4}')" "$(awk -v b="${bytes:-0}" 'BEGIN{printf "%.1f", b/1e6}')" "$elapsed" "$result"
-  if [ "$rc" -ne 0 ]; then
-    grep -E "ERROR|INVARIANT|runtime error|SUMMARY|Test unit written" "$logs/$h.log" | tail -8 | sed 's/^/    /' || true
-  fi
+  fuzz_one "$h" &
+  running=$((running + 1))
+done
+wait
+printf '%-10s %12s %8s %8s %10s %6s  %s\n' harness executions cov ft input_MB time result
+for h in "${harnesses[@]}"; do
+  cat "$logs/$h.row"
+  [ "$(cat "$logs/$h.rc" 2>/dev/null || echo 1)" = 0 ] || failed+=("$h")
 done
 
 if ((${#failed[@]})); then
