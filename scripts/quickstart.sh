@@ -9,8 +9,9 @@ what=${1:-}
 case "$what" in
   demo)
     # An unmodified Python program (Debian's python3-spidev and python3-libgpiod) drives three
-    # emulated L6470s through /dev/spidev0.0 and /dev/gpiochip0, provided by the preload library.
-    scripts/setup.sh build
+    # emulated L6470s through /dev/spidev0.0 and /dev/gpiochip0, provided by the preload library:
+    # the only target the demo builds (the test command builds the rest).
+    BUILD_TARGETS=l6470emu-preload scripts/setup.sh build
     L6470EMU_CHAIN="bus=0 cs=0 chips=3xL6470" LD_PRELOAD="$PWD/build/libl6470emu-preload.so" \
       exec /usr/bin/python3 scripts/demo_preload.py "${@:2}"
     ;;

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project needs (only the missing ones, with one
 # `apt-get update` first) and builds the project. Usage: scripts/setup.sh [BUILD_DIR [CMAKE_ARGS...]]
+# BUILD_TARGETS="a b" builds only those targets (the demo needs the preload library alone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,6 +14,7 @@ packages=(
   python3-dev pybind11-dev python3-pybind11 python3-pytest python3-pytest-xdist python3-numpy python3-matplotlib help2man man-db dpkg-dev lintian
   libfuse3-dev qemu-system-x86 busybox-static cpio kmod
   libyaml-cpp-dev spi-tools golang-go
+  lcov
 )
 
 missing=()
@@ -31,4 +33,6 @@ fi
 build_dir=${1:-build}
 shift || true
 cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "$@" >/dev/null
-cmake --build "$build_dir" -j"$(nproc)"
+targets=()
+for t in ${BUILD_TARGETS:-}; do targets+=(--target "$t"); done
+cmake --build "$build_dir" -j"$(nproc)" "${targets[@]}"
