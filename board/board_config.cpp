@@ -617,9 +617,13 @@ struct Parser {
       }
       const KeySpec* spec = find_key(key);
       if (spec == nullptr) {
-        const std::string near = key_suggestion(key);
+        std::string near = key_suggestion(key);
+        // "axsi.0", "axes.1": a misspelt axis.K (the chip's number kept).
+        if (const std::size_t dot = key.find('.'); near.empty() && dot != std::string_view::npos &&
+                                                     closest_names(key.substr(0, dot), {"axis"}) == "axis")
+          near = "axis" + std::string(key.substr(dot));
         return fail("unknown key " + quoted_text(key) + (near.empty() ? "" : ": did you mean " + near + "=?") +
-                    " (chain keys: " + key_list(Scope::chain) + "; board-wide: " + key_list(Scope::board) + ")");
+                    " (chain keys: " + key_list(Scope::chain) + ", axis.K; board-wide: " + key_list(Scope::board) + ")");
       }
       if (auto it = in_clause.find(spec->name); it != in_clause.end())
         return fail(std::string(key) + "= is given twice in this clause (" + quoted_text(it->second) + ", then " +

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/near_miss.hpp"
+
 namespace l6470emu {
 namespace {
 
@@ -100,6 +102,23 @@ const std::array<Item, 13> kItems{{
 
 #undef L6470EMU_FIELD
 
+/// Every item name an axis takes, in the order the docs list them.
+std::vector<std::string> item_names() {
+  std::vector<std::string> names;
+  for (const Item& i : kItems) names.emplace_back(i.name);
+  for (const char* n : {"stops", "start", "switch"}) names.emplace_back(n);
+  return names;
+}
+
+std::string item_list() {
+  std::string out;
+  for (const std::string& n : item_names()) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+/// The items closest to a misspelt `word` ("switch" for "swich"), or "".
+std::string item_suggestion(std::string_view word) { return closest_names(word, item_names()); }
+
 const Item* find_item(std::string_view name) {
   for (const Item& i : kItems)
     if (i.name == name) return &i;
@@ -176,7 +195,12 @@ std::string parse_items(std::string_view text, AxisSpec& spec, bool load_only) {
     start = comma + 1;
     if (item.empty()) return "empty item (items are NAME=VALUE separated by commas)";
     const std::size_t eq = item.find('=');
-    if (eq == std::string_view::npos || eq == 0) return "item " + quoted(item) + " is not NAME=VALUE";
+    if (eq == std::string_view::npos || eq == 0) {
+      // "swich:100" is a misspelt "switch=..." as often as a missing '='.
+      const std::string_view word = item.substr(0, std::min(item.find_first_of(":="), item.size()));
+      const std::string near = item_suggestion(word);
+      return "item " + quoted(item) + " is not NAME=VALUE" + (near.empty() ? "" : " (did you mean " + near + "=...?)");
+    }
     const std::string_view name = item.substr(0, eq), value = item.substr(eq + 1);
     if (value.empty()) return name == "stops" ? "stops= needs LO..HI" : std::string(name) + "= has no value";
     if (name != "switch") {
@@ -215,8 +239,8 @@ std::string parse_items(std::string_view text, AxisSpec& spec, bool load_only) {
       if (std::string e = parse_switch(value, sw); !e.empty()) return e;
       spec.switches.push_back(sw);
     } else {
-      return "unknown item " + quoted(name) +
-             " (steps, torque, current, r, l, rotor, load, friction, force, vs, rds, rsense, stops, start, pullin, switch)";
+      const std::string near = item_suggestion(name);
+      return "unknown item " + quoted(name) + (near.empty() ? "" : ": did you mean " + near + "=?") + " (" + item_list() + ")";
     }
   }
   if ((spec.has_lower_stop && spec.start_position < spec.lower_stop) ||

@@ -131,6 +131,15 @@ TEST(AxisConfig, EveryItemErrorNamesTheItemAndWhatItTakes) {
   }
 }
 
+TEST(AxisConfig, AMisspeltItemOrAxisKeyIsNamedWithItsNearMiss) {
+  EXPECT_NE(error_of("chips=L6470 axis.0=torqe=1").find("unknown item 'torqe': did you mean torque=?"), std::string::npos);
+  EXPECT_NE(error_of("chips=L6470 axis.0=swich:100").find("item 'swich:100' is not NAME=VALUE (did you mean switch=...?)"),
+            std::string::npos);
+  const std::string key = error_of("chips=L6470 axsi.0=steps=200");
+  EXPECT_NE(key.find("unknown key 'axsi.0': did you mean axis.0=?"), std::string::npos) << key;
+  EXPECT_NE(key.find(", axis.K;"), std::string::npos) << "the keys listed name axis.K: " << key;
+}
+
 TEST(AxisConfig, RuntimeLoadChangesAcceptOnlyLoadItems) {
   LoadSpec load;
   EXPECT_EQ(parse_axis_load("friction=0.1,force=-0.02,load=10", load), "");
