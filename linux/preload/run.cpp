@@ -68,6 +68,8 @@ void start_run(DeviceBoard& board) {
 
 bool in_run() { return g_board != nullptr; }
 
+bool run_reads_report() { return g_board != nullptr && g_report_path != nullptr; }
+
 Tick run_next_tick() {
   if (!g_board) return kNever;
   return g_board->scenario_next_tick();

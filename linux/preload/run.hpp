@@ -18,6 +18,8 @@ namespace l6470emu::preload {
 void start_run(DeviceBoard& board);
 /// Whether this process is part of a run.
 bool in_run();
+/// Whether `l6470emu run` reads this process's report (and prints what ended it itself).
+bool run_reads_report();
 /// The next tick the world changes at: the scenario's next timed step (kNever: none).
 Tick run_next_tick();
 /// The run's simulated time limit (kNever: none).

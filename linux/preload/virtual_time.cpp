@@ -206,8 +206,9 @@ std::string VirtualHostTime::describe_board() {
 
 void VirtualHostTime::end_deadlocked(const std::string& report) {
   end_run(RunEnd::deadlock, report);  // `l6470emu run` learns the cause from its report, not from the status
-  // The report on standard error (as a sanitizer's), and in the log file when there is one.
-  write_stderr_lines(report);
+  // The report on standard error (as a sanitizer's; under `l6470emu run`, run prints it from the
+  // run's report, once), and in the log file when there is one.
+  if (!run_reads_report()) write_stderr_lines(report);
   if (!log_is_stderr()) {
     std::size_t at = 0;
     while (at <= report.size()) {

@@ -216,6 +216,8 @@ TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
   EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
   EXPECT_NE(r.err.find("deadlock at t=1.000000 s"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("deadlocked in virtual time at 1.000000 s"), std::string::npos) << r.err;
+  // Said once: run prints the preload's report, which then stays off the program's stderr.
+  EXPECT_EQ(r.err.find("deadlock at t="), r.err.rfind("deadlock at t=")) << r.err;
 }
 
 TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
