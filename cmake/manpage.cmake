@@ -7,7 +7,7 @@ foreach(v PROGRAM HELP2MAN INCLUDE OUTPUT)
   endif()
 endforeach()
 
-set(subcommands demo tables serve ctl run campaign replay decode convert plot units)
+set(subcommands demo tables serve ctl run campaign coverage replay decode convert plot units)
 set(section "[SUBCOMMANDS]\n")
 foreach(sub ${subcommands})
   execute_process(COMMAND ${PROGRAM} ${sub} --help OUTPUT_VARIABLE help RESULT_VARIABLE rc)
