@@ -538,7 +538,7 @@ std::optional<int> RunCommand::run() {
   else if (cause == RunEnd::sanitizer) status = kRunSanitizerError;
   else if (!exited || code != 0) status = kRunProgramFailed;
   else if (!failures.empty()) status = kRunExpectationFailed;
-  else if (judged.empty() && !scenario.steps.empty()) {
+  else if (judged.empty()) {  // with or without a scenario: nothing says how the run went
     status = kRunNotStarted;
     why = " (it left no report: it ended by _exit() or a signal before exit(), or the preload was not loaded)";
   }
@@ -550,8 +550,12 @@ std::optional<int> RunCommand::run() {
   const std::string words = run.stopped_by ? "run was stopped by a signal" : status_words(status);
 
   std::ostream& out = std::cerr;
-  out << "l6470emu run: " << program_[0] << " " << ended << " at " << seconds_text(end_tick)
-      << (config.time.virtual_time ? " of virtual time" : " of board time") << "\n";
+  // Without a report (killed by a signal, _exit()) nothing says when it ended: no "at 0 s".
+  const bool when_known = !judged.empty() || cause_block || wall_timeout;
+  out << "l6470emu run: " << program_[0] << " " << ended
+      << (when_known ? " at " + seconds_text(end_tick) + (config.time.virtual_time ? " of virtual time" : " of board time")
+                     : std::string(" (when, in virtual time, is unknown: it left no report)"))
+      << "\n";
   if (cause_block)
     for (const auto& d : cause_block->detail) out << "  " << d << "\n";
   if (verbose_) {

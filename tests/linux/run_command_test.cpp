@@ -220,6 +220,14 @@ TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
   EXPECT_EQ(r.err.find("deadlock at t="), r.err.rfind("deadlock at t=")) << r.err;
 }
 
+TEST_F(RunCommand, AProgramEndingWithoutAReportIsStatusSevenWithOrWithoutAScenario) {
+  // os._exit skips the preload's report at exit: nothing says how the run went.
+  const RunResult r = run({"--chain", "chips=L6470"}, python("import os\nstatus()\nos._exit(0)\n"));
+  EXPECT_EQ(r.status, kRunNotStarted) << r.err;
+  EXPECT_NE(r.err.find("(when, in virtual time, is unknown: it left no report)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("at 0.000000 s"), std::string::npos) << r.err;
+}
+
 TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
   for (const char* code : {"3", "86", "87"}) {
     const RunResult r = run({"--chain", "chips=L6470"}, {"/bin/sh", "-c", std::string("exit ") + code});
