@@ -97,7 +97,7 @@ def _start_coverage(config) -> None:
     workerinput = getattr(config, "workerinput", None)
     path = workerinput.get("l6470emu_coverage") if workerinput is not None else None
     if path is None:
-        path = config.getoption("l6470emu_coverage")
+        path = config.getoption("l6470emu_coverage", None)
         if path is None:
             return
         if not path:
@@ -133,11 +133,10 @@ def pytest_configure_node(node):
 def pytest_sessionfinish(session):
     """Every Board and Chain still alive merges its coverage now (a worker may end without the
     interpreter's exit handlers), before the controller's summary reads the file."""
-    if _session_coverage is None:
+    extension = sys.modules.get("l6470emu._l6470emu")  # a session that never imported it has nothing to merge
+    if extension is None:
         return
-    from ._l6470emu import _flush_coverage
-
-    for why in _flush_coverage():
+    for why in extension._flush_coverage():
         sys.stderr.write(f"l6470emu: coverage not written: {why}\n")
 
 
