@@ -14,6 +14,8 @@ l6470emu.units converts register values to physical units (step/s, mA, ...) and 
 campaign() runs `l6470emu campaign` (every fault at every point of a program's run, each rerun
 judged) and returns its report as a CampaignResult; campaign_merge() joins shards' reports
 (docs/campaigns-python.md).
+Board and Chain collect interface coverage with coverage=FILE (default: $L6470EMU_COVERAGE);
+coverage_report() and coverage_total() read coverage files (docs/coverage-python.md).
 """
 from ._l6470emu import (
     DEFAULT_MAX_FRAMES,
@@ -41,6 +43,8 @@ from ._l6470emu import (
     TraceEvent,
     __version__,
     check_rules,
+    coverage_report,
+    coverage_total,
     decode,
     motion,
     register_table,
@@ -87,6 +91,8 @@ __all__ = [
     "campaign",
     "campaign_merge",
     "check_rules",
+    "coverage_report",
+    "coverage_total",
     "decode",
     "motion",
     "preload_library",

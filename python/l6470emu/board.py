@@ -75,13 +75,20 @@ class Board:
     every chain into this native trace (trace(), decode(), replay() read it). check: the driver
     sanitizer, "error" (default: the first broken rule of the chip raises l6470emu.SanitizerError
     with the report), "warn" (a log line) or "off"; check_allow: rule names let pass. A
-    description or options naming check= themselves win.
+    description or options naming check= themselves win. coverage: collect interface coverage of
+    everything the board meets and merge it into this file on close(), at the end of a `with`,
+    when the board is destroyed or the interpreter exits (docs/coverage-python.md); True
+    collects it in memory only (coverage_data()), False not at all; None (default) collects
+    into $L6470EMU_COVERAGE when it is set. A file that cannot take coverage is a ValueError here.
+    The code under test's reads count as the driver's (Line.get_value of BUSY/FLAG, the edge
+    events event_read hands out); the test's own looks (level(), axis()) do not.
     """
 
     def __init__(self, chips: Union[str, int, Sequence[str]] = "L6470", *, bus: int = 0, cs: int = 0,
                  options: str = "", description: Optional[str] = None,
                  trace_path: Optional[Union[str, os.PathLike]] = None,
-                 check: str = "error", check_allow: Sequence[str] = ()):
+                 check: str = "error", check_allow: Sequence[str] = (),
+                 coverage: Union[str, os.PathLike, bool, None] = None):
         if description is None:
             description = f"bus={bus} cs={cs} chips={_chips_word(chips)}"
             if options:
@@ -94,7 +101,7 @@ class Board:
             description += f" check={check}" + (" check.allow=" + ",".join(check_allow) if check_allow else "")
         #: the board description the board was built from
         self.description: str = description
-        self._core = _BoardCore(description, "l6470emu.Board")
+        self._core = _BoardCore(description, "l6470emu.Board", coverage)
         self.trace_path = None if trace_path is None else os.fspath(trace_path)
         self._log: List[str] = []
         self._gpiochips = {}
@@ -224,15 +231,30 @@ class Board:
         return "".join(line + "\n" for line in self._log)
 
     def close(self) -> None:
-        """Stops recording (the trace file is complete); the board stays usable."""
+        """Stops recording (the trace file is complete) and merges the interface coverage met so
+        far into the coverage file (RuntimeError when it cannot be written); the board stays usable."""
         for k in range(self._core.chain_count()):
             self._core.stop_recording(k)
+        self._core.flush_coverage()
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
         self.close()
+
+    # ---- interface coverage ----------------------------------------------------------
+
+    def coverage_data(self) -> Optional[dict]:
+        """The interface coverage met so far as a dict, the coverage file's structure
+        ({"format", "version", "variants": {VARIANT: {"hit": {CATEGORY: [POINT, ...]},
+        "chain positions present": [...]}}}), or None when the board collects none."""
+        return self._core.coverage_data()
+
+    @property
+    def coverage_path(self) -> Optional[str]:
+        """The coverage file the board merges into (absolute), or None."""
+        return self._core.coverage_path()
 
     def _recorded(self) -> str:
         if self.trace_path is None:
@@ -512,7 +534,10 @@ class Line:
         self._needs_request()
         if self._type == LINE_REQ_DIR_OUT:
             return self._value
-        return self._logical(self._chip._board._core.level(*self._where))
+        core = self._chip._board._core
+        if PINS[self._offset % 5] in ("BUSY", "FLAG"):
+            core.note_output_read(*self._where)  # the driver looks (coverage: BUSY, FLAG's alarms observed)
+        return self._logical(core.level(*self._where))
 
     def set_value(self, value: int) -> None:
         """Drives an output line (SW, STCK, STBY_RST reach the chip; BUSY and FLAG are the chip's)."""
@@ -553,16 +578,24 @@ class Line:
         sec = int(timeout)
         return self.event_read() if self.event_wait(sec, int(round((timeout - sec) * 1e9))) else None
 
+    def _hand_out(self, event: LineEvent) -> LineEvent:
+        """An edge event given to the driver: a read of the pin, and an edge it waited on."""
+        chain, chip, pin = self._where
+        if PINS[pin] in ("BUSY", "FLAG"):
+            rising = (event.type == LineEvent.RISING_EDGE) != bool(self._flags & LINE_REQ_FLAG_ACTIVE_LOW)
+            self._chip._board._core.note_output_edge(chain, chip, pin, rising)
+        return event
+
     def event_read(self) -> LineEvent:
         """The oldest pending event (waits for one without a time limit, as a blocking read)."""
         while not self._events:
             self.event_wait(sec=3600)
-        return self._events.pop(0)
+        return self._hand_out(self._events.pop(0))
 
     def event_read_multiple(self) -> List[LineEvent]:
         self.event_wait()
         events, self._events = self._events, []
-        return events
+        return [self._hand_out(e) for e in events]
 
     def __repr__(self):
         return f"Line({self._chip.name()}, {self._offset}, {self.name()})"

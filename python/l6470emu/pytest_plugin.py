@@ -30,6 +30,12 @@ run has no such point:
   @pytest.mark.l6470emu_campaign(faults=("ocd", "uvlo"), points=("during_motion",), chips=(0,),
                                  fail_on=None)
 
+Interface coverage (docs/coverage-python.md): with --l6470emu-coverage=FILE, every Board and
+Chain the session makes (the fixtures' and the tests' own) collects interface coverage into FILE,
+and every program run gets L6470EMU_COVERAGE=FILE (the preload merges into it at exit). Under
+pytest-xdist every worker merges into the same FILE; the session ends with a one-paragraph
+summary (points met of points there are; `l6470emu coverage report FILE --show-missing` for the rest).
+
 Installed, the plugin is registered through its pytest11 entry point; from a build tree, put
 `pytest_plugins = ["l6470emu.pytest_plugin"]` in the top conftest.py (with the build's python/
 directory on PYTHONPATH).
@@ -56,6 +62,11 @@ DEFAULT_CAMPAIGN_FAULTS: Tuple[str, ...] = ("ocd", "thermal_warning", "thermal_b
 DEFAULT_CAMPAIGN_POINTS: Tuple[str, ...] = ("after_config", "during_motion", "idle_polling", "before_last_command")
 #: the l6470emu_campaign marker's default chips: chip 0 (the MISO end)
 DEFAULT_CAMPAIGN_CHIPS: Tuple[int, ...] = (0,)
+#: the environment variable naming the coverage file Boards, Chains and preloaded programs merge into
+COVERAGE_ENV = "L6470EMU_COVERAGE"
+_COVERAGE_OPTION = "--l6470emu-coverage"
+# The session's coverage file (absolute) while --l6470emu-coverage is in force, else None.
+_session_coverage: Optional[str] = None
 
 
 class CampaignCase(NamedTuple):
@@ -71,7 +82,87 @@ class CampaignCase(NamedTuple):
         return f"{self.fault}-chip{self.chip}-{self.point}"
 
 
+def pytest_addoption(parser):
+    group = parser.getgroup("l6470emu", "l6470emu: emulated L6470-family chips")
+    group.addoption(_COVERAGE_OPTION, dest="l6470emu_coverage", metavar="FILE", default=None,
+                    help="collect the interface coverage of every l6470emu Board, Chain and program the session "
+                         "runs and merge it into FILE (docs/coverage-python.md)")
+
+
+def _start_coverage(config) -> None:
+    """--l6470emu-coverage: FILE made absolute and checked at start-up (a usage error, not a failure at
+    the end), then named in this process's environment so that every Board and Chain (coverage=None)
+    and every program run collects into it. Workers take the controller's FILE (they may chdir)."""
+    global _session_coverage
+    workerinput = getattr(config, "workerinput", None)
+    path = workerinput.get("l6470emu_coverage") if workerinput is not None else None
+    if path is None:
+        path = config.getoption("l6470emu_coverage", None)
+        if path is None:
+            return
+        if not path:
+            raise pytest.UsageError(f"{_COVERAGE_OPTION}: the coverage file name is empty")
+        path = os.path.abspath(os.path.expanduser(path))
+        from ._l6470emu import _coverage_problem
+
+        why = _coverage_problem(path)
+        if why:
+            raise pytest.UsageError(f"{_COVERAGE_OPTION}: {why}")
+    previous = os.environ.get(COVERAGE_ENV)
+    os.environ[COVERAGE_ENV] = path
+    _session_coverage = path
+
+    def restore():
+        global _session_coverage
+        _session_coverage = None
+        if previous is None:
+            os.environ.pop(COVERAGE_ENV, None)
+        else:
+            os.environ[COVERAGE_ENV] = previous
+
+    config.add_cleanup(restore)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """pytest-xdist: each worker gets the controller's absolute coverage file."""
+    if _session_coverage is not None:
+        node.workerinput["l6470emu_coverage"] = _session_coverage
+
+
+def pytest_sessionfinish(session):
+    """Every Board and Chain still alive merges its coverage now (a worker may end without the
+    interpreter's exit handlers), before the controller's summary reads the file."""
+    extension = sys.modules.get("l6470emu._l6470emu")  # a session that never imported it has nothing to merge
+    if extension is None:
+        return
+    for why in extension._flush_coverage():
+        sys.stderr.write(f"l6470emu: coverage not written: {why}\n")
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """The controller's one paragraph: the points met of the points there are, and the file."""
+    if _session_coverage is None or hasattr(config, "workerinput"):
+        return
+    from ._l6470emu import coverage_total
+
+    terminalreporter.write_sep("-", "l6470emu interface coverage")
+    if not os.path.exists(_session_coverage):
+        terminalreporter.write_line(f"no Board, Chain or program collected coverage: {_session_coverage} not written")
+        return
+    try:
+        hit, total = coverage_total(_session_coverage)
+    except ValueError as e:
+        terminalreporter.write_line(f"cannot read the coverage: {e}")
+        return
+    percent = 100.0 * hit / total if total else 100.0
+    terminalreporter.write_line(
+        f"{hit}/{total} interface points met ({percent:.1f}%), merged into {_session_coverage}; "
+        f"`l6470emu coverage report {_session_coverage} --show-missing` lists the points never met.")
+
+
 def pytest_configure(config):
+    _start_coverage(config)
     config.addinivalue_line(
         "markers",
         f"{_MARKER}(*chips, check=\"error\", check_allow=()): the chips of the l6470_chain and spidev_board "
@@ -315,6 +406,8 @@ class SpidevBoard:
         env["L6470EMU_LOG"] = str(self.log_path)
         if self.trace_path is not None:
             env["L6470EMU_TRACE"] = str(self.trace_path)
+        if _session_coverage is not None:  # --l6470emu-coverage: the preload merges into it at exit
+            env[COVERAGE_ENV] = _session_coverage
         return env
 
     def run(self, args: Sequence[Union[str, os.PathLike]], *, timeout: float = 60, check: bool = True,
@@ -365,6 +458,8 @@ class SpidevBoard:
         fault, chip, point = self.campaign_case
         self._campaign_result = self._campaign_rerun = None
         try:
+            if env is not None and _session_coverage is not None:
+                env = dict(env, **{COVERAGE_ENV: _session_coverage})
             result = l6470emu.campaign(argv, chain=self.description, faults=fault, chips=chip, at=point,
                                        fail_on=self.campaign_fail_on, json_path=self.campaign_json_path, jobs=1,
                                        wall_timeout=timeout, cwd=cwd, env=env)

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/chip.hpp"
+#include "coverage_output.hpp"
 
 namespace l6470emu::python {
 
@@ -31,6 +32,14 @@ AxisSpec axis_from_text(const Chip& chip, const std::string& text);
 /// The attached axis's load with the items of `text` (load=, friction=, force=) changed;
 /// ValueError without an axis or for a bad item. The caller applies it (recorded where it records).
 LoadSpec load_from_text(const Chip& chip, const std::string& text);
+/// coverage_report(), coverage_total(), and the merge of every live object's coverage at exit.
+void bind_coverage(py::module_& m);
+/// What a coverage= argument asks for: None (the file L6470EMU_COVERAGE names, when set; else
+/// nothing), False (nothing), True (collected in memory only), or a path (made absolute).
+/// ValueError with one line when the file cannot take coverage (check_coverage_output).
+CoverageRequest coverage_request_from(py::handle arg);
+/// `data` as a dict: the coverage file's JSON structure.
+py::object coverage_dict(const CoverageData& data);
 /// The private functions l6470emu.units is written over (register values <-> physical units).
 void bind_units(py::module_& m);
 

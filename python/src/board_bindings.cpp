@@ -90,16 +90,16 @@ LoadSpec load_from_text(const Chip& chip, const std::string& text) {
 
 void bind_board(py::module_& m) {
   py::class_<PyBoard> b(m, "_BoardCore", "The board behind l6470emu.Board (use that class).");
-  b.def(py::init([](const std::string& description, const std::string& origin) {
+  b.def(py::init([](const std::string& description, const std::string& origin, py::object coverage) {
           ParseResult r = parse_board_config(description, origin);
           if (!r.config) throw py::value_error(r.error.message);
           if (!r.config->time.virtual_time)
             throw py::value_error("l6470emu: " + origin +
                                   ": a board in the test process runs in virtual time (drop time=wall; "
                                   "spidev_board runs programs in wall time)");
-          return std::make_unique<PyBoard>(*r.config);
+          return std::make_unique<PyBoard>(*r.config, coverage_request_from(coverage));
         }),
-        py::arg("description"), py::arg("origin"));
+        py::arg("description"), py::arg("origin"), py::arg("coverage") = py::none());
   b.def("chain_count", [](PyBoard& s) { return s.board().chain_count(); });
   b.def("chip_count", [](PyBoard& s, long long c) { return s.board().chip_count(chain_arg(s, c)); });
   b.def("chain_name", [](PyBoard& s, long long c) { return s.board().chain_name(chain_arg(s, c)); });
@@ -246,6 +246,25 @@ void bind_board(py::module_& m) {
     if (!err.empty()) throw py::value_error(err);
   });
   b.def("stop_recording", [](PyBoard& s, long long c) { return s.board().stop_recording(chain_arg(s, c)); });
+  // what the host (the code under test) reads, and interface coverage
+  b.def("note_output_read", [](PyBoard& s, long long c, long long k, long long p) {
+    const std::size_t chain = chain_arg(s, c);
+    s.board().note_output_read(chain, chip_arg(s, chain, k), pin_arg(p));
+  });
+  b.def("note_output_edge", [](PyBoard& s, long long c, long long k, long long p, bool rising) {
+    const std::size_t chain = chain_arg(s, c);
+    s.board().note_output_edge(chain, chip_arg(s, chain, k), pin_arg(p), rising);
+  });
+  b.def("coverage_data", [](PyBoard& s) -> py::object {
+    return s.board().coverage_enabled() ? coverage_dict(s.board().coverage()) : py::none();
+  });
+  b.def("coverage_path", [](PyBoard& s) -> py::object {
+    return s.coverage_path().empty() ? py::object(py::none()) : py::object(py::str(s.coverage_path()));
+  });
+  b.def("flush_coverage", [](PyBoard& s) {
+    if (const std::string why = s.flush_coverage(); !why.empty())
+      throw std::runtime_error("l6470emu: coverage not written: " + why);
+  });
   b.def("take_log", [](PyBoard& s) {
     std::uint64_t dropped = 0;
     auto lines = s.take_log(dropped);

@@ -70,9 +70,17 @@ std::int32_t position_arg(py::handle v, const char* what) {
 /// The sanitizer after SPI traffic: check=warn lines become l6470emu.SanitizerWarning warnings,
 /// a check=error failure raises l6470emu.SanitizerError with the report.
 void after_spi(PyChain& p) {
+  p.look();  // interface coverage: the flags the traffic raised
   for (const std::string& line : p.take_check_lines())
     if (PyErr_WarnEx(sanitizer_warning(), line.c_str(), 1) != 0) throw py::error_already_set();
   if (auto report = p.take_check_failure()) throw SanitizerFailure(*report);
+}
+
+/// close(): the recording ends, the coverage met so far goes into its file.
+void close_chain(PyChain& p) {
+  p.close();
+  if (const std::string why = p.flush_coverage(); !why.empty())
+    throw std::runtime_error("l6470emu: coverage not written: " + why);
 }
 
 std::uint8_t level_arg(py::handle v, const char* what) {
@@ -116,9 +124,13 @@ frame), True to record into memory (Chain.trace), or None. check: the driver san
 "error" (default: the first broken rule of the chip, such as an unknown opcode, a refused
 command, a frame that is not the chain's length or an answer never read, raises
 l6470emu.SanitizerError with its report), "warn" (an l6470emu.SanitizerWarning each) or "off";
-check_allow: rule names it lets pass (l6470emu.check_rules()).)");
+check_allow: rule names it lets pass (l6470emu.check_rules()). coverage: collect interface
+coverage of everything the chain does and merge it into this file when the chain is closed,
+destroyed, or the interpreter exits (docs/coverage-python.md); True collects it in memory only
+(coverage_data()), False not at all; None (default) collects into $L6470EMU_COVERAGE when set.)");
 
-  c.def(py::init([](py::object chips, py::object record, py::object frame_gap_ticks, py::object check, py::object check_allow) {
+  c.def(py::init([](py::object chips, py::object record, py::object frame_gap_ticks, py::object check, py::object check_allow,
+                    py::object coverage) {
           const std::string spec = chain_spec_from(chips);
           std::vector<const Variant*> variants;
           try {
@@ -133,14 +145,15 @@ check_allow: rule names it lets pass (l6470emu.check_rules()).)");
             to.path = path_from(record, "record");
           const auto gap = static_cast<Tick>(int_in_range(frame_gap_ticks, "frame_gap_ticks", 1, 1LL << 32));
           const CheckConfig cc = check_config_from(check, check_allow);
+          const CoverageRequest cov = coverage_request_from(coverage);
           try {
-            return std::make_unique<PyChain>(variants, to, gap, cc);
+            return std::make_unique<PyChain>(variants, to, gap, cc, cov);
           } catch (const std::runtime_error& e) {
             throw std::runtime_error(std::string("record: ") + e.what());
           }
         }),
         py::arg("chips") = "L6470", py::kw_only(), py::arg("record") = py::none(), py::arg("frame_gap_ticks") = 8,
-        py::arg("check") = "error", py::arg("check_allow") = py::tuple());
+        py::arg("check") = "error", py::arg("check_allow") = py::tuple(), py::arg("coverage") = py::none());
   c.def_property(
        "check", [](const PyChain& p) { return std::string(to_string(p.check().level)); },
        [](PyChain& p, py::object level) {
@@ -414,10 +427,22 @@ Time does not advance by itself: call advance() between frames as a bus would ta
       .def("set_stby_rst_pin",
            [](PyChain& p, py::handle chip, py::handle level) { p.set_stby_rst_pin(chip_arg(p, chip), level_arg(level, "level")); },
            py::arg("chip"), py::arg("level"), "STBY/RST input: low holds the logic in reset (SPI silent); rising edge = power-up state.")
-      .def("busy_pin", [](PyChain& p, py::handle chip) { return p.chain().chip(chip_arg(p, chip)).busy_sync_pin(); },
-           py::arg("chip"), "BUSY/SYNC output level: False = pulled low (busy).")
-      .def("flag_pin", [](PyChain& p, py::handle chip) { return p.chain().chip(chip_arg(p, chip)).flag_pin(); },
-           py::arg("chip"), "FLAG output level: False = pulled low (an enabled alarm is active).")
+      .def("busy_pin",
+           [](PyChain& p, py::handle chip) {
+             const std::size_t k = chip_arg(p, chip);
+             const bool level = p.chain().chip(k).busy_sync_pin();
+             p.note_output_read(k, Pin::BUSY, level);  // the host's read (coverage: BUSY observed, an edge waited on)
+             return level;
+           },
+           py::arg("chip"), "BUSY/SYNC output level: False = pulled low (busy). A read by the host, for coverage.")
+      .def("flag_pin",
+           [](PyChain& p, py::handle chip) {
+             const std::size_t k = chip_arg(p, chip);
+             const bool level = p.chain().chip(k).flag_pin();
+             p.note_output_read(k, Pin::FLAG, level);
+             return level;
+           },
+           py::arg("chip"), "FLAG output level: False = pulled low (an enabled alarm is active). A read by the host, for coverage.")
       .def("set_adc_input",
            [](PyChain& p, py::handle chip, py::handle code) {
              p.set_adc_input(chip_arg(p, chip), static_cast<std::uint8_t>(int_in_range(code, "code", 0, 31)));
@@ -482,9 +507,11 @@ Time does not advance by itself: call advance() between frames as a bus would ta
             return py::none();
           },
           "A copy of the trace recorded in memory (Chain(..., record=True)), else None.")
-      .def("close", &PyChain::close, "Stops recording (a trace file is complete and closed); the chain stays usable.")
+      .def("close", &close_chain,
+           "Stops recording (a trace file is complete and closed) and merges the interface coverage met so far "
+           "into the coverage file (RuntimeError when it cannot be written); the chain stays usable.")
       .def("__enter__", [](py::object self) { return self; })
-      .def("__exit__", [](PyChain& p, py::args) { p.close(); })
+      .def("__exit__", [](PyChain& p, py::args) { close_chain(p); })
       .def(
           "take_diagnostics",
           [](PyChain& p) {
@@ -493,6 +520,20 @@ Time does not advance by itself: call advance() between frames as a bus would ta
             return out;
           },
           "The host mistakes the chips noticed since the last call (unknown opcodes, refused commands), oldest first.");
+
+  // ---- interface coverage ---------------------------------------------------------------
+  c.def("coverage_data",
+        [](const PyChain& p) -> py::object { return p.collecting_coverage() ? coverage_dict(p.coverage()) : py::none(); },
+        "The interface coverage met so far as a dict, the coverage file's structure ({\"format\", \"version\", "
+        "\"variants\": {VARIANT: {\"hit\": {CATEGORY: [POINT, ...]}, \"chain positions present\": [...]}}}), "
+        "or None when the chain collects none.")
+      .def_property_readonly(
+          "coverage_path",
+          [](const PyChain& p) -> py::object {
+            if (p.coverage_path().empty()) return py::none();
+            return py::str(p.coverage_path());
+          },
+          "The coverage file the chain merges into (absolute), or None.");
 }
 
 }  // namespace l6470emu::python

@@ -20,4 +20,5 @@ PYBIND11_MODULE(_l6470emu, m) {
   l6470emu::python::bind_motion(m);
   l6470emu::python::bind_units(m);
   l6470emu::python::bind_board(m);
+  l6470emu::python::bind_coverage(m);
 }

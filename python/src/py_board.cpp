@@ -19,7 +19,8 @@ class FixedHostClock final : public HostClock {
 
 }  // namespace
 
-PyBoard::PyBoard(const BoardConfig& config) : config_(config), clock_(std::make_unique<FixedHostClock>()) {
+PyBoard::PyBoard(const BoardConfig& config, const CoverageRequest& coverage)
+    : config_(config), clock_(std::make_unique<FixedHostClock>()) {
   for (const ChainConfig& cc : config_.chains) {
     SpidevSettings s;
     s.mode = cc.mode;
@@ -40,10 +41,21 @@ PyBoard::PyBoard(const BoardConfig& config) : config_(config), clock_(std::make_
       },
       *clock_);
   board_->set_edge_sink([this](const PinEdge& e) { on_edge(e); });
+  if (coverage.collect) {
+    board_->enable_coverage();
+    if (!coverage.path.empty())
+      coverage_out_ = std::make_unique<CoverageOutput>(coverage.path, [b = board_.get()] { return b->coverage(); });
+  }
 }
 
 PyBoard::~PyBoard() {
+  coverage_out_.reset();  // merged while the board is there
   for (std::size_t k = 0; k < board_->chain_count(); ++k) board_->stop_recording(k);
+}
+
+const std::string& PyBoard::coverage_path() const {
+  static const std::string none;
+  return coverage_out_ ? coverage_out_->path() : none;
 }
 
 void PyBoard::close(std::size_t chain) {

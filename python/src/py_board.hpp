@@ -1,7 +1,8 @@
 // The state behind l6470emu.Board: an OS-free Board (board/board.hpp) of a board description in
 // virtual time inside the test process, with the spidev device rules (linux/spidev_rules.hpp) per
-// chain, the edges of requested pins queued per pin and the board's diagnostics kept as lines.
-// No Python types here (board_bindings.cpp wraps it); no threads, files or clocks of the host.
+// chain, the edges of requested pins queued per pin and the board's diagnostics kept as lines,
+// and its interface coverage's file (merged into on close, destruction or exit). No Python types
+// here (board_bindings.cpp wraps it); no threads or clocks of the host.
 #pragma once
 
 #include <linux/spi/spidev.h>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "board/board.hpp"
+#include "coverage_output.hpp"
 #include "linux/spidev_rules.hpp"
 
 namespace l6470emu::python {
@@ -31,8 +33,9 @@ class PyBoard {
   /// Diagnostic lines kept at most.
   static constexpr std::size_t kMaxLogLines = 10000;
 
-  /// Builds the board of `config` (which must be in virtual time).
-  explicit PyBoard(const BoardConfig& config);
+  /// Builds the board of `config` (which must be in virtual time), collecting interface
+  /// coverage when `coverage` asks (its file checked by the caller).
+  explicit PyBoard(const BoardConfig& config, const CoverageRequest& coverage = {});
   ~PyBoard();
   PyBoard(const PyBoard&) = delete;
   PyBoard& operator=(const PyBoard&) = delete;
@@ -69,6 +72,13 @@ class PyBoard {
   /// Takes the diagnostics kept so far (one line each); `dropped` gets how many were not kept.
   std::vector<std::string> take_log(std::uint64_t& dropped);
 
+  // ---- interface coverage -------------------------------------------------------------
+
+  /// The coverage file merged into ("" for none or in memory only).
+  const std::string& coverage_path() const;
+  /// Merges what is new into the coverage file: "" or one line why not.
+  std::string flush_coverage() { return coverage_out_ ? coverage_out_->flush() : std::string(); }
+
  private:
   using PinKey = std::tuple<std::size_t, std::size_t, unsigned>;
   struct EdgeQueue {
@@ -86,7 +96,8 @@ class PyBoard {
   std::map<PinKey, EdgeQueue> edges_;
   std::vector<SpidevSettings> spi_;
   std::vector<unsigned> users_;
-  std::unique_ptr<Board> board_;         // last: destroyed first (it refers to the clock and sinks)
+  std::unique_ptr<Board> board_;         // destroyed before the clock and sinks it refers to
+  std::unique_ptr<CoverageOutput> coverage_out_;  // last: destroyed first, merging the board's coverage
 };
 
 }  // namespace l6470emu::python

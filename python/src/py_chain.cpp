@@ -28,7 +28,7 @@ std::string describe_python_chain(const std::vector<const Variant*>& variants, c
 }  // namespace
 
 PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap,
-                 const CheckConfig& check)
+                 const CheckConfig& check, const CoverageRequest& coverage)
     : chain_(std::make_unique<Chain>(make_chain(variants))),
       diagnostics_(std::make_unique<DiagnosticStore>()),
       frame_gap_(frame_gap) {
@@ -38,8 +38,24 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
         if (lines->size() < kMaxDiagnostics) lines->emplace_back(line);
       });
   checker_ = std::make_unique<ChainChecker>(*sanitizer_, *chain_, "Chain");
+  if (coverage.collect) {
+    coverage_ = std::make_unique<CoverageCollector>();
+    coverage_->add_chain(*chain_);
+    sanitizer_->set_broken_sink([cov = coverage_.get()](const Violation& v) {
+      std::optional<std::size_t> chip;  // the chain index, or the whole chain
+      if (!v.chip_key.empty() && v.chip_key.find_first_not_of("0123456789") == std::string::npos)
+        chip = static_cast<std::size_t>(std::stoull(v.chip_key));
+      cov->rule_broken(0, chip, v.rule);
+    });
+    for (std::size_t k = 0; k < chain_->size(); ++k)
+      chain_->chip(k).set_command_sink([cov = coverage_.get(), chain = chain_.get(), k](const Opcode& op, std::uint32_t arg) {
+        cov->command(0, k, chain->chip(k), op, arg);
+      });
+    coverage_->look(0, *chain_);  // the power-up flags (UVLO...) are raised
+  }
   for (std::size_t k = 0; k < chain_->size(); ++k) {
-    chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), checker = checker_.get(), k](const Diagnostic& d) {
+    chain_->chip(k).set_diagnostic_sink([store = diagnostics_.get(), checker = checker_.get(), cov = coverage_.get(),
+                                         k](const Diagnostic& d) {
       static constexpr const char* kKinds[] = {"wrong_cmd", "notperf_cmd", "ignored"};
       if (store->kept.size() == kMaxDiagnostics) {
         store->kept.pop_front();
@@ -47,6 +63,7 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
       }
       store->kept.push_back({d.tick, k, kKinds[static_cast<int>(d.kind)], d.message});
       checker->chip_diagnostic(k, d);
+      if (cov) cov->diagnostic(0, k, d);
     });
   }
   // The header's board lines: the variants and the checks (axes come as events when attached).
@@ -62,9 +79,21 @@ PyChain::PyChain(const std::vector<const Variant*>& variants, const RecordTo& re
   bus_ = std::make_unique<ChainBus>(rec_ ? static_cast<SpiDevice&>(*rec_) : *chain_, *chain_, *checker_);
   bus_->set_untimed();  // time moves only when Python says so
   host_ = std::make_unique<ChainHost>(*chain_, *bus_, frame_gap_);
+  // Last: a chain that failed to be built merges nothing.
+  if (coverage_ && !coverage.path.empty())
+    coverage_out_ = std::make_unique<CoverageOutput>(coverage.path, [cov = coverage_.get()] { return cov->data(); });
 }
 
-PyChain::~PyChain() = default;
+PyChain::~PyChain() {
+  coverage_out_.reset();  // merged while the collector is there
+  if (coverage_)
+    for (std::size_t k = 0; k < chain_->size(); ++k) chain_->chip(k).set_command_sink({});
+}
+
+const std::string& PyChain::coverage_path() const {
+  static const std::string none;
+  return coverage_out_ ? coverage_out_->path() : none;
+}
 
 void PyChain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
   bus_->begin({});
@@ -77,6 +106,7 @@ void PyChain::frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx
 void PyChain::advance_to(Tick tick) {
   bus().advance_to(tick);
   if (rec_) rec_->observe_outputs();
+  look();
 }
 
 void PyChain::set_sw_pin(std::size_t chip, bool level) {
@@ -84,6 +114,8 @@ void PyChain::set_sw_pin(std::size_t chip, bool level) {
     rec_->set_sw_pin(chip, level);
   else
     chain_->chip(chip).set_sw_pin(level);
+  if (coverage_) coverage_->input(0, chip, Pin::SW, level);
+  look();
 }
 
 void PyChain::set_stck_pin(std::size_t chip, bool level) {
@@ -91,6 +123,8 @@ void PyChain::set_stck_pin(std::size_t chip, bool level) {
     rec_->set_stck_pin(chip, level);
   else
     chain_->chip(chip).set_stck_pin(level);
+  if (coverage_) coverage_->input(0, chip, Pin::STCK, level);
+  look();
 }
 
 void PyChain::set_stby_rst_pin(std::size_t chip, bool level) {
@@ -98,11 +132,19 @@ void PyChain::set_stby_rst_pin(std::size_t chip, bool level) {
     rec_->set_stby_rst_pin(chip, level);
   else
     chain_->chip(chip).set_stby_rst_pin(level);
+  if (coverage_) coverage_->input(0, chip, Pin::STBY_RST, level);
+  look();
 }
 
 void PyChain::set_adc_input(std::size_t chip, std::uint8_t code) { fault(chip, TraceFault::ADCIN, code); }
 
 void PyChain::fault(std::size_t chip, TraceFault fault, std::uint8_t value) {
+  apply_fault_here(chip, fault, value);
+  if (coverage_) coverage_->event(0, chip, fault, value);
+  look();
+}
+
+void PyChain::apply_fault_here(std::size_t chip, TraceFault fault, std::uint8_t value) {
   if (!rec_) {
     apply_fault(*chain_, chip, fault, value);
     return;
@@ -126,6 +168,7 @@ void PyChain::set_axis_load(std::size_t chip, const LoadSpec& load) {
     rec_->set_axis_load(chip, load);
   else
     chain_->chip(chip).set_axis_load(load);
+  look();
 }
 
 void PyChain::attach_axis(std::size_t chip, const AxisSpec& spec) {
@@ -133,6 +176,7 @@ void PyChain::attach_axis(std::size_t chip, const AxisSpec& spec) {
     rec_->attach_axis(chip, spec);
   else
     chain_->chip(chip).attach_axis(spec);
+  look();
 }
 
 void PyChain::close() {

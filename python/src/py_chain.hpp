@@ -2,7 +2,9 @@
 // asked, a RecordingChain in front of it so that every frame, pin and fault goes into a
 // native trace (a file flushed event by event, or a Trace in memory). Frames go through the
 // board's ChainBus, watched by the driver sanitizer (check=). Diagnostics the chips raise are
-// kept for Python to take. No Python types here; chain_bindings.cpp wraps it.
+// kept for Python to take. Interface coverage (coverage=) is collected as the board collects it
+// and merged into its file on close(), destruction or exit. No Python types here;
+// chain_bindings.cpp wraps it.
 #pragma once
 
 #include <cstdint>
@@ -13,11 +15,13 @@
 #include <vector>
 
 #include "board/chain_bus.hpp"
+#include "board/coverage_collector.hpp"
 #include "board/sanitizer.hpp"
 #include "daisychain/chain.hpp"
 #include "daisychain/host.hpp"
 #include "daisychain/recording_chain.hpp"
 #include "spi/trace.hpp"
+#include "coverage_output.hpp"
 
 namespace l6470emu::python {
 
@@ -42,7 +46,7 @@ class PyChain {
   static constexpr std::size_t kMaxDiagnostics = 10000;
 
   PyChain(const std::vector<const Variant*>& variants, const RecordTo& record, Tick frame_gap,
-          const CheckConfig& check = {CheckLevel::error, {}});
+          const CheckConfig& check = {CheckLevel::error, {}}, const CoverageRequest& coverage = {});
   ~PyChain();
   PyChain(const PyChain&) = delete;
   PyChain& operator=(const PyChain&) = delete;
@@ -94,7 +98,27 @@ class PyChain {
   /// Under check=error: the report of the first broken rule, taken.
   std::optional<std::string> take_check_failure() { return sanitizer_->take_failure(); }
 
+  // ---- interface coverage (coverage=) ---------------------------------------------
+
+  bool collecting_coverage() const { return coverage_ != nullptr; }
+  /// The coverage file merged into ("" for none or in memory only).
+  const std::string& coverage_path() const;
+  /// What the chain has met so far (empty data when coverage is off).
+  CoverageData coverage() const { return coverage_ ? coverage_->data() : CoverageData{}; }
+  /// Merges what is new into the coverage file: "" or one line why not.
+  std::string flush_coverage() { return coverage_out_ ? coverage_out_->flush() : std::string(); }
+  /// After a step of the run (SPI traffic through the host or frame()): the flags every chip shows.
+  void look() {
+    if (coverage_) coverage_->look(0, *chain_);
+  }
+  /// The host read output `pin` (BUSY, FLAG) of `chip` (busy_pin(), flag_pin()).
+  void note_output_read(std::size_t chip, Pin pin, bool level) {
+    if (coverage_) coverage_->output_read(0, chip, chain_->chip(chip), pin, level);
+  }
+
  private:
+  void apply_fault_here(std::size_t chip, TraceFault fault, std::uint8_t value);  // through the recorder if any
+
   struct DiagnosticStore {
     std::deque<ChainDiagnostic> kept;
     std::uint64_t dropped = 0;
@@ -113,6 +137,10 @@ class PyChain {
   std::unique_ptr<ChainHost> host_;
   std::string record_path_;
   Tick frame_gap_;
+  // Coverage: the chips' command sinks, their diagnostic sink and the sanitizer feed the
+  // collector; the output (destroyed first, in ~PyChain) merges it into the file.
+  std::unique_ptr<CoverageCollector> coverage_;
+  std::unique_ptr<CoverageOutput> coverage_out_;
 };
 
 }  // namespace l6470emu::python

@@ -37,7 +37,9 @@ def test_module_functions_refuse_odd_arguments_with_python_exceptions(tmp_path, 
         call_all(getattr(l6470emu, name))
     for args in itertools.product(ODD_VALUES, repeat=1):
         for make in (lambda a: l6470emu.Chain(a), lambda a: l6470emu.Chain(record=a), l6470emu.Trace.load,
-                     l6470emu.Trace.parse, lambda a: l6470emu.Chain(frame_gap_ticks=a)):
+                     l6470emu.Trace.parse, lambda a: l6470emu.Chain(frame_gap_ticks=a),
+                     lambda a: l6470emu.Chain(coverage=a), lambda a: l6470emu.Board(coverage=a),
+                     l6470emu.coverage_report, l6470emu.coverage_total):
             try:
                 make(*args)
             except EXPECTED:

@@ -1,7 +1,7 @@
 """The README's examples are tests: its Python session runs as a doctest, and every code block
 marked `<!-- file: PATH -->` in it and in docs/firmware.md is that file verbatim (the files
-themselves are built and run by tests/install/install_test.sh, by ctest's examples and by this
-pytest session: examples/pytest-driver)."""
+themselves are built and run by tests/install/install_test.sh and by ctest's examples:
+examples/pytest-driver is ctest's example_pytest_driver)."""
 import doctest
 import re
 from pathlib import Path
