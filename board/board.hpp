@@ -125,7 +125,7 @@ class Board {
   const Sanitizer& sanitizer() const { return sanitizer_; }
   /// Under check=error: the report of the first broken rule since the last call, taken. A front
   /// ends its host's run with it (the preload: exit status kSanitizerExitStatus).
-  std::optional<std::string> take_check_failure() { return sanitizer_.take_failure(); }
+  std::optional<std::string> take_check_failure(FailureEnd end = FailureEnd::run_ends) { return sanitizer_.take_failure(end); }
 
   // ---- SPI with the chip select on a pin: a firmware front drives CS and clocks bytes itself ----
 

@@ -63,7 +63,7 @@ std::string violation_line(const Violation& v) {
   return s;
 }
 
-std::string violation_report(const Violation& v) {
+std::string violation_report(const Violation& v, FailureEnd end) {
   const RuleInfo& r = rule_info(v.rule);
   std::string s = "l6470emu: driver sanitizer: " + std::string(r.name) + " on " + v.chain;
   if (!v.chip.empty()) s += ", " + v.chip;
@@ -72,7 +72,9 @@ std::string violation_report(const Violation& v) {
   s += "  what:      " + v.what + "\n";
   s += "  rule:      " + std::string(r.about) + "\n";
   s += "  datasheet: " + std::string(r.datasheet) + "\n";
-  s += "  (check=error: the run ends here. To allow this rule: check.allow=" + std::string(r.name) +
+  s += std::string(end == FailureEnd::run_ends ? "  (check=error: the run ends here."
+                                              : "  (check=error: l6470emu.SanitizerError is raised here.") +
+       " To allow this rule: check.allow=" + std::string(r.name) +
        " in the board description, L6470EMU_CHECK_ALLOW=" + std::string(r.name) + ", or check_allow=[\"" +
        std::string(r.name) + "\"] in Python)\n";
   return s;
@@ -109,9 +111,9 @@ void Sanitizer::report(const Violation& v) {
   }
 }
 
-std::optional<std::string> Sanitizer::take_failure() {
+std::optional<std::string> Sanitizer::take_failure(FailureEnd end) {
   if (!failure_) return std::nullopt;
-  std::string r = violation_report(*failure_);
+  std::string r = violation_report(*failure_, end);
   failure_.reset();
   return r;
 }

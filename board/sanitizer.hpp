@@ -40,9 +40,14 @@ struct Violation {
 
 /// "spidev0.0: chip 1: WRONG_CMD: byte 0xEB: reserved opcode (frame 3, byte 0)".
 std::string violation_line(const Violation& v);
-/// The report that ends a run under check=error: the rule, the chain and chip, the frame and
-/// byte, what happened, the datasheet's place, and how to allow the rule. Several lines.
-std::string violation_report(const Violation& v);
+/// How a check=error failure reaches the program: it ends the run (a preloaded or firmware
+/// program), or it is raised as an exception (Python's SanitizerError) that the test may catch.
+enum class FailureEnd : std::uint8_t { run_ends, raised };
+
+/// The report of a failure under check=error: the rule, the chain and chip, the frame and byte,
+/// what happened, the datasheet's place, what happens now (`end`), and how to allow the rule.
+/// Several lines.
+std::string violation_report(const Violation& v, FailureEnd end = FailureEnd::run_ends);
 
 /// A board's check settings and its one failure: where every ChainChecker reports.
 class Sanitizer {
@@ -61,7 +66,7 @@ class Sanitizer {
   /// Whether a failure is waiting to be taken.
   bool failed() const { return failure_.has_value(); }
   /// The failure's report (violation_report), taken: the next violation can be reported.
-  std::optional<std::string> take_failure();
+  std::optional<std::string> take_failure(FailureEnd end = FailureEnd::run_ends);
   /// The failure, without taking it.
   const std::optional<Violation>& failure() const { return failure_; }
   /// Broken rules reported so far at warn or error (allowed ones and check=off: none), and the

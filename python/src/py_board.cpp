@@ -75,7 +75,7 @@ long PyBoard::message(std::size_t chain, std::span<const spi_ioc_transfer> xfers
   run_spidev_message(board_->begin_transfer(chain, spidev_wire_settings(s)), s, xfers, tx, rx);
   const Tick end = board_->end_transfer(chain);
   board_->advance_to(end);  // the caller's call takes the message's bus time
-  if (auto report = board_->take_check_failure()) throw SanitizerFailure(*report);
+  if (auto report = board_->take_check_failure(FailureEnd::raised)) throw SanitizerFailure(*report);
   return total;
 }
 

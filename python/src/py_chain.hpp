@@ -96,7 +96,8 @@ class PyChain {
     return out;
   }
   /// Under check=error: the report of the first broken rule, taken.
-  std::optional<std::string> take_check_failure() { return sanitizer_->take_failure(); }
+  /// The failure's report, worded for an exception (SanitizerError).
+  std::optional<std::string> take_check_failure() { return sanitizer_->take_failure(FailureEnd::raised); }
 
   // ---- interface coverage (coverage=) ---------------------------------------------
 

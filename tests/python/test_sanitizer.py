@@ -30,6 +30,8 @@ def test_a_chain_raises_the_report_of_the_first_broken_rule_by_default():
     assert "driver sanitizer: FRAME_LENGTH on Chain, every chip, frame 1" in report
     assert "datasheet: §8 Serial interface and Figure 18" in report
     assert "check.allow=FRAME_LENGTH" in report
+    # An exception the test may catch: nothing "ends here".
+    assert "SanitizerError is raised here" in report and "the run ends here" not in report
 
 
 def test_a_refused_command_names_the_chip_the_frame_and_the_byte():
