@@ -356,6 +356,26 @@ Tick Board::first_change(ChainState& c, std::size_t chip, Pin pin, bool level, T
 }
 
 void Board::advance_chain(ChainState& c, Tick target) {
+  // Collecting coverage: a look at every change of the motion's phase on the way, so that a
+  // flag that rises and falls with time alone (MOT_STATUS constant speed inside a host's sleep)
+  // counts as raised. Each chip's STATUS holds still through its run of uniform ticks.
+  for (int phases = 0; coverage_ && phases < 64; ++phases) {
+    Tick next = target;
+    for (std::size_t k = 0; k < c.chain.size(); ++k) {
+      const Chip& chip = c.chain.chip(k);
+      if (!chip.spi_enabled()) continue;
+      (void)chip.status();  // works the run out, so that the levels know how long they hold
+      const Chip::OutputLevels o = chip.output_levels();
+      if (o.active && o.steady_through >= c.chain.now() && o.steady_through + 1 < next) next = o.steady_through + 1;
+    }
+    if (next >= target) break;
+    advance_chain_to(c, next);
+    coverage_->look(c.index, c.chain, true);
+  }
+  advance_chain_to(c, target);
+}
+
+void Board::advance_chain_to(ChainState& c, Tick target) {
   // Through the recording when there is one: it records every BUSY and FLAG edge at its tick.
   SpiDevice& dev = spi_of(c);
   if (c.watched.empty() || (c.prediction_valid && target < c.predicted_edge)) {

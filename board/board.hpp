@@ -290,6 +290,7 @@ class Board {
                    const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);
   void catch_up(ChainState& c);
   void advance_chain(ChainState& c, Tick target);
+  void advance_chain_to(ChainState& c, Tick target);
   Tick first_change(ChainState& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
   Tick predict_next_edge(ChainState& c);
   void emit_changes(ChainState& c, Tick tick);
