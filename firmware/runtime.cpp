@@ -9,9 +9,12 @@
 #include <stdexcept>
 
 #include "board/coverage_file.hpp"
+#include "board/environment_names.hpp"
 #include "board/scenario_runner.hpp"
 #include "daisychain/chip_numbering.hpp"
 #include "firmware/run.hpp"
+
+extern char** environ;  // POSIX's, declared here: <unistd.h> is not for the OS-free fronts
 
 namespace l6470emu {
 
@@ -708,6 +711,11 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
     error = "l6470emu: firmware: the board is already open (one board per program)";
     return nullptr;
   }
+  // A mistyped L6470EMU_* variable is named at start-up, as the preload names it.
+  if (const std::string unknown = unknown_environment_variables(
+          environ, "firmware programs read L6470EMU_CHAIN, _CONFIG, _LOG, _TRACE, _CHECK, _CHECK_ALLOW, _COVERAGE");
+      !unknown.empty())
+    std::fputs(unknown.c_str(), stderr);
   ParseResult parsed;
   const char* chain = std::getenv("L6470EMU_CHAIN");
   const char* file = std::getenv("L6470EMU_CONFIG");

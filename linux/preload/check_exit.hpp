@@ -13,13 +13,6 @@ namespace l6470emu::preload {
 /// sanitizer's exit: no atexit handlers or stdio flushes run (another thread may hold their locks).
 [[noreturn]] void end_run_for_check(const std::string& report);
 
-/// The L6470EMU_* environment variables the preload (and the l6470emu tools) read.
-const char* const* known_environment_variables();
-
-/// One line per L6470EMU_* variable of `environ` that nobody reads, naming the closest known
-/// one; "" when there is none.
-std::string unknown_environment_variables(char** environ);
-
 /// An open() of `path` that is no node of the board: once per path, when it looks like a spidev
 /// or gpiochip node, a log line saying which nodes the board has.
 void note_missing_node(const char* path);

@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "board/coverage_file.hpp"
+#include "board/environment_names.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/device_paths.hpp"
 #include "linux/log.hpp"
@@ -64,7 +65,9 @@ void atfork_child() {
 // mistyped L6470EMU_* variable gets a warning even when it leaves nothing configured.
 __attribute__((constructor)) void load_config() {
   Guard guard;
-  if (const std::string unknown = unknown_environment_variables(environ); !unknown.empty())
+  if (const std::string unknown = unknown_environment_variables(
+          environ, "the preload reads L6470EMU_CHAIN, _CONFIG, _SOCKET, _LOG, _TRACE, _SHM, _CHECK, _CHECK_ALLOW, _COVERAGE");
+      !unknown.empty())
     raw_write_all(2, unknown.data(), unknown.size());
   const char* socket = std::getenv("L6470EMU_SOCKET");
   const char* chain = std::getenv("L6470EMU_CHAIN");
