@@ -874,7 +874,7 @@ TEST(CoverageFile, DISABLED_AMergeThroughASymbolicLinkUpdatesTheFileItPointsAt) 
   EXPECT_EQ(merge_into_coverage_file(dir.file("link.json"), run_b()), "");
   CoverageData ab = run_a();
   ab.merge(run_b());
-  EXPECT_EQ(read_coverage_file(target), ab) << "the file the link points at did not get the merge";
+  EXPECT_EQ(read_coverage_file(target).to_json(), ab.to_json()) << "the file the link points at did not get the merge";
   struct stat st {};
   ASSERT_EQ(lstat(dir.file("link.json").c_str(), &st), 0);
   EXPECT_TRUE(S_ISLNK(st.st_mode)) << "the link was replaced by a file";
