@@ -14,7 +14,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 seconds=${1:-60}
-harnesses=(spi_chain native saleae sigrok umockdev ftrace config protocol sketch ctl_reply scenario)
+harnesses=(spi_chain native saleae sigrok umockdev ftrace config protocol sketch ctl_reply scenario coverage)
 build=build-fuzz
 
 echo "== fuzz: setting up $build (clang, libFuzzer, ASan + UBSan)"
