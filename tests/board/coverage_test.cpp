@@ -735,6 +735,24 @@ TEST(CoverageData, ANonCoverageTextIsRefusedInOneLine) {
   EXPECT_NE(one_line_error(replaced("\"Move FWD\"", "\"Move sideways\"")).find("Move sideways"), std::string::npos);
 }
 
+// BUG (board/coverage.cpp, CoverageData::from_json; found by fuzz_coverage, input in
+// tests/fuzz/regressions/coverage/): the refusal quotes the file's own names raw: a variant, a
+// category or a point whose JSON string holds "\n" makes the error two lines, and one holding
+// "\u001b" puts an escape sequence on the terminal of `l6470emu coverage report` (stderr). The
+// header promises one line. Disabled until the names are quoted safely (and cut short); run it
+// with --gtest_also_run_disabled_tests.
+TEST(CoverageData, DISABLED_ARefusalQuotesTheFilesNamesOnOneLineWithoutControlCharacters) {
+  for (const std::string text :
+       {std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L6470":{"hit":{"\n":[]}}}})"),
+        std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L64\u001b[2J70":{}}})"),
+        std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L6470":{"hit":{"commands":["Move\nFWD"]}}}})")}) {
+    const std::string e = one_line_error(text);
+    ASSERT_NE(e, "(accepted)") << text;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    EXPECT_EQ(e.find('\x1b'), std::string::npos) << e;
+  }
+}
+
 TEST(CoverageData, CategoriesAreNamedBothWays) {
   for (std::size_t c = 0; c < kCoverageCategoryCount; ++c) {
     const auto cat = static_cast<CoverageCategory>(c);
