@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "board/board_config.hpp"
 #include "board/check_rules.hpp"
 #include "spi/trace.hpp"
 
@@ -220,6 +221,23 @@ std::string chain_position_name(std::size_t number, std::size_t chips) {
   return "chip " + std::to_string(number) + " of " + std::to_string(chips);
 }
 
+bool is_chain_position_name(std::string_view name) {
+  // "chip K of N": K < N, plain decimal numbers without leading zeros, as chain_position_name writes them.
+  auto number = [&](std::size_t& at, std::uint64_t& out) {
+    const std::size_t start = at;
+    out = 0;
+    while (at < name.size() && name[at] >= '0' && name[at] <= '9' && at - start < 9) out = out * 10 + static_cast<unsigned>(name[at++] - '0');
+    return at > start && (at - start == 1 || name[start] != '0');
+  };
+  std::size_t at = 0;
+  std::uint64_t k = 0, n = 0;
+  if (name.substr(0, 5) != "chip ") return false;
+  at = 5;
+  if (!number(at, k) || name.substr(at, 4) != " of ") return false;
+  at += 4;
+  return number(at, n) && at == name.size() && k < n;
+}
+
 void CoverageData::merge(const CoverageData& other) {
   for (const auto& [name, o] : other.variants_) {
     PerVariant& mine = variants_[name];
@@ -256,7 +274,10 @@ CoverageData CoverageData::from_json(std::string_view text) {
   if (!j.is_object() || !j.contains("format") || j["format"] != "l6470emu-coverage")
     throw std::runtime_error("not an l6470emu coverage file (no \"format\": \"l6470emu-coverage\")");
   if (!j.contains("version") || !j["version"].is_number_integer() || j["version"] != kCoverageFormatVersion)
-    throw std::runtime_error("coverage format version " + (j.contains("version") ? j["version"].dump() : std::string("missing")) +
+    throw std::runtime_error("coverage format version " +
+                             (!j.contains("version")                 ? std::string("missing")
+                              : j["version"].is_number_integer() ? j["version"].dump()
+                                                                 : quoted_text(j["version"].dump())) +
                              ", this program reads version " + std::to_string(kCoverageFormatVersion));
   if (!j.contains("variants") || !j["variants"].is_object()) throw std::runtime_error("coverage file without \"variants\"");
   auto strings = [](const nlohmann::json& a, const std::string& where) {
@@ -264,25 +285,30 @@ CoverageData CoverageData::from_json(std::string_view text) {
     std::set<std::string> out;
     for (const auto& s : a) {
       if (!s.is_string()) throw std::runtime_error(where + ": not a list of names");
+      if (s.get_ref<const std::string&>().size() > 200) throw std::runtime_error(where + ": a name longer than any point's");
       out.insert(s.get<std::string>());
     }
     return out;
   };
   CoverageData d;
   for (const auto& [name, v] : j["variants"].items()) {
+    // Names from the file are quoted (control characters shown, long ones cut): one line each.
     const CoverageUniverse* u = coverage_universe(name);
-    if (!u) throw std::runtime_error("unknown chip variant \"" + name + "\"");
+    if (!u) throw std::runtime_error("unknown chip variant " + quoted_text(name));
     if (!v.is_object()) throw std::runtime_error(name + ": not an object");
     PerVariant& p = d.variants_[name];
     if (v.contains("chain positions present")) p.positions = strings(v["chain positions present"], name + ": chain positions present");
+    for (const std::string& position : p.positions)
+      if (!is_chain_position_name(position))
+        throw std::runtime_error(name + ": chain positions present: " + quoted_text(position) + " is no \"chip K of N\"");
     if (!v.contains("hit")) continue;
     if (!v["hit"].is_object()) throw std::runtime_error(name + ": \"hit\" is not an object");
     for (const auto& [cat, points] : v["hit"].items()) {
       const CoverageCategory c = coverage_category_named(cat);
-      if (c == CoverageCategory::count) throw std::runtime_error(name + ": unknown category \"" + cat + "\"");
+      if (c == CoverageCategory::count) throw std::runtime_error(name + ": unknown category " + quoted_text(cat));
       for (const std::string& point : strings(points, name + ": " + cat)) {
         const bool known = c == CoverageCategory::chain_positions ? p.positions.count(point) != 0 : u->find(c, point) >= 0;
-        if (!known) throw std::runtime_error(name + ": " + cat + ": unknown point \"" + point + "\"");
+        if (!known) throw std::runtime_error(name + ": " + cat + ": unknown point " + quoted_text(point));
         p.hit[static_cast<std::size_t>(c)].insert(point);
       }
     }

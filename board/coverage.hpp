@@ -95,6 +95,8 @@ std::string_view step_mode_name(std::uint8_t step_sel);
 
 /// "chip K of N", the name of a chain position (K as the board numbers its chips).
 std::string chain_position_name(std::size_t number, std::size_t chips);
+/// Whether `name` is one chain_position_name writes (K < N, plain decimal numbers).
+bool is_chain_position_name(std::string_view name);
 
 /// What one or more runs met: per variant in use, the points hit and the chain positions
 /// present. Merging is a union, so any order of merges gives the same data.

@@ -222,10 +222,12 @@ void CoverageCollector::output_read(std::size_t chain, std::size_t k, const Chip
   if (last >= 0 && (last != 0) != level) mark(s, CoverageCategory::pin_edges, std::string(pin_name(pin)) + (level ? " rising" : " falling"));
   last = level ? 1 : 0;
   if (level || !c.spi_enabled()) return;  // an output pulled low is the one that says something
-  if (pin == Pin::BUSY) return mark(s, CoverageCategory::flags_observed, "BUSY");
+  // BUSY low observes BUSY when it is BUSY (with STEP_MODE.SYNC_EN the pin is SYNC); FLAG low,
+  // every alarm flag set.
   const std::uint16_t status = c.status();
   for (std::size_t i = 0; i < s.flags.size(); ++i)
-    if (s.flags[i].alarm && s.flags[i].set_in(status)) mark_index(s, s.observed_index[i]);
+    if (s.flags[i].set_in(status) && (pin == Pin::BUSY ? s.flags[i].name == "BUSY" : s.flags[i].alarm))
+      mark_index(s, s.observed_index[i]);
 }
 
 void CoverageCollector::output_edge(std::size_t chain, std::size_t k, Pin pin, bool rising) {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 
 namespace l6470emu {
@@ -52,8 +53,17 @@ std::string directory_of(const std::string& path) {
 
 }  // namespace
 
-std::string update_file_locked(const std::string& path, const FileTransform& transform) {
-  if (path.empty()) return "no file named";
+std::string update_file_locked(const std::string& named, const FileTransform& transform) {
+  if (named.empty()) return "no file named";
+  // A symbolic link is followed: the file it names is updated (and renamed over), the link kept.
+  std::string path = named;
+  struct stat link {};
+  if (lstat(named.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+    char* target = realpath(named.c_str(), nullptr);
+    if (target == nullptr) return named + ": a link to " + errno_text(errno);
+    path = target;
+    std::free(target);
+  }
   // Lock the file itself; once locked, make sure it is still the one at `path` (another
   // process may have renamed its new text over it while this one waited).
   int fd = -1;

@@ -12,8 +12,8 @@ namespace l6470emu {
 /// sets `error` to one line (the file is then left as it is).
 using FileTransform = std::function<std::string(const std::string& old_text, std::string& error)>;
 
-/// Locks the file at `path` (created when missing, mode 0644), reads it, writes `transform`'s
-/// text beside it and renames it over the file: processes updating it at once take turns, each
+/// Locks the file at `path` (created when missing, mode 0644; a symbolic link: the file it names),
+/// reads it, writes `transform`'s text beside it and renames it over the file: processes updating it at once take turns, each
 /// seeing the others' updates. Returns "" or one line saying why not.
 std::string update_file_locked(const std::string& path, const FileTransform& transform);
 

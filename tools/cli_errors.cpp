@@ -87,10 +87,17 @@ std::string option_elsewhere(const CLI::App& app, const CLI::App* here, const st
 }
 
 int usage_error(const CLI::App& app, const CLI::ParseError& e, std::ostream& err) {
-  const std::vector<CLI::App*> parsed = app.get_subcommands();
-  const CLI::App* sub = parsed.empty() ? nullptr : parsed.back();
+  // The deepest subcommand parsed ("coverage report", "campaign merge") names the mistake.
+  const CLI::App* sub = nullptr;
+  std::string path;
+  for (const CLI::App* at = &app;;) {
+    const std::vector<CLI::App*> parsed = at->get_subcommands();
+    if (parsed.empty()) break;
+    sub = at = parsed.back();
+    path += " " + sub->get_name();
+  }
   const CLI::App& where = sub != nullptr ? *sub : app;
-  const std::string who = "l6470emu" + (sub != nullptr ? " " + sub->get_name() : std::string());
+  const std::string who = "l6470emu" + path;
   const std::string help = " (" + who + " --help)";
   std::string message = e.what();
   std::replace(message.begin(), message.end(), '\n', ' ');

@@ -480,12 +480,9 @@ TEST(CoverageCollection, ABoardOfTwoVariantsKeepsThemApart) {
   EXPECT_EQ(r.hits(CoverageCategory::chain_positions, "L6480"), Names{"chip 1 of 2"});
 }
 
-// BUG (board/coverage_collector.cpp, CoverageCollector::output_read): a BUSY pin read low marks
-// the flag BUSY observed whatever STATUS says. With STEP_MODE.SYNC_EN = 1 the pin is the SYNC
-// step-clock output, whose low level says nothing about BUSY: a driver that never saw BUSY set is
-// credited with it. Disabled until the collector looks at SYNC_EN (or at the BUSY flag itself);
-// run it with --gtest_also_run_disabled_tests.
-TEST(CoverageCollection, DISABLED_ASyncOutputReadLowIsNoBusyObserved) {
+// With STEP_MODE.SYNC_EN = 1 the BUSY pin is the SYNC output: a read of it low observes BUSY only
+// when STATUS shows BUSY set.
+TEST(CoverageCollection, ASyncOutputReadLowIsNoBusyObserved) {
   Rig r("chips=L6470");
   r.send(set_param(l6470(), "STEP_MODE", 0x80 | 0x07));  // SYNC_EN = 1, SYNC_SEL = 0, 1/128 step
   int tries = 0;
@@ -735,13 +732,10 @@ TEST(CoverageData, ANonCoverageTextIsRefusedInOneLine) {
   EXPECT_NE(one_line_error(replaced("\"Move FWD\"", "\"Move sideways\"")).find("Move sideways"), std::string::npos);
 }
 
-// BUG (board/coverage.cpp, CoverageData::from_json; found by fuzz_coverage, input in
-// tests/fuzz/regressions/coverage/): the refusal quotes the file's own names raw: a variant, a
-// category or a point whose JSON string holds "\n" makes the error two lines, and one holding
-// "\u001b" puts an escape sequence on the terminal of `l6470emu coverage report` (stderr). The
-// header promises one line. Disabled until the names are quoted safely (and cut short); run it
-// with --gtest_also_run_disabled_tests.
-TEST(CoverageData, DISABLED_ARefusalQuotesTheFilesNamesOnOneLineWithoutControlCharacters) {
+// A refusal quotes the file's own names (found by fuzz_coverage, input in
+// tests/fuzz/regressions/coverage/): a name holding "\n" or "\u001b" stays one line and puts no
+// escape sequence on a terminal.
+TEST(CoverageData, ARefusalQuotesTheFilesNamesOnOneLineWithoutControlCharacters) {
   for (const std::string text :
        {std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L6470":{"hit":{"\n":[]}}}})"),
         std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L64\u001b[2J70":{}}})"),
@@ -878,13 +872,9 @@ TEST(CoverageFile, CheckCoverageOutputRefusesAReadOnlyFileAndFolder) {
   EXPECT_NE(check_coverage_output(dir.file("ro/new.json")), "");
 }
 
-// BUG (board/coverage_file.cpp, merge_into_coverage_file): the merged file is written beside
-// PATH and renamed over PATH itself, so a PATH that is a symbolic link (a coverage file kept in a
-// shared folder, linked into each build tree) is replaced by a regular file holding the union,
-// and the file it pointed at never gets the run. check_coverage_output accepts the link (it
-// follows it). Disabled until the merge resolves the link first; run it with
-// --gtest_also_run_disabled_tests.
-TEST(CoverageFile, DISABLED_AMergeThroughASymbolicLinkUpdatesTheFileItPointsAt) {
+// A coverage file reached through a symbolic link (one file shared by several build trees) is
+// merged into where the link points; the link stays a link.
+TEST(CoverageFile, AMergeThroughASymbolicLinkUpdatesTheFileItPointsAt) {
   TempDir dir;
   const std::string target = dir.write("shared.json", run_a().to_json());
   ASSERT_EQ(symlink(target.c_str(), dir.file("link.json").c_str()), 0);
@@ -1067,14 +1057,9 @@ TEST(CoverageReport, EachLcovLineRecordPointsAtTheListingLineOfItsPoint) {
   EXPECT_EQ(record.find("\nDA:" + std::to_string(broken_line) + ","), std::string::npos);
 }
 
-// BUG (board/coverage.cpp, CoverageData::from_json): the names under "chain positions present"
-// are taken as they are, unchecked (every other name must be a point of the variant), so a file
-// can bring any text as a chain position, a newline included. coverage_lcov writes each position
-// as a listing line; one with a newline takes two lines and every DA record after it points one
-// line above its point (here "BUSY rising" is hit on its line, but the DA record names the line
-// before). Disabled until from_json refuses positions that are not chain_position_name(K, N)
-// with K < N; run it with --gtest_also_run_disabled_tests.
-TEST(CoverageReport, DISABLED_AChainPositionWithANewlineCannotShiftTheLcovLines) {
+// Chain positions are checked as every other name: a position that is no "chip K of N" (a newline
+// in it would shift every later DA record of the LCOV listing) is refused.
+TEST(CoverageReport, AChainPositionWithANewlineCannotShiftTheLcovLines) {
   const std::string text = R"({"format": "l6470emu-coverage", "version": 1, "variants": {"L6470": {)"
                            R"("chain positions present": ["chip 0 of 1\nx", "chip 0 of 2"], )"
                            R"("hit": {"commands": ["HardHiZ"], "pin edges": ["BUSY rising"]}}}})";

@@ -159,14 +159,9 @@ TEST(CoverageReportCommand, AThresholdOutsideZeroToAHundredIsOneLineAndExitTwo) 
   }
 }
 
-// BUG (tools/cli_errors.cpp, the usage errors of a subcommand's subcommand): a bad value of an
-// option of `coverage report` is reported as "l6470emu coverage: --fail-under: ... (l6470emu
-// coverage --help)": it names `coverage`, not `coverage report`, and points at a help that does
-// not list --fail-under; every other subcommand names itself ("l6470emu demo: --chips: Value 300
-// not in range 1 to 256 (l6470emu demo --help)"). The range also prints as "0.000000 to
-// 100.000000". Disabled until the error names the subcommand; run it with
-// --gtest_also_run_disabled_tests.
-TEST(CoverageReportCommand, DISABLED_ABadThresholdNamesCoverageReportAndItsHelp) {
+// A bad option value of `coverage report` names `coverage report` and its help, as every other
+// subcommand names itself.
+TEST(CoverageReportCommand, ABadThresholdNamesCoverageReportAndItsHelp) {
   TempDir dir;
   const std::string f = dir.write("a.json", small_run().to_json());
   const RunResult r = l6470emu("coverage report --fail-under 120 " + f);
