@@ -18,31 +18,31 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export L6470EMU_LOG=off
 
-# Prints the wall seconds of one run (the client times its own loop with the raw clock).
+# Prints one run's CPU nanoseconds per round trip (the client times its own loop and prints its
+# count; CPU time is what a busy machine disturbs least).
 once() {  # once COVERAGE(0|1) CLIENT ARGS...
   local with=$1; shift
   local env=(env L6470EMU_CHAIN="bus=0 cs=0 chips=L6470; time=virtual" LD_PRELOAD="$preload")
   [ "$with" = 1 ] && { rm -f "$work/c.json"; env+=(L6470EMU_COVERAGE="$work/c.json"); }
-  "${env[@]}" "$@" | awk '{ print $2 }'
+  "${env[@]}" "$@" | awk '{ printf "%.1f\n", $5 / $1 * 1e9 }'  # CPU ns per round trip
 }
 
-measure() {  # measure NAME COUNT CLIENT ARGS...
-  local name=$1 count=$2; shift 2
-  local off=999 on=999 t
+measure() {  # measure NAME CLIENT ARGS...
+  local name=$1; shift
+  local off=1e12 on=1e12 t
   for _ in $(seq "$rounds"); do
     t=$(once 0 "$@"); off=$(awk -v a="$t" -v b="$off" 'BEGIN { print (a < b ? a : b) }')
     t=$(once 1 "$@"); on=$(awk -v a="$t" -v b="$on" 'BEGIN { print (a < b ? a : b) }')
   done
-  awk -v n="$name" -v c="$count" -v a="$off" -v b="$on" \
-    'BEGIN { printf "%-40s %12.0f %12.0f %8.3fx\n", n, c / a, c / b, b / a }'
+  awk -v n="$name" -v a="$off" -v b="$on" 'BEGIN { printf "%-40s %12.1f %12.1f %8.3fx\n", n, a, b, b / a }'
 }
 
 echo "machine: $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) (before the runs); best of $rounds alternating runs"
-printf '%-40s %12s %12s %9s\n' "client (round trips per wall second)" "without" "with" "cost"
-measure "C, NOP frames" 1000000 "$client" /dev/spidev0.0 1000000 nop
-measure "C, GetStatus polled" 1500000 "$client" /dev/spidev0.0 1500000 getstatus
+printf '%-40s %12s %12s %9s\n' "client (CPU ns per round trip)" "without" "with" "cost"
+measure "C, NOP frames" "$client" /dev/spidev0.0 1000000 nop
+measure "C, GetStatus polled" "$client" /dev/spidev0.0 1500000 getstatus
 if /usr/bin/python3 -c "import spidev" 2>/dev/null; then
-  measure "Python + python3-spidev, GetStatus polled" 300000 /usr/bin/python3 "$python_client" /dev/spidev0.0 300000
+  measure "Python + python3-spidev, GetStatus polled" /usr/bin/python3 "$python_client" /dev/spidev0.0 300000
 else
   echo "Python + python3-spidev: not installed, skipped"
 fi
