@@ -38,7 +38,7 @@ void CoverageCollector::add_chain(const Chain& chain, NumberFrom numbering) {
     s.get_status_index = s.universe->find(CoverageCategory::commands, "GetStatus");
   }
   chains_.push_back(std::move(chips));
-  looks_.push_back(ChainLook{false, 0, std::vector<std::uint64_t>(chain.size(), 0)});
+  looks_.push_back(ChainLook{});
 }
 
 CoverageCollector::ChipState& CoverageCollector::chip(std::size_t chain, std::size_t chip) {
@@ -80,6 +80,7 @@ void CoverageCollector::command(std::size_t chain, std::size_t k, const Chip& c,
     saw_status(s, c.status(), true);
     return;
   }
+  if (op.command != Command::GetParam) looks_[chain].dirty = true;  // reads raise no flag
   const std::string name(to_string(op.command));
   switch (op.command) {
     case Command::NOP: case Command::Reserved: case Command::Unknown:
@@ -135,6 +136,7 @@ void CoverageCollector::command(std::size_t chain, std::size_t k, const Chip& c,
 
 void CoverageCollector::diagnostic(std::size_t chain, std::size_t k, const Diagnostic& d) {
   ChipState& s = chip(chain, k);
+  looks_[chain].dirty = true;  // WRONG_CMD / NOTPERF_CMD latched
   const bool pending = s.has_pending;
   s.has_pending = false;  // refused: neither written nor run
   if (d.detail == DiagnosticDetail::read_only_write) return mark(s, CoverageCategory::refusals, "SetParam of a read-only register");
@@ -163,14 +165,9 @@ void CoverageCollector::diagnostic(std::size_t chain, std::size_t k, const Diagn
 void CoverageCollector::look(std::size_t chain, const Chain& ch, bool force) {
   auto& chips = chains_.at(chain);
   ChainLook& last = looks_[chain];
-  bool changed = force || !last.looked || ch.now() - last.at >= kLookInterval;
-  for (std::size_t k = 0; k < chips.size() && k < ch.size(); ++k) {
-    const std::uint64_t decoded = ch.chip(k).decoded_bytes();
-    changed = changed || decoded != last.decoded[k] || chips[k].has_pending;
-    last.decoded[k] = decoded;
-  }
-  if (!changed) return;
+  if (!force && last.looked && !last.dirty && ch.now() - last.at < kLookInterval) return;
   last.looked = true;
+  last.dirty = false;
   last.at = ch.now();
   for (std::size_t k = 0; k < chips.size() && k < ch.size(); ++k) {
     ChipState& s = chips[k];
@@ -189,7 +186,7 @@ void CoverageCollector::look(std::size_t chain, const Chain& ch, bool force) {
 
 void CoverageCollector::event(std::size_t chain, std::size_t k, TraceFault fault, std::uint8_t value) {
   ChipState& s = chip(chain, k);
-  looks_[chain].looked = false;  // the next look looks
+  looks_[chain].dirty = true;  // the next look looks
   switch (fault) {
     case TraceFault::THERMAL:
       if (value >= 1 && value <= 3) mark(s, CoverageCategory::events, "THERMAL " + std::string(thermal_name(value)));
@@ -204,7 +201,7 @@ void CoverageCollector::event(std::size_t chain, std::size_t k, TraceFault fault
 
 void CoverageCollector::input(std::size_t chain, std::size_t k, Pin pin, bool level) {
   ChipState& s = chip(chain, k);
-  looks_[chain].looked = false;  // the next look looks
+  looks_[chain].dirty = true;  // the next look looks
   if (pin == Pin::SW) {
     if (!level && !s.sw_low) mark(s, CoverageCategory::events, "SW closed");
     if (level && s.sw_low) mark(s, CoverageCategory::events, "SW opened");

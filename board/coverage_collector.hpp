@@ -34,9 +34,9 @@ class CoverageCollector {
   /// Chip `chip` noticed a host mistake (Chip's DiagnosticSink): a refusal or a wrong command.
   void diagnostic(std::size_t chain, std::size_t chip, const Diagnostic& d);
   /// After a step of the run (a frame, a pin, a fault, a wait): the flags every chip shows now.
-  /// Cheap when nothing reached the chips' decoders since the last look and less than
-  /// kLookInterval ticks have passed: flags that rise with time alone (the motion's phases) are
-  /// looked at that often, or at the next command, pin or fault.
+  /// Cheap when nothing but reads (GetStatus, GetParam: they raise no flag) reached the chips
+  /// since the last look and less than kLookInterval ticks have passed: flags that rise with time
+  /// alone (the motion's phases) are looked at that often, or at the next command, pin or fault.
   /// `force`: look whatever happened (the run's end).
   void look(std::size_t chain, const Chain& ch, bool force = false);
   /// How often time alone makes a look: 1 ms.
@@ -88,7 +88,7 @@ class CoverageCollector {
   struct ChainLook {
     bool looked = false;
     Tick at = 0;
-    std::vector<std::uint64_t> decoded;  // each chip's decoded_bytes() then
+    bool dirty = true;  // a command other than a read, a refusal, a pin or a fault since then
   };
   std::vector<ChainLook> looks_;
 };
