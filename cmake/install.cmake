@@ -93,6 +93,28 @@ if(L6470EMU_HELP2MAN)
     set_tests_properties(manpage PROPERTIES LABELS tools SKIP_RETURN_CODE 77)
   endif()
   install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  # A page per subcommand, l6470emu-run(1) and so on, each from its own --help.
+  set(L6470EMU_SUBCOMMAND_PAGES demo tables serve ctl run campaign campaign-merge coverage-report coverage-merge
+      replay decode convert plot units)
+  set(sub_pages "")
+  foreach(sub ${L6470EMU_SUBCOMMAND_PAGES})
+    set(page ${PROJECT_BINARY_DIR}/man/l6470emu-${sub}.1)
+    add_custom_command(OUTPUT ${page}.gz
+      COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/man
+      COMMAND ${CMAKE_COMMAND} -DPROGRAM=$<TARGET_FILE:l6470emu> -DHELP2MAN=${L6470EMU_HELP2MAN} -DSUB=${sub}
+              -DVERSION=${PROJECT_VERSION} -DOUTPUT=${page} -P ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.cmake
+      COMMAND gzip -9nf ${page}
+      DEPENDS l6470emu ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.cmake ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.h2m
+      COMMENT "Generating the l6470emu-${sub}(1) man page" VERBATIM)
+    list(APPEND sub_pages ${page}.gz)
+  endforeach()
+  add_custom_target(l6470emu_subcommand_manpages ALL DEPENDS ${sub_pages})
+  install(FILES ${sub_pages} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+  if(L6470EMU_TESTS)  # every subcommand has its page, and run's lists its options
+    add_test(NAME subcommand_manpages COMMAND sh ${PROJECT_SOURCE_DIR}/tests/tools/subcommand_manpages_test.sh
+             ${PROJECT_BINARY_DIR}/man ${L6470EMU_SUBCOMMAND_PAGES})
+    set_tests_properties(subcommand_manpages PROPERTIES LABELS tools SKIP_RETURN_CODE 77)
+  endif()
 else()
   message(STATUS "l6470emu: help2man not found: no man page (apt-get install help2man)")
 endif()
