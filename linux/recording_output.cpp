@@ -169,6 +169,21 @@ std::unique_ptr<TraceOutput> open_mapped_trace_output(const std::string& path) {
 }
 
 std::unique_ptr<TraceOutput> open_recording_output(const std::string& path, std::function<std::int64_t()> clock) {
+  // Only a regular file, never through a symbolic link, and nothing that could block: a FIFO
+  // opened for writing waits for a reader (a daemon holding its board's lock would wait with it),
+  // and a root daemon must not follow another user's link to overwrite what it names.
+  {
+    int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0 && errno == ENOENT) fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      if (errno == ELOOP) throw std::runtime_error(path + ": a symbolic link: name the file itself");
+      throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
+    }
+    struct stat st {};
+    const bool regular = fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+    ::close(fd);
+    if (!regular) throw std::runtime_error(path + ": not a regular file (a device, a FIFO or a directory): a trace goes to a file");
+  }
   if (gzip_file_name(path)) {
     TraceFlushPolicy policy;
     policy.gzip_bytes = kRecordingGzipFlushBytes;

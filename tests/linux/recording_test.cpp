@@ -10,6 +10,8 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "run_program.hpp"
 #include "board/trace_recorder.hpp"
@@ -223,6 +225,27 @@ TEST_F(RecordingDaemon, CtlTraceStartAndStopRecordWhatHappensInBetween) {
   const RunResult d = daemon_->process().stop(SIGTERM);
   daemon_.reset();
   EXPECT_EQ(d.status, 0) << d.err;
+}
+
+TEST_F(RecordingDaemon, ATracePathThatIsAFifoALinkOrADeviceIsRefusedAndTheDaemonServesOn) {
+  start({});
+  const std::string fifo = trace_ + ".fifo", link = trace_ + ".link", target = trace_ + ".target";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  { std::ofstream(target) << "someone else's file\n"; }
+  ASSERT_EQ(symlink(target.c_str(), link.c_str()), 0);
+  // A FIFO opened for writing would wait for a reader with the board's lock held: refused at once.
+  const RunResult f = ctl({"trace", "start", fifo});
+  EXPECT_EQ(f.status, 1);
+  EXPECT_NE(f.err.find("not a regular file"), std::string::npos) << f.err;
+  const RunResult l = ctl({"trace", "start", link});
+  EXPECT_EQ(l.status, 1);
+  EXPECT_NE(l.err.find("a symbolic link"), std::string::npos) << l.err;
+  EXPECT_EQ(read_file(target), "someone else's file\n");
+  EXPECT_EQ(ctl({"trace", "start", "/dev/null"}).status, 1);
+  EXPECT_EQ(ctl({"status"}).status, 0) << "the daemon still answers";
+  unlink(fifo.c_str());
+  unlink(link.c_str());
+  unlink(target.c_str());
 }
 
 TEST_F(RecordingDaemon, ADaemonKilledWhileRecordingLeavesACompleteTrace) {
