@@ -117,8 +117,20 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
       continue;
     }
     if (n <= 0) return false;
-    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c))
-      if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_RIGHTS) std::memcpy(&fd, CMSG_DATA(c), sizeof fd);
+    // Every descriptor received is owned: the first is the packet's, any more (a peer that sent
+    // several) are closed at once, never kept open for good.
+    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
+      if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_RIGHTS || c->cmsg_len < CMSG_LEN(0)) continue;
+      const std::size_t count = (c->cmsg_len - CMSG_LEN(0)) / sizeof(int);
+      for (std::size_t i = 0; i < count; ++i) {
+        int received = -1;
+        std::memcpy(&received, CMSG_DATA(c) + i * sizeof(int), sizeof received);
+        if (fd < 0)
+          fd = received;
+        else
+          ::close(received);
+      }
+    }
     if (msg.msg_flags & MSG_TRUNC) {
       errno = EMSGSIZE;
       return false;

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include <filesystem>
 #include <gtest/gtest.h>
 
 #include "linux/protocol.hpp"
@@ -167,6 +168,57 @@ TEST_F(DaemonLimits, OutOfDescriptorsTheDaemonWaitsInsteadOfSpinningAndRecovers)
   EXPECT_TRUE(served) << "the daemon serves again once descriptors are free";
   const RunResult r = d.stop(SIGTERM);
   EXPECT_NE(r.err.find("out of file descriptors"), std::string::npos) << r.err;
+}
+
+/// Open descriptors of process `pid`.
+std::size_t open_descriptors(pid_t pid) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/fd")) ++n;
+  return n;
+}
+
+TEST_F(DaemonLimits, DescriptorsAClientSendsWithAPacketAreNeverKeptOpen) {
+  ServeDaemon d(kChain);
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  const int spare = open("/dev/null", O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(spare, 0);
+  auto hello_with_two_descriptors = [&] {
+    const int fd = connect_to(d.socket());
+    if (fd < 0) return false;
+    const RequestHeader req{static_cast<std::uint32_t>(Op::hello), 0, 0, kProtocolVersion};
+    iovec iov{const_cast<RequestHeader*>(&req), sizeof req};
+    alignas(cmsghdr) char control[CMSG_SPACE(2 * sizeof(int))] = {};
+    msghdr msg{};
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    cmsghdr* c = CMSG_FIRSTHDR(&msg);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SCM_RIGHTS;
+    c->cmsg_len = CMSG_LEN(2 * sizeof(int));
+    const int two[2] = {spare, spare};
+    std::memcpy(CMSG_DATA(c), two, sizeof two);
+    const bool sent = sendmsg(fd, &msg, MSG_NOSIGNAL) == static_cast<ssize_t>(sizeof req);
+    char buf[256];
+    timeval tv{5, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    (void)recv(fd, buf, sizeof buf, 0);  // the answer (or the hang-up): the daemon has read the packet
+    close(fd);
+    return sent;
+  };
+  ASSERT_TRUE(hello_with_two_descriptors());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const std::size_t before = open_descriptors(d.process().pid());
+  for (int i = 0; i < 50; ++i) ASSERT_TRUE(hello_with_two_descriptors());
+  // Finished connections are reaped at the daemon's next look (its accept loop wakes each second).
+  std::size_t after = open_descriptors(d.process().pid());
+  for (int i = 0; i < 40 && after > before + 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    after = open_descriptors(d.process().pid());
+  }
+  EXPECT_LE(after, before + 2) << "50 packets of two descriptors each";
+  close(spare);
 }
 
 TEST_F(DaemonLimits, ClientsPastTheCapAreRefusedToldWhyAndTheRestServed) {
