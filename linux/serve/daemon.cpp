@@ -389,8 +389,17 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
     Connection& conn = connections.emplace_back();
     conn.fd = c;
     conn.pid = peer.pid;
-    if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex, &connection_ended, &stopping] {
-          serve_connection(board, control, conn, stopping);
+    if (!start_thread(conn.thread, [&board, &control, &conn, &connections_mutex, &connection_ended, &stopping, &log] {
+          // Out of memory (a tight ulimit -v): this client is refused with the reason, the
+          // daemon serves the others on.
+          try {
+            serve_connection(board, control, conn, stopping);
+          } catch (const std::bad_alloc&) {
+            log.line("serve: out of memory for a client's buffers; refused it");
+            refuse(conn.fd, "the daemon is out of memory for this client's buffers; try again when others have left");
+          } catch (const std::exception& e) {
+            log.line(std::string("serve: a client's connection ended: ") + e.what());
+          }
           std::lock_guard l(connections_mutex);
           conn.done = true;
           connection_ended.notify_all();

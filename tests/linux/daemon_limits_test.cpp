@@ -221,6 +221,34 @@ TEST_F(DaemonLimits, DescriptorsAClientSendsWithAPacketAreNeverKeptOpen) {
   close(spare);
 }
 
+TEST_F(DaemonLimits, OutOfMemoryForAClientRefusesItAndTheDaemonServesOn) {
+  // Under ulimit -v, client threads get their stacks but not always their buffers: each such
+  // client is refused with the reason (std::bad_alloc escaped the thread and aborted the daemon).
+  const std::string path = temp_socket_path("enomem");
+  Background d({"/bin/sh", "-c", "ulimit -v 300000; exec \"$0\" serve --chain \"$1\" --socket \"$2\"",
+                l6470emu_program(), kChain, path});
+  for (int i = 0; i < 500 && d.out().find("listening on") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::vector<int> clients;
+  for (int i = 0; i < 40; ++i)
+    if (const int fd = connect_to(path); fd >= 0) {
+      (void)say_hello(fd);
+      clients.push_back(fd);
+    }
+  EXPECT_EQ(kill(d.pid(), 0), 0) << "the daemon is alive";
+  for (int fd : clients) close(fd);
+  bool served = false;
+  for (int i = 0; i < 50 && !served; ++i) {
+    const int fd = connect_to(path);
+    served = fd >= 0 && answers_hello(fd);
+    if (fd >= 0) close(fd);
+    if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_TRUE(served) << "clients are served once the others left";
+  const RunResult r = d.stop(SIGTERM);
+  EXPECT_EQ(r.status, 0) << r.err;
+}
+
 TEST_F(DaemonLimits, ClientsPastTheCapAreRefusedToldWhyAndTheRestServed) {
   ServeDaemon d(kChain);
   ASSERT_TRUE(d.ready());
