@@ -170,7 +170,7 @@ def cli_pages(program, out_dir):
     def page(words, title, about):
         text = run([program, *words, "--help"])
         name = "-".join(words) or "l6470emu"
-        body = [f"# `{title}`", "", about, "", "```text", text.rstrip("\n"), "```", ""]
+        body = [f"# `{title}`", "", about, "", "```{code-block} text", ":class: cli-help", "", text.rstrip("\n"), "```", ""]
         nested = subcommands(text) if words else []
         if nested:
             body += ["Its subcommands: " + ", ".join(f"[`{title} {n}`]({name}-{n}.md)" for n in nested) + ".", ""]

@@ -50,6 +50,7 @@ html_theme_options = {
 html_sidebars = {"**": ["about.html", "navigation.html", "relations.html", "searchbox.html"]}
 html_static_path = ["_static"]
 html_js_files = ["file-protocol.js"]
+html_css_files = ["site.css"]
 html_copy_source = False  # no _sources/ copies of the pages
 html_show_sourcelink = False
 
