@@ -452,6 +452,16 @@ def main():
     for name in FRAMEWORK_JS:
         for f in out_dir.glob(f"_static/{name}"):
             f.unlink()
+    # Sphinx leaves the page of a removed or renamed document behind: remove it, so that neither
+    # the checks below nor an install see it.
+    built = {str(p.with_suffix(".html")) for p in kept if is_page(p) and (stage_dir / p).is_file()
+             and not (stage_dir / p).is_symlink()}
+    built |= {"index.html", "search.html", "genindex.html", "py-modindex.html"}
+    for page in out_dir.rglob("*.html"):
+        rel = page.relative_to(out_dir)
+        if rel.parts[0] not in ("_static", "_downloads", "_images") and str(rel) not in built:
+            say(f"removed {rel}: no page makes it any more")
+            page.unlink()
     # The front page is docs/index.html (the pages keep the source tree's layout, so that their
     # links to each other and to source files are the ones GitHub shows).
     write_if_changed(out_dir / "index.html",
