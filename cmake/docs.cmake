@@ -28,6 +28,12 @@ if(L6470EMU_TESTS)
                        ENVIRONMENT "PYTHONDONTWRITEBYTECODE=1")
 endif()
 
-# The built site, when there is one (a .buildinfo is Sphinx's own bookkeeping).
+# The built site, when there is one (a .buildinfo is Sphinx's own bookkeeping), and with it the
+# lintian override that says why its search scripts are its own (cmake/l6470emu.lintian-overrides).
 install(DIRECTORY ${PROJECT_BINARY_DIR}/docs/html/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/html OPTIONAL
         PATTERN ".buildinfo" EXCLUDE)
+install(CODE "
+  if(EXISTS \"${PROJECT_BINARY_DIR}/docs/html/index.html\")
+    file(INSTALL \"${PROJECT_SOURCE_DIR}/cmake/l6470emu.lintian-overrides\"
+         DESTINATION \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_DATAROOTDIR}/lintian/overrides\" RENAME l6470emu)
+  endif()")
