@@ -12,7 +12,9 @@ if(NOT TARGET l6470emu_python)
   return()
 endif()
 
-set(L6470EMU_DOCS_JOBS 2 CACHE STRING "Sphinx processes building the documentation site")
+# One process: on the 2-core machine a clean build took 30-32 s with -j 1 and 40-43 s with -j 2
+# (at load averages of 4-21, other builds running).
+set(L6470EMU_DOCS_JOBS 1 CACHE STRING "Sphinx processes building the documentation site")
 add_custom_target(l6470emu_docs
   COMMAND ${Python_EXECUTABLE} ${PROJECT_SOURCE_DIR}/docs/build_site.py --source ${PROJECT_SOURCE_DIR}
           --build ${PROJECT_BINARY_DIR} --jobs ${L6470EMU_DOCS_JOBS}

@@ -83,7 +83,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--source", required=True, type=Path)
     ap.add_argument("--build", required=True, type=Path)
-    ap.add_argument("--jobs", default="2")
+    ap.add_argument("--jobs", default="1")
     args = ap.parse_args()
     source, build = args.source.resolve(), args.build.resolve()
 
