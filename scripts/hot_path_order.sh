@@ -3,7 +3,7 @@
 # message runs through, which the link places side by side (gold's --section-ordering-file) so
 # that they share the processor's instruction cache instead of evicting each other. Without it a
 # change anywhere in the library moves a tight client's time per message by 10-40 % with the same
-# instructions (README.md, § Performance).
+# instructions (docs/reference/performance.md).
 #
 # It runs the benchmark clients under valgrind's callgrind: the C client (NOP messages and
 # GetStatus polls; unrecorded, recorded into a plain trace and into a .trace.gz) and, when

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The README's two commands:
+# The README's two commands (docs/guide/install.md):
 #   scripts/quickstart.sh demo   set up (Debian packages, build) and run the demo
-#   scripts/quickstart.sh test   set up and run the whole test suite (gcc), then again under ASan+UBSan
-#                                (clang), then a bounded fuzz pass of every input parser
+#   scripts/quickstart.sh test   set up and run the whole test suite (gcc), build the documentation
+#                                site and open it in headless Chromium, then the suite again under
+#                                ASan+UBSan (clang), then a bounded fuzz pass of every input parser
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-}
@@ -26,7 +27,11 @@ case "$what" in
       echo "== $name: $((SECONDS - t)) s (total $((SECONDS - started)) s) =="
     }
     stage "set up and build (RelWithDebInfo)" scripts/setup.sh build
-    stage "tests (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j"$(nproc)"
+    stage "tests (RelWithDebInfo)" ctest --test-dir build --output-on-failure -j"$(nproc)" -LE '^docs$'
+    # The documentation site (docs/build_site.py: Sphinx, warnings as errors, every internal link
+    # checked), then opened in headless Chromium: ctest's `docs` test (tests/docs/docs_test.py).
+    stage "documentation site (build, links, headless Chromium)" \
+      ctest --test-dir build --output-on-failure -L '^docs$'
     # The headline figures, so that a regression shows in every run's log. Numbers only: no
     # pass/fail on timing (machines are noisy; --no-verdicts leaves out "met" / "NOT MET");
     # bench/compare.sh REV compares two revisions side by side. About 30 s of CPU to build

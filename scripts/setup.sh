@@ -15,6 +15,7 @@ packages=(
   libfuse3-dev qemu-system-x86 busybox-static cpio kmod
   libyaml-cpp-dev spi-tools golang-go
   lcov
+  python3-sphinx python3-myst-parser python3-breathe doxygen chromium chromium-driver python3-selenium
 )
 
 missing=()

@@ -1,7 +1,7 @@
 #!/bin/sh
 # The pytest example as ctest runs it: its tests with --l6470emu-coverage (the program run under
 # the preload and the driver class on an in-process Board both merge into FILE), then the report
-# of the interface coverage they met (README.md shows it).
+# of the interface coverage they met (docs/guide/python.md shows the tests).
 # Usage: run_with_coverage.sh PYTHON L6470EMU FILE [PYTEST ARGS...]
 set -e
 python=$1 program=$2 file=$3

@@ -1,4 +1,4 @@
-"""A small driver for a daisy chain of L6470s over py-spidev: the kind of module the README's
+"""A small driver for a daisy chain of L6470s over py-spidev: the kind of module the Python guide's
 pytest example tests. Nothing here knows about the emulator; on a board with real chips it
 runs unchanged. Chip 0 is the one that drives MISO: in a frame of N bytes, byte k is chip k's.
 

@@ -240,11 +240,11 @@ def test_a_board_with_two_chains_opens_each_spidev_and_gpiochip():
         l6470emu.Board("L6470", options="time=wall")
 
 
-def test_the_readme_documents_every_option_of_the_fixtures():
+def test_the_python_guide_documents_every_option_of_the_fixtures():
     from pathlib import Path
     from l6470emu import pytest_plugin
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    section = readme[readme.index("## Testing your driver with pytest"):readme.index("## Examples\n")]
+    guide = (Path(__file__).resolve().parents[2] / "docs" / "guide" / "python.md").read_text()
+    section = guide[guide.index("## Testing your driver with pytest"):guide.index("## Examples\n")]
     for option in pytest_plugin._BOARD_OPTIONS:
         assert f"`{option}`" in section, option
     board = pytest_plugin.SpidevBoard(["L6470"], Path("/tmp"))

@@ -1,4 +1,5 @@
-// The README's register, STATUS and command tables are generated from the model's own tables.
+// The generated tables of the documents (registers, STATUS, commands, variants, units in
+// docs/reference/tables.md; the sanitizer's rules in docs/linux.md) are the model's own tables.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -9,18 +10,18 @@
 namespace l6470emu {
 namespace {
 
-std::string read_readme() {
-  std::ifstream in(std::string(L6470EMU_SOURCE_DIR) + "/README.md");
+std::string read_tables_page() {
+  std::ifstream in(std::string(L6470EMU_SOURCE_DIR) + "/docs/reference/tables.md");
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
 }
 
-TEST(Readme, GeneratedTablesMatchTheModel) {
-  const std::string text = read_readme();
+TEST(Docs, TheTablesPagesTablesMatchTheModel) {
+  const std::string text = read_tables_page();
   ASSERT_FALSE(text.empty());
   EXPECT_EQ(refresh_generated_blocks(text), text)
-      << "README tables are stale: run build/l6470emu tables --update-readme README.md";
+      << "docs/reference/tables.md is stale: run build/l6470emu tables --update-readme docs/reference/tables.md";
 }
 
 TEST(Docs, TheLinuxPagesSanitizerRulesMatchTheModel) {
@@ -33,9 +34,10 @@ TEST(Docs, TheLinuxPagesSanitizerRulesMatchTheModel) {
       << "docs/linux.md's rules table is stale: run build/l6470emu tables --update-readme docs/linux.md";
 }
 
-TEST(Readme, HasEveryGeneratedBlock) {
-  const std::string text = read_readme();
-  for (const char* name : {"l6470-registers", "l6470-status", "commands"})
+TEST(Docs, TheTablesPageHasEveryGeneratedBlock) {
+  const std::string text = read_tables_page();
+  for (const char* name : {"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
+                           "variant-differences", "units"})
     EXPECT_NE(text.find(std::string("<!-- BEGIN generated:") + name + " -->"), std::string::npos) << name;
 }
 
