@@ -8,16 +8,6 @@ namespace {
 constexpr std::uint32_t kPositionMask = 0x3FFFFF;  // 22-bit ABS_POS / N arguments
 constexpr std::uint32_t kSpeedMask = 0xFFFFF;      // Run's 20-bit SPD
 
-bool is_motion(Command c) {
-  switch (c) {
-    case Command::Run: case Command::StepClock: case Command::Move: case Command::GoTo: case Command::GoTo_DIR:
-    case Command::GoUntil: case Command::ReleaseSW: case Command::GoHome: case Command::GoMark:
-      return true;
-    default:
-      return false;
-  }
-}
-
 }  // namespace
 
 void CoverageCollector::add_chain(const Chain& chain, NumberFrom numbering) {
@@ -127,7 +117,7 @@ void CoverageCollector::command(std::size_t chain, std::size_t k, const Chip& c,
       mark(s, CoverageCategory::commands, name);
       break;
   }
-  if (is_motion(op.command)) {
+  if (is_motion_command(op.command)) {
     s.pending = op;
     s.pending_step_sel = c.profile().step_sel;
     s.has_pending = true;

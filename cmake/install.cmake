@@ -82,6 +82,7 @@ if(L6470EMU_HELP2MAN)
             -DINCLUDE=${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m -DOUTPUT=${PROJECT_BINARY_DIR}/l6470emu.1
             -P ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
     DEPENDS l6470emu ${PROJECT_SOURCE_DIR}/docs/l6470emu.h2m ${CMAKE_CURRENT_LIST_DIR}/manpage.cmake
+            ${CMAKE_CURRENT_LIST_DIR}/manpage_chars.cmake
     COMMENT "Generating the l6470emu(1) man page")
   # Installed compressed, as Debian's policy asks (man reads it the same everywhere).
   add_custom_command(OUTPUT ${PROJECT_BINARY_DIR}/l6470emu.1.gz
@@ -105,6 +106,7 @@ if(L6470EMU_HELP2MAN)
               -DVERSION=${PROJECT_VERSION} -DOUTPUT=${page} -P ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.cmake
       COMMAND gzip -9nf ${page}
       DEPENDS l6470emu ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.cmake ${CMAKE_CURRENT_LIST_DIR}/manpage_sub.h2m
+              ${CMAKE_CURRENT_LIST_DIR}/manpage_chars.cmake
       COMMENT "Generating the l6470emu-${sub}(1) man page" VERBATIM)
     list(APPEND sub_pages ${page}.gz)
   endforeach()

@@ -23,8 +23,7 @@ file(READ ${INCLUDE} sections)
 get_filename_component(dir ${OUTPUT} DIRECTORY)
 file(WRITE ${dir}/l6470emu-sections.h2m "${sections}\n${section}")
 # help2man in a UTF-8 locale (in its default, C, it writes "??" for every non-ASCII character);
-# then the characters become groff's own names, so that man shows them in a UTF-8 locale and
-# ASCII stand-ins (us, ^2, ->, x) under LC_ALL=C.
+# then the characters become groff's own names (manpage_chars.cmake).
 execute_process(COMMAND ${HELP2MAN} --locale=C.UTF-8 --no-info --section=1 --source=l6470emu
                         --name=register-level\ emulator\ of\ the\ ST\ L6470-family\ SPI\ motion\ engines
                         --include=${dir}/l6470emu-sections.h2m --output=${OUTPUT} ${PROGRAM}
@@ -33,15 +32,6 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "help2man failed (${rc})")
 endif()
 file(READ ${OUTPUT} page)
-string(REPLACE "µ" "\\*(Mc" page "${page}")
-string(REPLACE "²" "\\(S2" page "${page}")
-string(REPLACE "→" "\\(->" page "${page}")
-string(REPLACE "×" "\\(mu" page "${page}")
-string(REPLACE "·" "\\(md" page "${page}")
-string(REPLACE "…" "..." page "${page}")
-string(REPLACE "–" "\\(en" page "${page}")
-string(REPLACE "—" "\\(em" page "${page}")
-# The micro sign has no ASCII stand-in in groff (it prints "<micro>"): "u" on the ascii device.
-# (tests/tools/manpage_test.sh checks the page under LC_ALL=C.)
-string(REPLACE "\n.SH NAME" "\n.ie '\\*(.T'ascii' .ds Mc u\n.el .ds Mc \\(mc\n.SH NAME" page "${page}")
+include(${CMAKE_CURRENT_LIST_DIR}/manpage_chars.cmake)
+groff_characters(page)
 file(WRITE ${OUTPUT} "${page}")

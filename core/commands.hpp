@@ -15,6 +15,18 @@ enum class Command : std::uint8_t {
   Unknown,   ///< no such command, or a parameter address the variant lacks
 };
 
+/// Whether `c` starts (or steers) a motion: Run, StepClock, Move, GoTo, GoTo_DIR, GoUntil,
+/// ReleaseSW, GoHome, GoMark.
+constexpr bool is_motion_command(Command c) {
+  switch (c) {
+    case Command::Run: case Command::StepClock: case Command::Move: case Command::GoTo: case Command::GoTo_DIR:
+    case Command::GoUntil: case Command::ReleaseSW: case Command::GoHome: case Command::GoMark:
+      return true;
+    default:
+      return false;
+  }
+}
+
 /// A decoded opcode byte.
 struct Opcode {
   Command command = Command::Unknown;

@@ -33,15 +33,7 @@ constexpr FaultSpec kFaults[] = {
     {CampaignFault::block, "block", "STEP_LOSS_A", "a hard stop in the way of the rotor where it is: the motor stalls against it (boards with an axis)"},
 };
 
-bool is_motion(Command c) {
-  switch (c) {
-    case Command::Run: case Command::StepClock: case Command::Move: case Command::GoTo: case Command::GoTo_DIR:
-    case Command::GoUntil: case Command::ReleaseSW: case Command::GoHome: case Command::GoMark:
-      return true;
-    default:
-      return false;
-  }
-}
+bool is_motion(Command c) { return is_motion_command(c); }
 bool is_config(Command c) { return c == Command::SetParam || c == Command::ResetDevice || c == Command::ResetPos; }
 bool is_poll(Command c) { return c == Command::GetStatus || c == Command::GetParam; }
 

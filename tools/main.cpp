@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
   tables->add_option("--table", table, "which table")
       ->check(l6470emu::one_of({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
                                 "variant-differences", "sanitizer-rules", "units"}));
-  tables->add_option("--update-readme", readme, "rewrite the generated blocks of this README instead");
+  tables->add_option("--update-readme", readme, "rewrite the generated blocks of this Markdown file instead (docs/reference/tables.md, docs/linux.md)");
 
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::RunCommand run_command(app);         // run

@@ -1,5 +1,5 @@
 // Markdown tables generated from the variant tables the emulator itself uses,
-// so the README cannot drift from the model (a test checks it is in sync).
+// so the reference pages (docs/reference/tables.md) cannot drift from the model (a test checks them).
 #pragma once
 
 #include <string>

@@ -23,6 +23,7 @@
 #include "linux/protocol.hpp"
 #include "raw_client.hpp"
 #include "run_program.hpp"
+#include "support/test_support.hpp"
 
 namespace l6470emu::test {
 namespace {
@@ -33,6 +34,18 @@ int connect_to(const std::string& path) { return connect_raw(path); }
 
 /// Whether the daemon answers a hello on `fd` (false: it refused, closed the connection or never answers).
 bool answers_hello(int fd) { return say_hello(fd).answered; }
+
+/// Whether the daemon at `path` answers a new client's hello within about 5 s.
+bool served_within_5s(const std::string& path) {
+  for (int i = 0; i < 50; ++i) {
+    const int fd = connect_to(path);
+    const bool served = fd >= 0 && answers_hello(fd);
+    if (fd >= 0) close(fd);
+    if (served) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
 
 /// User and system CPU seconds a process has used so far.
 double cpu_seconds(pid_t pid) {
@@ -158,13 +171,7 @@ TEST_F(DaemonLimits, OutOfDescriptorsTheDaemonWaitsInsteadOfSpinningAndRecovers)
   const double used = cpu_seconds(d.pid()) - before;
   EXPECT_LT(used, 0.3) << "a spinning accept loop burns a whole core";
   for (int fd : clients) close(fd);
-  bool served = false;
-  for (int i = 0; i < 50 && !served; ++i) {
-    const int fd = connect_to(path);
-    served = fd >= 0 && answers_hello(fd);
-    if (fd >= 0) close(fd);
-    if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  const bool served = served_within_5s(path);
   EXPECT_TRUE(served) << "the daemon serves again once descriptors are free";
   const RunResult r = d.stop(SIGTERM);
   EXPECT_NE(r.err.find("out of file descriptors"), std::string::npos) << r.err;
@@ -221,16 +228,6 @@ TEST_F(DaemonLimits, DescriptorsAClientSendsWithAPacketAreNeverKeptOpen) {
   close(spare);
 }
 
-// AddressSanitizer, as gcc (__SANITIZE_ADDRESS__) and clang (__has_feature) say it: its program
-// maps terabytes of shadow memory, which no ulimit -v lets it start with.
-#if defined(__SANITIZE_ADDRESS__)
-#define L6470EMU_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define L6470EMU_TEST_ASAN 1
-#endif
-#endif
-
 TEST_F(DaemonLimits, OutOfMemoryForAClientRefusesItAndTheDaemonServesOn) {
 #if defined(L6470EMU_TEST_ASAN)
   GTEST_SKIP() << "an AddressSanitizer build cannot start under ulimit -v";
@@ -250,13 +247,7 @@ TEST_F(DaemonLimits, OutOfMemoryForAClientRefusesItAndTheDaemonServesOn) {
     }
   EXPECT_EQ(kill(d.pid(), 0), 0) << "the daemon is alive";
   for (int fd : clients) close(fd);
-  bool served = false;
-  for (int i = 0; i < 50 && !served; ++i) {
-    const int fd = connect_to(path);
-    served = fd >= 0 && answers_hello(fd);
-    if (fd >= 0) close(fd);
-    if (!served) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
+  const bool served = served_within_5s(path);
   EXPECT_TRUE(served) << "clients are served once the others left";
   const RunResult r = d.stop(SIGTERM);
   EXPECT_EQ(r.status, 0) << r.err;

@@ -1,6 +1,17 @@
 // Shared helpers for the tests: a one-chip rig and readable conversions.
 #pragma once
 
+// AddressSanitizer, as gcc (__SANITIZE_ADDRESS__) and clang (__has_feature) say it: defines
+// L6470EMU_TEST_ASAN in a sanitized build (its programs keep freed memory in quarantine and map
+// terabytes of shadow memory: no peak or ulimit -v says anything there).
+#if defined(__SANITIZE_ADDRESS__)
+#define L6470EMU_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define L6470EMU_TEST_ASAN 1
+#endif
+#endif
+
 #include <cstdint>
 
 #include "daisychain/chain.hpp"

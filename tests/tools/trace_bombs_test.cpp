@@ -16,6 +16,7 @@
 
 #include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
+#include "support/test_support.hpp"
 #include "support/trace_test_support.hpp"
 
 namespace l6470emu {
@@ -67,15 +68,6 @@ void write_gz(const std::string& path, const std::string& text) {
   w.write(text);
   w.close();
 }
-
-// AddressSanitizer, as gcc (__SANITIZE_ADDRESS__) and clang (__has_feature) say it.
-#if defined(__SANITIZE_ADDRESS__)
-#define L6470EMU_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define L6470EMU_TEST_ASAN 1
-#endif
-#endif
 
 /// Generously above what the program needs for these inputs (~10 MB), far below what any of
 /// them unpacks to (100 MB and more). A sanitizer build's program keeps freed memory in
