@@ -6,6 +6,7 @@
 
 #include "tools/cli_errors.hpp"
 #include "tools/cmd_plot.hpp"
+#include "tools/cmd_report.hpp"
 #include "tools/cmd_units.hpp"
 #include "tools/cmd_campaign.hpp"
 #include "tools/cmd_coverage.hpp"
@@ -65,6 +66,7 @@ int main(int argc, char** argv) {
   l6470emu::add_trace_commands(app);             // replay, decode, convert
   l6470emu::add_plot_command(app);               // plot (python3 -m l6470emu.plot)
   l6470emu::add_units_command(app);              // units (register values <-> step/s, mA, ...)
+  l6470emu::add_report_command(app);             // report (one HTML page per run)
 
   // Every usage error: one line, a suggestion for a near miss, exit status 2.
   if (auto status = l6470emu::parse_command_line(app, argc, argv, std::cout, std::cerr)) return *status;

@@ -56,6 +56,13 @@ std::string count_option(const std::string& text) {
   return {};
 }
 
+/// Ends the program with `status` when it is not 0 (CLI11 returns it from main quietly).
+void finish(int status) {
+  if (status != 0) throw CLI::RuntimeError(status);
+}
+
+}  // namespace
+
 void add_trace_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("TRACE", a.path, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
       ->required();
@@ -85,13 +92,6 @@ void add_number_from_option(CLI::App* sub, std::string& value) {
   sub->add_option("--number-from", value,
                   "which end chip 0 is at: miso (chip 0 drives MISO, the default) or mosi (chip 0 reads the host's MOSI)");
 }
-
-/// Ends the program with `status` when it is not 0 (CLI11 returns it from main quietly).
-void finish(int status) {
-  if (status != 0) throw CLI::RuntimeError(status);
-}
-
-}  // namespace
 
 void add_trace_commands(CLI::App& app) {
   auto replay = std::make_shared<ReplayArgs>();

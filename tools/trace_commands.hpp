@@ -83,6 +83,12 @@ struct ConvertArgs {
 /// `l6470emu convert`: 0, or 2 on bad input.
 int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err);
 
+/// Adds the options every trace subcommand takes (TRACE, --format, --chain, --board, --select,
+/// --framing, --sigrok-decoder, --max-frames) to `sub`, into `a`.
+void add_trace_options(CLI::App* sub, TraceArgs& a);
+/// Adds --number-from to `sub`, into `value`.
+void add_number_from_option(CLI::App* sub, std::string& value);
+
 /// Adds replay, decode and convert to `app`. They run in CLI11 callbacks and end the
 /// program through CLI::RuntimeError with their exit status when it is not 0.
 void add_trace_commands(CLI::App& app);

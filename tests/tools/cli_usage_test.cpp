@@ -27,9 +27,9 @@ TEST(UsageErrors, AMisspeltSubcommandIsNamedWithTheNearestOne) {
   expect_usage_error("dcode x", "l6470emu: unknown subcommand 'dcode'; did you mean 'decode'?");
   expect_usage_error("frobnicate",
                      "l6470emu: unknown subcommand 'frobnicate' (demo, tables, serve, ctl, run, campaign, coverage, replay, decode, convert, "
-                     "plot, units; l6470emu --help)");
+                     "plot, units, report; l6470emu --help)");
   expect_usage_error("", "l6470emu: a subcommand is required: demo, tables, serve, ctl, run, campaign, coverage, replay, decode, convert, "
-                         "plot, units (l6470emu --help)");
+                         "plot, units, report (l6470emu --help)");
   expect_usage_error("--verison", "l6470emu: unknown option '--verison'; did you mean '--version'?");
   expect_usage_error("--decode x", "l6470emu: unknown option '--decode'; did you mean 'decode'?");
 }
@@ -60,7 +60,7 @@ TEST(UsageErrors, AMisspeltCtlCommandIsNamedBeforeAnyDaemonIsAsked) {
 
 TEST(UsageErrors, AnOptionOfAnotherSubcommandSaysWhoseItIs) {
   expect_usage_error("decode x -o y",
-                     "l6470emu decode: unknown option '-o' ('-o' is an option of convert and plot) (l6470emu decode --help)");
+                     "l6470emu decode: unknown option '-o' ('-o' is an option of convert, plot and report) (l6470emu decode --help)");
 }
 
 TEST(UsageErrors, MissingAndBadValuesAreOneLineWithStatusTwo) {
