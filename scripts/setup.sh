@@ -16,6 +16,7 @@ packages=(
   libyaml-cpp-dev spi-tools golang-go
   lcov
   python3-sphinx python3-myst-parser python3-breathe doxygen chromium chromium-driver python3-selenium
+  libjs-dygraphs
 )
 
 missing=()
