@@ -234,32 +234,63 @@ class Collapser {
   std::deque<Pending> tail_;
 };
 
-/// Keeps timeline entries within the row budget: the budget left is spread over the time
-/// slices left; rows beyond a slice's share become summarised spans, except frames with
-/// commands, diagnostics or divergences, which have a reserve of their own.
+/// The time slices the timeline's row budget is shared over.
+constexpr std::size_t kSlices = 1000;
+
+std::size_t slice_of(Tick t, Tick end) {
+  return std::min<std::size_t>(kSlices - 1, static_cast<std::size_t>(static_cast<unsigned __int128>(t) * kSlices / std::max<Tick>(end, 1)));
+}
+
+/// Each slice's share of `budget` rows when slice i has counts[i]: all of them up to a level
+/// chosen so that the shares add up to the budget (slices with few rows keep them all; the
+/// others share what is left equally).
+std::vector<std::size_t> water_fill(const std::vector<std::size_t>& counts, std::size_t budget) {
+  std::size_t lo = 0, hi = *std::max_element(counts.begin(), counts.end());
+  auto total = [&](std::size_t level) {
+    std::size_t n = 0;
+    for (std::size_t c : counts) n += std::min(c, level);
+    return n;
+  };
+  while (lo < hi) {  // the highest level whose total fits
+    const std::size_t mid = lo + (hi - lo + 1) / 2;
+    if (total(mid) <= budget)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  std::vector<std::size_t> share(counts.size());
+  for (std::size_t i = 0; i < counts.size(); ++i) share[i] = std::min(counts[i], lo);
+  return share;
+}
+
+/// Keeps timeline entries within the row budget. Without shares it keeps everything (a trace
+/// with fewer frames than the budget); with them (from a counting pass, water_fill) each time
+/// slice keeps its first rows up to its share, and stands the rest as summarised spans, except
+/// frames with commands, diagnostics or divergences, which have a reserve of their own. A
+/// counting keeper only counts each slice's rows.
 class Keeper {
  public:
-  Keeper(ReportData& data, std::size_t budget, Tick end) : data_(data), budget_(budget), end_(std::max<Tick>(end, 1)) {
-    reserve_ = budget / 5;
-    budget_ -= reserve_;
-  }
+  Keeper(ReportData& data, std::size_t reserve, Tick end, const std::vector<std::size_t>* shares,
+         std::vector<std::size_t>* counts)
+      : data_(data), reserve_(reserve), end_(end), shares_(shares), counts_(counts) {}
 
   void add(ReportEntry&& e) {
-    const std::size_t slice = std::min<std::size_t>(
-        kSlices - 1, static_cast<std::size_t>(static_cast<unsigned __int128>(e.tick) * kSlices / end_));
+    const std::size_t slice = slice_of(e.tick, end_);
+    const std::size_t rows = e.rows.size();
+    if (counts_) {
+      (*counts_)[slice] += rows;
+      return;
+    }
     if (slice != slice_) {
       slice_ = slice;
       slice_kept_ = 0;
-      share_ = (budget_ - std::min(budget_, kept_)) / (kSlices - slice);
     }
-    const std::size_t rows = e.rows.size();
-    bool keep = slice_kept_ + rows <= std::max<std::size_t>(share_, 1) && kept_ + rows <= budget_;
-    if (!keep && significant(e) && reserve_used_ + rows <= reserve_) {
+    bool keep = shares_ == nullptr || slice_kept_ + rows <= (*shares_)[slice];
+    if (keep) {
+      slice_kept_ += rows;
+    } else if (significant(e) && reserve_used_ + rows <= reserve_) {
       keep = true;
       reserve_used_ += rows;
-    } else if (keep) {
-      slice_kept_ += rows;
-      kept_ += rows;
     }
     if (keep) {
       close_gap();
@@ -285,7 +316,6 @@ class Keeper {
   }
 
  private:
-  static constexpr std::size_t kSlices = 1000;
   static bool significant(const ReportEntry& e) {
     for (const ReportRow& r : e.rows)
       if (r.diverged || r.diagnostic || commands(r) > 0) return true;
@@ -297,22 +327,28 @@ class Keeper {
   }
 
   ReportData& data_;
-  std::size_t budget_, reserve_ = 0, reserve_used_ = 0, kept_ = 0;
+  std::size_t reserve_, reserve_used_ = 0;
   Tick end_;
-  std::size_t slice_ = static_cast<std::size_t>(-1), slice_kept_ = 0, share_ = 0;
+  const std::vector<std::size_t>* shares_;
+  std::vector<std::size_t>* counts_;
+  std::size_t slice_ = static_cast<std::size_t>(-1), slice_kept_ = 0;
   std::optional<ReportGap> gap_;
 };
 
 /// The main pass: frames, what each chip made of them, the chips' state after each.
 class FramePass {
  public:
-  FramePass(ReportData& data, Chain& chain, const ReportOptions& o, const std::string& name, Tick end, Tick shown_to)
+  /// `shares`: the timeline's row share of each time slice (nullptr: keep every row). With
+  /// `counts`, the pass only counts each slice's rows (for water_fill) and extracts nothing else.
+  FramePass(ReportData& data, Chain& chain, const ReportOptions& o, const std::string& name, Tick end, Tick shown_to,
+            const std::vector<std::size_t>* shares = nullptr, std::vector<std::size_t>* counts = nullptr)
       : data_(data),
         chain_(chain),
         options_(o),
         numbering_(o.number_from, chain.size()),
         watch_(name, numbering_),
-        keeper_(data, o.limits.timeline_rows, end),
+        keeper_(data, o.limits.timeline_rows / 5, end, shares, counts),
+        counting_(counts != nullptr),
         collapser_([this](ReportEntry&& e) { keeper_.add(std::move(e)); }),
         tracker_(chain, [this](const ProtocolEvent& e) { on_event(e); }, o.number_from),
         end_(end),
@@ -358,6 +394,10 @@ class FramePass {
     pending_.back().row.diverged = watch_.frames_diverged() != before;
     tracker_.end_frame();
     ++frames_;
+    if (counting_) {
+      release();
+      return;
+    }
     const Tick at = e.end();
     for (std::size_t k = 0; k < chain_.size(); ++k) {
       if (decoded_[k] == 2) look_registers(k, at);
@@ -372,7 +412,7 @@ class FramePass {
     if (e.chip >= chain_.size()) throw TraceError(trace_name, e.line, trace_chip_outside_chain(e.chip, chain_.size()));
     follow(e.tick);
     tracker_.apply(e);
-    if (e.kind == TraceEventKind::advance) return;
+    if (e.kind == TraceEventKind::advance || counting_) return;
     ReportChip& c = chips_[e.chip];
     if (e.is_observation()) {
       watch_.observation(e, observed_level(chain_.chip(e.chip), e.pin));
@@ -396,13 +436,16 @@ class FramePass {
     release();
     collapser_.finish();
     keeper_.finish();
+    if (counting_) return;
     follow(shown_to_);
     for (std::size_t k = 0; k < chain_.size(); ++k) {
       look_state(k, chain_.now());
       look_phase(k, chain_.now());
+      thinned_ = thinned_ || chips_[k].states.size() > state_budget_ || chips_[k].phase.size() > phase_budget_;
       thin_states(chips_[k].states, 0, shown_to_, state_budget_);
       thin_phase(chips_[k].phase, 0, shown_to_, phase_budget_);
     }
+    if (thinned_) data_.summarised = true;
     data_.frames = frames_;
     data_.divergent_frames = watch_.frames_diverged();
     data_.divergent_pins = watch_.pins_diverged();
@@ -484,7 +527,7 @@ class FramePass {
 
   /// Lets the chain run up to `until`, looking at the phase drive of the chips that move.
   void follow(Tick until) {
-    while (chain_.now() < until) {
+    while (!counting_ && chain_.now() < until) {
       bool moving = false;
       for (std::size_t k = 0; k < chain_.size() && !moving; ++k) moving = motion_active(chain_.chip(k).motion());
       if (!moving) {
@@ -518,7 +561,10 @@ class FramePass {
       }
     }
     v.push_back(s);
-    if (v.size() > 8 * state_budget_) thin_states(v, 0, shown_to_, state_budget_);
+    if (v.size() > 8 * state_budget_) {
+      thin_states(v, 0, shown_to_, state_budget_);
+      thinned_ = true;
+    }
   }
 
   void look_phase(std::size_t k, Tick t) {
@@ -531,7 +577,10 @@ class FramePass {
       return;
     }
     v.push_back({t, d.coil_a, d.coil_b});
-    if (v.size() > 8 * phase_budget_) thin_phase(v, 0, shown_to_, phase_budget_);
+    if (v.size() > 8 * phase_budget_) {
+      thin_phase(v, 0, shown_to_, phase_budget_);
+      thinned_ = true;
+    }
   }
 
   void look_registers(std::size_t k, Tick t) {
@@ -620,6 +669,8 @@ class FramePass {
   ChipNumbering numbering_;
   DivergenceWatch watch_;
   Keeper keeper_;
+  bool counting_;
+  bool thinned_ = false;  // a series was thinned on the way
   Collapser collapser_;
   std::vector<ReportChip> chips_;
   std::vector<Seen> seen_;
@@ -704,9 +755,14 @@ ReportData make_report_data(const TraceFile& file, const TraceWorld& world, cons
   data.numbering = describe_numbering(options.number_from);
   data.notes = file.header().notes;
   if (world.overrides) data.notes.push_back(world.override_note(file.path()));
+  std::uint64_t frames = 0;
   {
     auto in = file.read();
-    data.end_tick = trace_end_tick(*in);
+    TraceEvent e;
+    while (in->next(e)) {
+      data.end_tick = std::max(data.end_tick, e.kind == TraceEventKind::frame ? e.end() : e.tick);
+      frames += e.kind == TraceEventKind::frame;
+    }
   }
   Chain probe = world.make_chain();
   const std::size_t n = probe.size();
@@ -722,10 +778,29 @@ ReportData make_report_data(const TraceFile& file, const TraceWorld& world, cons
     motion = sample_motion(*in, chain, data.end_tick, mo);
     data.shown_to = motion.to;
   }
+  // More frames than the timeline keeps: a first pass counts the rows each time slice would
+  // show, so that the budget goes where the rows are.
+  std::optional<std::vector<std::size_t>> shares;
+  if (frames > options.limits.timeline_rows) {
+    std::vector<std::size_t> counts(kSlices);
+    auto in = file.read();
+    Chain chain = world.make_chain();
+    ReportData scratch;
+    FramePass pass(scratch, chain, options, in->header().name, data.end_tick, data.shown_to, nullptr, &counts);
+    TraceEvent e;
+    while (in->next(e)) {
+      if (e.kind == TraceEventKind::frame)
+        pass.frame(e);
+      else
+        pass.other(e, in->header().name);
+    }
+    pass.finish();
+    shares = water_fill(counts, options.limits.timeline_rows - options.limits.timeline_rows / 5);
+  }
   {
     auto in = file.read();
     Chain chain = world.make_chain();
-    FramePass pass(data, chain, options, in->header().name, data.end_tick, data.shown_to);
+    FramePass pass(data, chain, options, in->header().name, data.end_tick, data.shown_to, shares ? &*shares : nullptr);
     TraceEvent e;
     while (in->next(e)) {
       if (e.kind == TraceEventKind::frame)

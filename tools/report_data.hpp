@@ -25,10 +25,10 @@ namespace l6470emu {
 /// spans (their frames counted exactly), and each series keeps, per time slice, its first and
 /// last sample and those with the extremes.
 struct ReportLimits {
-  std::size_t timeline_rows = 60'000;   ///< frame rows kept in full, a repeated group counted once per row
+  std::size_t timeline_rows = 100'000;   ///< frame rows kept in full, a repeated group counted once per row
   std::size_t motion_points = 60'000;   ///< position/speed samples, all chips together (sample_motion)
-  std::size_t state_samples = 45'000;   ///< register samples after frames and events, all chips together
-  std::size_t phase_samples = 90'000;   ///< phase drive samples, all chips together
+  std::size_t state_samples = 60'000;   ///< register samples after frames and events, all chips together
+  std::size_t phase_samples = 120'000;  ///< phase drive samples, all chips together
   std::size_t input_edges = 20'000;     ///< SW/STCK/STBY input edges kept
   std::size_t findings = 1'000;         ///< diagnostics, sanitizer findings and divergences kept, each
   std::size_t register_changes = 20'000;  ///< register writes kept (the rest counted)

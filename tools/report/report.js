@@ -77,9 +77,9 @@
       el('span', {}, `${fmtS(D.end)} s`), el('span', {}, `${findingsTotal} findings`)));
   if (D.first_divergence) app.append(el('div', {class: 'banner', role: 'alert'}, 'DIVERGED: ' + D.first_divergence +
     ' — from there on the page shows the emulator\'s model of the run, not what the trace holds.'));
-  if (D.summarised) app.append(el('div', {class: 'notice'}, 'This run is longer than a page shows one by one: hatched ' +
-    'spans of the timeline stand for frames counted but not listed, and the series keep per time slice their first, ' +
-    'last and extreme samples (docs/report.md, "Size").'));
+  if (D.summarised) app.append(el('div', {class: 'notice'}, 'This run is longer than a page shows one by one: grey ' +
+    'spans of the timeline marked "frames summarised" stand for frames counted but not listed, and the series keep per time ' +
+    'slice their first, last and extreme samples (docs/report.md, "Size").'));
   app.append(el('nav', {}, ...[['timeline', 'Timeline'], ['chips', 'Chips'], ['findings', `Findings (${findingsTotal})`],
     ['coverage', 'Coverage'], ['campaign', 'Campaign']].filter(([id]) => (id !== 'coverage' || D.coverage) && (id !== 'campaign' || D.campaign))
     .map(([id, t]) => el('a', {href: '#' + id}, t))));
@@ -100,7 +100,7 @@
   const lanesDiv = el('div', {class: 'chart', id: 'lanes', style: `height:${120 + 95 * nChain}px`});
   app.append(lanesDiv);
   const table = el('table', {class: 'frames', id: 'frames'});
-  table.append(el('colgroup', {}, el('col', {style: 'width:5em'}), el('col', {style: 'width:7.5em'}), el('col', {style: 'width:5em'}),
+  table.append(el('colgroup', {}, el('col', {style: 'width:6.5em'}), el('col', {style: 'width:9.5em'}), el('col', {style: 'width:5em'}),
     el('col', {style: 'width:11%'}), el('col', {style: 'width:11%'}), ...chips.map(() => el('col', {}))));
   table.append(el('thead', {}, el('tr', {}, el('th', {class: 'num'}, 'frame'), el('th', {class: 'num'}, 't (s)'), el('th', {class: 'num'}, 'CS µs'),
     el('th', {}, 'MOSI'), el('th', {}, 'MISO'), ...chips.map((c) => el('th', {}, `chip ${c.number} (${c.variant})`)))));
@@ -459,4 +459,5 @@
     setCursor: (i) => setCursor(i, true), setCursorSeconds: (t) => setCursorTick(Math.round(t / TICK)), frame: frameAt,
     window: () => charts[0].g.xAxisRange()};
   setCursor(0, false);
+  window.l6470emuReport.readyMs = performance.now();  // since the navigation began: how long the page took to open
 })();
