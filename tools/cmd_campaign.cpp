@@ -39,6 +39,7 @@
 #include "tools/cli_errors.hpp"
 #include "tools/output_check.hpp"
 #include "tools/campaign_report.hpp"
+#include "tools/cmd_report.hpp"
 #include "tools/run_outcome.hpp"
 #include "tools/trace_input.hpp"
 
@@ -230,6 +231,7 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
   cmd_->add_option("--shard", shard_, "run only shard K of N (K/N): reruns K-1, K-1+N, ...; join with campaign merge");
   cmd_->add_option("--json", json_, "write the report as JSON (reproducing scenarios are written beside it)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report: one testcase per fault and chip");
+  cmd_->add_option("--html", html_, "write the report page (docs/report.md): the clean run's trace with the matrix");
   cmd_->add_option("--fail-on", fail_on_,
                    "verdicts that fail the campaign (default silent_failure,hang,deadlock,crash; also detected, survived, "
                    "survived-unread)");
@@ -336,6 +338,11 @@ int CampaignCommand::run_campaign() {
       if (const std::string why = output_problem(*out, inputs); !why.empty())
         return usage("cannot write " + quoted_text(*out) + ": " + why);
   if (!json_.empty() && json_ == junit_) return usage("--json and --junit name the same file");
+  if (!html_.empty()) {
+    if (const std::string why = output_problem(html_, inputs); !why.empty()) return usage("cannot write " + quoted_text(html_) + ": " + why);
+    if (html_ == json_ || html_ == junit_) return usage("--html names the same file as another output");
+    if (config.chains.size() != 1) return usage("--html shows one chain: the board has " + std::to_string(config.chains.size()));
+  }
   // Coverage: the clean run's only (L6470EMU_COVERAGE asks the same); the faulted reruns collect none.
   if (const char* env = std::getenv(kCoverageEnv); env && *env && cmd_->count("--coverage") == 0) coverage_ = env;
   unsetenv(kCoverageEnv);
@@ -681,6 +688,15 @@ int CampaignCommand::run_campaign() {
   if (!junit_.empty() && !write_file(junit_, campaign_junit(report, fail_on))) {
     std::cerr << "l6470emu campaign: cannot write " << junit_ << "\n";
     status = kRunUsage;
+  }
+  if (!html_.empty()) {  // the clean run's page with the matrix
+    ReportArgs page;
+    page.trace.path = clean_trace;
+    if (!coverage_.empty()) page.coverage = {coverage_};
+    page.campaign_report = report;
+    page.output = html_;
+    page.title = "campaign: " + program_.front();
+    if (run_report(page, std::cerr, "campaign --html") != 0) status = kRunUsage;
   }
   if (g_stop.load()) {
     std::cerr << "l6470emu campaign: stopped by signal " << g_stop.load() << " after " << report.reruns.size() << " of "

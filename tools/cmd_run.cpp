@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,6 +33,7 @@
 #include "linux/scenario_file.hpp"
 #include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"
+#include "tools/cmd_report.hpp"
 #include "tools/kernel_nodes.hpp"
 #include "tools/output_check.hpp"
 #include "tools/xml_text.hpp"
@@ -382,6 +384,7 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
+  cmd_->add_option("--html", html_, "write the run's report page to this file (docs/report.md; with --record, from that trace)");
   cmd_->add_option("--coverage", coverage_,
                    "collect interface coverage and merge it into this file (every process of the program; docs/coverage.md)");
   cmd_->add_option("--nodes", nodes_,
@@ -422,6 +425,23 @@ std::optional<int> RunCommand::run() {
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   if (text.find("check=") == std::string::npos) config.check.level = CheckLevel::error;
+  // --html without --record: the run is recorded into a temporary trace for the page.
+  struct TempTrace {
+    std::string path;
+    ~TempTrace() {
+      if (!path.empty()) unlink(path.c_str());
+    }
+  } temp_trace;
+  if (!html_.empty()) {
+    if (config.chains.size() != 1) return usage("l6470emu run: --html shows one chain: the board has " + std::to_string(config.chains.size()));
+    if (record_.empty()) {
+      try {
+        temp_trace.path = record_ = temp_file("trace", "");
+      } catch (const std::exception& e) {
+        return usage(std::string("l6470emu run: --html: ") + e.what());
+      }
+    }
+  }
   if (!record_.empty()) config.trace = record_;
   // The reports, checked before the program starts: one that cannot be written, or that is an
   // input, ends the run here (an output never overwrites an input).
@@ -436,6 +456,12 @@ std::optional<int> RunCommand::run() {
       if (const std::string why = output_problem(record_, inputs); !why.empty())
         return usage("l6470emu run: cannot write --record " + quoted_text(record_) + ": " + why);
     if (!junit_.empty() && junit_ == record_) return usage("l6470emu run: --junit and --record name the same file");
+    if (!html_.empty()) {
+      if (const std::string why = output_problem(html_, inputs); !why.empty())
+        return usage("l6470emu run: cannot write --html " + quoted_text(html_) + ": " + why);
+      if (html_ == junit_ || html_ == record_ || html_ == outcome_ || html_ == coverage_)
+        return usage("l6470emu run: --html names the same file as another of the run's outputs");
+    }
     // L6470EMU_COVERAGE in run's own environment asks the same as --coverage (a suite run with it set).
     const char* env_coverage = std::getenv(kCoverageEnv);
     if (cmd_->count("--coverage") == 0 && env_coverage && *env_coverage) coverage_ = env_coverage;
@@ -660,6 +686,18 @@ std::optional<int> RunCommand::run() {
       std::cerr << "l6470emu run: cannot write the JUnit report " << junit_ << "; exit 2\n";
       return kRunUsage;
     }
+  }
+  if (!html_.empty()) {  // the page of what was recorded (nothing is when the program never opened the chain)
+    ReportArgs page;
+    page.trace.path = record_;
+    if (!coverage_.empty() && std::filesystem::exists(coverage_)) page.coverage = {coverage_};
+    page.output = html_;
+    page.title = "run: " + program_.front();
+    struct stat st {};
+    if (stat(record_.c_str(), &st) != 0 || st.st_size == 0)
+      std::cerr << "l6470emu run: no page: the program never used the chain (nothing was recorded)\n";
+    else if (run_report(page, std::cerr, "run --html") != 0)
+      return kRunUsage;
   }
   return status;
 }

@@ -18,7 +18,8 @@ class RunCommand {
 
  private:
   CLI::App* cmd_ = nullptr;
-  std::string board_file_, chain_, scenario_file_, time_ = "virtual", nodes_ = "preload", timeout_, junit_, record_, outcome_, coverage_;
+  std::string board_file_, chain_, scenario_file_, time_ = "virtual", nodes_ = "preload", timeout_, junit_, record_, outcome_, coverage_,
+      html_;
   bool verbose_ = false;
   std::vector<std::string> program_;
 };

@@ -4,7 +4,8 @@ python3-selenium): every fixture trace, and a campaign driver's clean run with i
 file and its campaign's JSON report. For each page: no JavaScript error and nothing loaded from
 anywhere, the timeline holds as many frames as `decode` counts, the cursor moved to a known
 instant (typed into the page's time box, as a person would) shows the ABS_POS and STATUS that
-`decode` shows there, the arrow keys move it frame by frame and + zooms. Takes the screenshot
+`decode` shows there, the arrow keys move it frame by frame and + zooms; `run --html` and
+`campaign --html` write such pages too. Takes the screenshot
 docs/report.md shows (L6470EMU_UPDATE_DOCS=1 writes it to docs/report.png).
 
 Usage: report_browser_test.py L6470EMU SOURCE_DIR WORK_DIR CAMPAIGN_DRIVER
@@ -167,6 +168,21 @@ if r.returncode == 0:
     links = browser.find_elements(By.CSS_SELECTOR, "table.matrix a[href^='#rerun-']")
     check(len(links) == reruns, "every matrix cell links to its rerun (%d links)" % len(links))
     check("Interface coverage:" in browser.find_element(By.ID, "coverage").text, "the coverage report is on the page")
+
+# run --html and campaign --html write the same pages in one go.
+page = os.path.join(work, "run.html")
+r = run("run", "--chain", "chips=L6470", "--record", os.path.join(camp, "run.trace"), "--html", page, "--", driver)
+check(r.returncode == 0 and os.path.exists(page), "run --html writes the page (%s)" % r.stderr.strip().splitlines()[-1:])
+if os.path.exists(page):
+    check_page("run --html", os.path.join(camp, "run.trace"), page)
+page = os.path.join(work, "campaign-html.html")
+r = subprocess.run([l6470emu, "campaign", "--chain", "chips=L6470", "--faults", "ocd,uvlo", "--html", page, "--", driver],
+                   cwd=camp, capture_output=True, text=True, timeout=300)
+check(os.path.exists(page) and "campaign --html: " in r.stderr, "campaign --html writes the page (%s)" % r.stderr.strip().splitlines()[-1:])
+if os.path.exists(page):
+    open_page(page)
+    check(not errors(), "campaign --html: no JavaScript error")
+    check(len(browser.find_elements(By.CSS_SELECTOR, "table.matrix a[href^='#rerun-']")) > 0, "campaign --html: the matrix is on the page")
 
 # The screenshot the docs show: three chips, the cursor on the Move commands, zoomed in.
 page = os.path.join(work, "docs.html")
