@@ -96,7 +96,7 @@ if(L6470EMU_HELP2MAN)
   install(FILES ${PROJECT_BINARY_DIR}/l6470emu.1.gz DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
   # A page per subcommand, l6470emu-run(1) and so on, each from its own --help.
   set(L6470EMU_SUBCOMMAND_PAGES demo tables serve ctl run campaign campaign-merge coverage-report coverage-merge
-      replay decode convert plot units)
+      replay decode convert plot units report)
   set(sub_pages "")
   foreach(sub ${L6470EMU_SUBCOMMAND_PAGES})
     set(page ${PROJECT_BINARY_DIR}/man/l6470emu-${sub}.1)

@@ -177,6 +177,7 @@
   // The lanes: per chip BUSY, FLAG, SW (as the emulated chip has them), STCK and STBY (as the trace
   // drove them); above them a row per chip with the frames, drawn under the chart.
   const LANES = ['BUSY', 'FLAG', 'SW', 'STCK', 'STBY'];
+  const RIGHT_GAP = 59;  // where the motion charts have their SPEED axis: the time axes line up
   const laneBase = (ci, l) => (nChain - 1 - ci) * LANES.length + (LANES.length - 1 - l);
   const frameRowY = (ci) => nChain * LANES.length + (nChain - 1 - ci) + 0.1;
   {
@@ -211,7 +212,7 @@
     chips.forEach((c, ci) => { LANES.forEach((l, li) => ticks.push({v: laneBase(ci, li) + 0.35, label: `${c.number} ${l}`}));
       ticks.push({v: frameRowY(ci) + 0.4, label: `chip ${c.number}`}); });
     chart(lanesDiv, rows, {
-      labels, colors, stepPlot: true, connectSeparatedPoints: true, strokeWidth: 1.5, legend: 'never',
+      labels, colors, stepPlot: true, connectSeparatedPoints: true, strokeWidth: 1.5, legend: 'never', rightGap: RIGHT_GAP,
       valueRange: [-0.3, nChain * LANES.length + nChain + 0.2], yAxisLabelWidth: 70,
       axes: {y: {ticker: () => ticks, drawGrid: false}, x: {valueFormatter: (x) => 't=' + x.toFixed(6) + ' s',
         axisLabelFormatter: (x) => x.toPrecision(6).replace(/\.?0+$/, '') + ' s'}},
@@ -302,17 +303,23 @@
       labels: ['t', 'ABS_POS', 'SPEED (step/s)'], colors: ['#0b5394', '#9a4a00'], ylabel: `ABS_POS (1/${c.motion.microsteps} step)`,
       y2label: 'step/s', series: {'SPEED (step/s)': {axis: 'y2'}}, strokeWidth: 1.5, yAxisLabelWidth: 70,
       axes: {x: {valueFormatter: (x) => 't=' + x.toFixed(6) + ' s', axisLabelFormatter: (x) => x.toPrecision(6).replace(/\.?0+$/, '') + ' s'},
-             y2: {independentTicks: true}},
+             y2: {independentTicks: true, axisLabelWidth: 50}},
     });
     const p = c.ph;
     chart(phaseDiv, p.t.map((t, i) => [sec(t), p.a[i] / 10, p.b[i] / 10]).concat([[sec(D.shown_to), p.a[p.a.length - 1] / 10, p.b[p.b.length - 1] / 10]]), {
       labels: ['t', 'coil A %', 'coil B %'], colors: ['#5b2a86', '#1e6b30'], stepPlot: true, valueRange: [-105, 105], yAxisLabelWidth: 70,
-      ylabel: 'phase drive %', strokeWidth: 1.5,
+      ylabel: 'phase drive %', strokeWidth: 1.5, rightGap: RIGHT_GAP,
     });
     return {c, regs};
   });
   const FIELD_MEANING = {MOT_STATUS: ['stopped', 'accelerating', 'decelerating', 'constant speed'], DIR: ['reverse', 'forward'],
     TH_STATUS: ['normal', 'warning', 'bridge shutdown', 'device shutdown']};
+  function statusWords(c, status) {  // the fields that are set, by name ("HiZ FWD MOT_STATUS=3 UVLO")
+    return c.status_fields.map(([name, bit, width, low]) => {
+      const v = (status >> bit) & ((1 << width) - 1);
+      return width > 1 ? (v ? `${name}=${v}` : '') : (low ? v === 0 : v === 1) ? name : '';
+    }).filter((w) => w).join(' ');
+  }
   function renderRegisters() {
     const f = frameAt(cursor.frame), at = f.gap ? cursor.tick : f.tick + f.dur;
     for (const {c, regs} of panels) {
@@ -326,7 +333,7 @@
       for (const [addr, name] of c.live_registers) {
         const v = {ABS_POS: c.st.pos[si], EL_POS: c.st.el[si], SPEED: c.st.speed[si], STATUS: status}[name];
         const meaning = {ABS_POS: `${v} microsteps`, EL_POS: `step ${v >> 7}, microstep ${v & 127} of 128`,
-          SPEED: `${(Math.abs(v) * STEP_PER_S).toFixed(2)} step/s${v < 0 ? ' (reverse)' : ''}`, STATUS: ''}[name];
+          SPEED: `${(Math.abs(v) * STEP_PER_S).toFixed(2)} step/s${v < 0 ? ' (reverse)' : ''}`, STATUS: statusWords(c, v)}[name];
         values.set(addr, [name, name === 'STATUS' ? hex(v, 4) : String(v), meaning, true]);
       }
       const tb = el('tbody', {});
