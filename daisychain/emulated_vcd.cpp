@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "daisychain/phase_drive.hpp"
 #include "daisychain/protocol_tracker.hpp"
 #include "spi/export_vcd.hpp"
 
@@ -13,7 +14,7 @@ namespace l6470emu {
 namespace {
 
 struct ChipWires {
-  int busy, flag, sw, stck, stby, abs_pos;
+  int busy, flag, sw, stck, stby, abs_pos, coil_a, coil_b;
 };
 
 }  // namespace
@@ -26,9 +27,11 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
   for (std::size_t k = 0; k < n; ++k) {
     const std::string scope = "chip" + std::to_string(k);
     const Chip& c = chain.chip(k);
+    const PhaseDrive d = phase_drive(c);
     wires[k] = {w.wire(scope, "BUSY", c.busy_sync_pin()), w.wire(scope, "FLAG", c.flag_pin()),
                 w.wire(scope, "SW", c.sw_pin()),          w.wire(scope, "STCK", false),
-                w.wire(scope, "STBY", c.spi_enabled()),   w.number(scope, "ABS_POS", c.position())};
+                w.wire(scope, "STBY", c.spi_enabled()),   w.number(scope, "ABS_POS", c.position()),
+                w.number(scope, "COIL_A", d.coil_a),      w.number(scope, "COIL_B", d.coil_b)};
   }
   ProtocolTracker tracker(chain);
   const Tick step = std::max<Tick>(options.sample_ticks, 1);
@@ -40,6 +43,9 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
       w.change(ns, wires[k].busy, c.busy_sync_pin());
       w.change(ns, wires[k].flag, c.flag_pin());
       w.change(ns, wires[k].abs_pos, c.position());
+      const PhaseDrive d = phase_drive(c);
+      w.change(ns, wires[k].coil_a, d.coil_a);
+      w.change(ns, wires[k].coil_b, d.coil_b);
     }
   };
   // Samples from the chain's time up to (not including) `until` while anything moves.

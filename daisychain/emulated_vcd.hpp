@@ -1,6 +1,7 @@
 // VCD export of a trace run through an emulated chain: the SPI wires bit by bit (mode 3)
-// plus, per chip, BUSY and FLAG as the emulator drives them, SW, STCK and STBY as the
-// trace drives them, and ABS_POS as a value. Levels between events are sampled, not exact.
+// plus, per chip, BUSY and FLAG as the emulator drives them, SW, STCK and STBY as the trace
+// drives them, ABS_POS, and the phase drive's COIL_A and COIL_B (daisychain/phase_drive.hpp, in
+// tenths of a percent of full scale) as values. Levels between events are sampled, not exact.
 #pragma once
 
 #include <iosfwd>

@@ -80,7 +80,8 @@ TEST(VcdExport, CarriesTheTracesPinsAndEmulatedChipsCarryPositions) {
   Chain chain(2);
   export_emulated_vcd(t, chain, emulated);
   const std::string v = emulated.str();
-  for (const char* name : {" BUSY $end", " FLAG $end", " SW $end", " STCK $end", " STBY $end", " ABS_POS $end"})
+  for (const char* name : {" BUSY $end", " FLAG $end", " SW $end", " STCK $end", " STBY $end", " ABS_POS $end",
+                           " COIL_A $end", " COIL_B $end"})
     EXPECT_NE(v.find(name), std::string::npos) << name;
   EXPECT_NE(v.find("r256 "), std::string::npos);  // chip 1 ends its Move at ABS_POS 256
 }
