@@ -203,7 +203,11 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
     }
     case Op::spi_message: {
       const std::size_t n = static_cast<std::size_t>(req.arg);
-      if (n > 4096 || payload.size() < n * sizeof(spi_ioc_transfer)) {
+      if (n > kMaxTransfers) {  // no spidev ioctl can carry more (a raw client's packet)
+        reply.result = -EINVAL;
+        return;
+      }
+      if (payload.size() < n * sizeof(spi_ioc_transfer)) {
         reply.result = -EPROTO;
         return;
       }

@@ -61,6 +61,9 @@ inline constexpr std::uint32_t kRefusalKind = 0x52454655;  // "REFU"
 
 /// Largest data of a message: bufsiz is at most 4 MiB (config), tx and rx each.
 inline constexpr std::size_t kMaxMessage = std::size_t{4} << 20;
+/// Most transfers of one SPI_IOC_MESSAGE, as the kernel's spidev takes them: the ioctl's size
+/// field is 14 bits, 511 transfers of 32 bytes (so at most 511 x 65.535 ms of delays).
+inline constexpr std::size_t kMaxTransfers = 511;
 /// Largest packet: a header, 511 transfers (_IOC_SIZE is 14 bits) and the tx data.
 inline constexpr std::size_t kMaxPacket = kMaxMessage + 16384 + 64;
 

@@ -376,5 +376,34 @@ TEST(DaemonProtocol, AnEmptySpiMessageIsAnsweredWithoutTouchingTheBus) {
   close(f.fd);
 }
 
+TEST(DaemonProtocol, AMessageOfMoreTransfersThanSpidevTakesIsRefusedAsTheKernelWould) {
+  // 512 transfers of 1 byte with the longest delay each: 33 s of bus time at 511, refused at 512
+  // (a raw client's packet; no SPI_IOC_MESSAGE can carry more than 511).
+  ParseResult p = parse_board_config(kChain, "test");
+  ASSERT_TRUE(p.config);
+  DiagnosticLog log("off");
+  DeviceBoard board(*p.config, log);
+  const NewFile f = board.open(0, true);
+  for (const std::size_t n : {std::size_t{512}, std::size_t{4096}}) {
+    const std::size_t payload = n * sizeof(spi_ioc_transfer) + n;  // the transfers, then their tx bytes
+    RequestHeader req{static_cast<std::uint32_t>(Op::spi_message), static_cast<std::uint32_t>(payload), f.handle, n};
+    std::vector<std::uint8_t> packet(sizeof req + payload);
+    std::memcpy(packet.data(), &req, sizeof req);
+    for (std::size_t i = 0; i < n; ++i) {
+      spi_ioc_transfer t{};
+      t.tx_buf = 1;
+      t.len = 1;
+      t.delay_usecs = 65535;
+      std::memcpy(packet.data() + sizeof req + i * sizeof t, &t, sizeof t);
+    }
+    ReplyHeader reply;
+    std::vector<std::uint8_t> out;
+    int pass_fd = -1;
+    serve_request(board, {}, packet, reply, out, pass_fd);
+    EXPECT_EQ(reply.result, -EINVAL) << n << " transfers";
+  }
+  close(f.fd);
+}
+
 }  // namespace
 }  // namespace l6470emu::test
