@@ -351,7 +351,6 @@ class FramePass {
         counting_(counts != nullptr),
         collapser_([this](ReportEntry&& e) { keeper_.add(std::move(e)); }),
         tracker_(chain, [this](const ProtocolEvent& e) { on_event(e); }, o.number_from),
-        end_(end),
         shown_to_(std::max(end, shown_to)) {
     const std::size_t n = chain.size();
     chips_.resize(n);
@@ -680,7 +679,7 @@ class FramePass {
   std::uint64_t frames_ = 0;
   std::vector<std::uint8_t> rx_;
   ProtocolTracker tracker_;
-  Tick end_, shown_to_, step_ = 1;
+  Tick shown_to_, step_ = 1;
   std::size_t state_budget_ = 64, phase_budget_ = 64, register_budget_ = 64, input_budget_ = 64;
 };
 

@@ -736,7 +736,7 @@ TEST(CoverageData, ANonCoverageTextIsRefusedInOneLine) {
 // tests/fuzz/regressions/coverage/): a name holding "\n" or "\u001b" stays one line and puts no
 // escape sequence on a terminal.
 TEST(CoverageData, ARefusalQuotesTheFilesNamesOnOneLineWithoutControlCharacters) {
-  for (const std::string text :
+  for (const std::string& text :
        {std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L6470":{"hit":{"\n":[]}}}})"),
         std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L64\u001b[2J70":{}}})"),
         std::string(R"({"format":"l6470emu-coverage","version":1,"variants":{"L6470":{"hit":{"commands":["Move\nFWD"]}}}})")}) {
@@ -809,7 +809,7 @@ TEST(CoverageFile, AMergeIntoAMissingOrEmptyFileStartsIt) {
 
 TEST(CoverageFile, ACorruptOrForeignFileIsLeftAsItIsAndTheMergeSaysWhy) {
   TempDir dir;
-  for (const std::string text : {std::string("{\"format\": \"l6470emu-coverage\", \"version\": 1, \"vari"),
+  for (const std::string& text : {std::string("{\"format\": \"l6470emu-coverage\", \"version\": 1, \"vari"),
                                  std::string("{\"name\": \"something else\"}\n"), std::string("\x1f\x8b\x08 binary")}) {
     const std::string path = dir.write("bad.json", text);
     const std::string why = merge_into_coverage_file(path, run_a());
