@@ -696,6 +696,7 @@ int CampaignCommand::run_campaign() {
     page.campaign_report = report;
     page.output = html_;
     page.title = "campaign: " + program_.front();
+    page.trace_shown = "(the clean run's recording)";
     if (run_report(page, std::cerr, "campaign --html") != 0) status = kRunUsage;
   }
   if (g_stop.load()) {

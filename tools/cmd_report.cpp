@@ -89,6 +89,7 @@ int run_report(const ReportArgs& args, std::ostream& err, const std::string& who
     const TraceWorld world = world_of(args.trace, file);
     print_notes(file.header(), err);
     ReportData data = make_report_data(file, world, options);
+    if (!args.trace_shown.empty()) data.trace_path = args.trace_shown;
     data.coverage = std::move(coverage);
     data.campaign = std::move(campaign);
     std::ostringstream page;

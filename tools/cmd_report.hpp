@@ -27,6 +27,9 @@ struct ReportArgs {
   std::string output;                 ///< the page to write
   std::string number_from = "miso";
   std::string title;                  ///< "" = the trace's name
+  /// How the page names the trace ("" = its path): a temporary recording (run --html without
+  /// --record, campaign --html) has a name of its own, so that the same run gives the same page.
+  std::string trace_shown;
 };
 
 /// Writes the page: 0, or 2 with one line on `err` ("l6470emu report: ...") for bad input (an

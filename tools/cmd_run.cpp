@@ -693,6 +693,7 @@ std::optional<int> RunCommand::run() {
     if (!coverage_.empty() && std::filesystem::exists(coverage_)) page.coverage = {coverage_};
     page.output = html_;
     page.title = "run: " + program_.front();
+    if (cmd_->count("--record") == 0) page.trace_shown = "(the run's recording)";
     struct stat st {};
     if (stat(record_.c_str(), &st) != 0 || st.st_size == 0)
       std::cerr << "l6470emu run: no page: the program never used the chain (nothing was recorded)\n";

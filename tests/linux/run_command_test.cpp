@@ -228,6 +228,22 @@ TEST_F(RunCommand, AProgramEndingWithoutAReportIsStatusSevenWithOrWithoutAScenar
   EXPECT_EQ(r.err.find("at 0.000000 s"), std::string::npos) << r.err;
 }
 
+TEST_F(RunCommand, TheSameRunGivesTheSameHtmlPageByteForByte) {
+  // Without --record the page is made from a temporary recording: its name must not reach the page.
+  std::string pages[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string page = path("page" + std::to_string(i) + ".html");
+    const RunResult r = run({"--chain", "chips=L6470", "--html", page}, python("status()\n"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream in(page, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    pages[i] = text.str();
+  }
+  EXPECT_FALSE(pages[0].empty());
+  EXPECT_TRUE(pages[0] == pages[1]) << "two runs of one program give two different pages";
+}
+
 TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {
   for (const char* code : {"3", "86", "87"}) {
     const RunResult r = run({"--chain", "chips=L6470"}, {"/bin/sh", "-c", std::string("exit ") + code});
