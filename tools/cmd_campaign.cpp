@@ -76,13 +76,6 @@ std::string file_word(const std::string& s) {
   return out;
 }
 
-bool write_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc | std::ios::binary);
-  out << text;
-  out.close();
-  return static_cast<bool>(out);
-}
-
 // A program run to its end in a process group of its own, its output to `out_path` (empty:
 // inherited); killed whole after `wall_limit_s` or when the campaign is stopped.
 struct Ended {
@@ -274,7 +267,7 @@ int CampaignCommand::run_merge() {
   std::string error;
   const auto merged = merge_campaign_reports(parts, error);
   if (!merged) return fail(error);
-  if (!write_file(merge_output_, campaign_json(*merged))) return fail("cannot write " + merge_output_);
+  if (!write_whole_file(merge_output_, campaign_json(*merged))) return fail("cannot write " + merge_output_);
   std::cerr << "l6470emu campaign merge: " << campaign_summary(*merged) << " -> " << merge_output_ << "\n";
   FailOn on;
   for (const RerunResult& r : merged->reruns)
@@ -349,7 +342,7 @@ int CampaignCommand::run_campaign() {
   if (!coverage_.empty() || cmd_->count("--coverage") > 0) {
     if (const std::string why = check_coverage_output(coverage_); !why.empty()) return usage("--coverage: " + why);
     if (coverage_ == json_ || coverage_ == junit_) return usage("--coverage names the same file as another output");
-    coverage_ = fs::absolute(coverage_).lexically_normal().string();
+    coverage_ = absolute_path(coverage_);
   }
 
   // The chips, and the faults asked for.
@@ -579,7 +572,7 @@ int CampaignCommand::run_campaign() {
     const std::string dir = work + "/" + std::to_string(p.index);
     fs::create_directory(dir);
     const std::string scenario_path = dir + "/" + name, outcome_path = dir + "/outcome.json", trace = dir + "/run.trace";
-    write_file(scenario_path, yaml);
+    write_whole_file(scenario_path, yaml);
     std::vector<std::string> argv{exe, "run"};
     argv.insert(argv.end(), board_args.begin(), board_args.end());
     argv.insert(argv.end(), {"--scenario", scenario_path, "--record", trace, "--outcome", outcome_path, "--"});
@@ -639,7 +632,7 @@ int CampaignCommand::run_campaign() {
     for (const std::string& a : program_) r.command += " " + shell_word(a);
     if (reproducers_ == "all" || r.verdict == Verdict::silent_failure || r.verdict == Verdict::hang || r.verdict == Verdict::deadlock ||
         r.verdict == Verdict::crash || r.fails(fail_on)) {
-      if (write_file(repro_path, yaml)) r.reproducer = repro_path;
+      if (write_whole_file(repro_path, yaml)) r.reproducer = repro_path;
     }
     results[slot] = std::move(r);
     const std::size_t n = ++done;
@@ -681,11 +674,11 @@ int CampaignCommand::run_campaign() {
   int status = nothing ? 1 : 0;
   for (const RerunResult& r : report.reruns)
     if (r.fails(fail_on)) status = 1;
-  if (!json_.empty() && !write_file(json_, campaign_json(report))) {
+  if (!json_.empty() && !write_whole_file(json_, campaign_json(report))) {
     std::cerr << "l6470emu campaign: cannot write " << json_ << "\n";
     status = kRunUsage;
   }
-  if (!junit_.empty() && !write_file(junit_, campaign_junit(report, fail_on))) {
+  if (!junit_.empty() && !write_whole_file(junit_, campaign_junit(report, fail_on))) {
     std::cerr << "l6470emu campaign: cannot write " << junit_ << "\n";
     status = kRunUsage;
   }

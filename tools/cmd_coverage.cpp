@@ -21,15 +21,6 @@ namespace l6470emu {
 
 namespace {
 
-bool write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc | std::ios::binary);
-  out << text;
-  out.close();
-  return static_cast<bool>(out);
-}
-
-std::string absolute(const std::string& path) { return std::filesystem::absolute(path).lexically_normal().string(); }
-
 std::string directory_of(const std::string& path) {
   const auto slash = path.rfind('/');
   return slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
@@ -90,20 +81,20 @@ int CoverageCommand::run_report() {
   } else if (format_ == "json") {
     text = coverage_json_report(*data);
   } else {
-    const std::string dir = absolute(!listing_dir_.empty() ? listing_dir_
+    const std::string dir = absolute_path(!listing_dir_.empty() ? listing_dir_
                                      : output_.empty()    ? std::string("l6470emu-interface")
-                                                          : directory_of(absolute(output_)) + "/l6470emu-interface");
+                                                          : directory_of(absolute_path(output_)) + "/l6470emu-interface");
     const CoverageLcov lcov = coverage_lcov(*data, dir);
     if (mkdir(dir.c_str(), 0755) != 0 && errno != EEXIST) return fail("cannot make " + dir + ": " + std::strerror(errno));
     for (const auto& [path, listing] : lcov.listings) {
       if (const std::string why = output_problem(path, inputs_); !why.empty()) return fail("cannot write " + path + ": " + why);
-      if (!write_text(path, listing)) return fail("cannot write " + path);
+      if (!write_whole_file(path, listing)) return fail("cannot write " + path);
     }
     text = lcov.tracefile;
   }
   if (output_.empty()) {
     std::cout << text << std::flush;
-  } else if (!write_text(output_, text)) {
+  } else if (!write_whole_file(output_, text)) {
     return fail("cannot write " + output_);
   }
   if (fail_under_) {
@@ -127,7 +118,7 @@ int CoverageCommand::run_merge() {
     return fail("cannot write " + merge_output_ + ": " + why);
   const auto data = read_inputs(merge_inputs_, "merge");
   if (!data) return kUsageError;
-  if (!write_text(merge_output_, data->to_json())) return fail("cannot write " + merge_output_);
+  if (!write_whole_file(merge_output_, data->to_json())) return fail("cannot write " + merge_output_);
   return 0;
 }
 

@@ -475,7 +475,7 @@ std::optional<int> RunCommand::run() {
               std::filesystem::equivalent(input, coverage_))
             why = "the same file as an input";
       if (!why.empty()) return usage("l6470emu run: --coverage: " + why);
-      config.coverage = std::filesystem::absolute(coverage_).lexically_normal().string();
+      config.coverage = absolute_path(coverage_);
     }
   }
 

@@ -12,6 +12,7 @@
 #include "linux/serve/control.hpp"
 #include "linux/serve/daemon.hpp"
 #include "tools/install_paths.hpp"
+#include "tools/output_check.hpp"
 #include "tools/kernel_nodes.hpp"
 
 namespace l6470emu {
@@ -95,7 +96,7 @@ std::optional<int> ServeCommands::run() {
         std::cerr << "l6470emu serve: --coverage: " << why << "\n";
         return 2;
       }
-      config.coverage = std::filesystem::absolute(coverage_).lexically_normal().string();
+      config.coverage = absolute_path(coverage_);
     }
     if (!serve_number_from_.empty()) {
       const auto from = number_from_named(serve_number_from_);
@@ -154,7 +155,7 @@ std::optional<int> ServeCommands::run() {
     }
     // The daemon runs elsewhere: a relative trace file is meant from here.
     if (all.size() >= 3 && all[0] == "trace" && all[1] == "start" && !all[2].empty() && all[2][0] != '/' && all[2][0] != '-')
-      all[2] = std::filesystem::absolute(all[2]).lexically_normal().string();
+      all[2] = absolute_path(all[2]);
     std::string command;
     for (const auto& w : all) command += (command.empty() ? "" : " ") + w;
     if (command == "help" || command == "--help") {

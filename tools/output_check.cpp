@@ -7,8 +7,19 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 
 namespace l6470emu {
+
+bool write_whole_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::trunc | std::ios::binary);
+  out << text;
+  out.close();
+  return static_cast<bool>(out);
+}
+
+std::string absolute_path(const std::string& path) { return std::filesystem::absolute(path).lexically_normal().string(); }
 
 std::string output_problem(const std::string& path, const std::vector<std::string>& inputs) {
   if (path.empty()) return "an empty path";

@@ -14,4 +14,11 @@ namespace l6470emu {
 /// is not left behind by the check.
 std::string output_problem(const std::string& path, const std::vector<std::string>& inputs);
 
+/// Writes `text` as the whole of the file at `path` (truncated first); false when it could not.
+bool write_whole_file(const std::string& path, const std::string& text);
+
+/// `path` made absolute against the working directory and normalised ("a/../b" is "b"): for a
+/// file named on the command line and handed to a program that may change directory.
+std::string absolute_path(const std::string& path);
+
 }  // namespace l6470emu
