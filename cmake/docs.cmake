@@ -26,7 +26,7 @@ if(L6470EMU_TESTS)
   # Skipped (77), with the reason, when a package it needs is missing.
   add_test(NAME docs COMMAND ${Python_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tests/docs/docs_test.py
            --source ${PROJECT_SOURCE_DIR} --build ${PROJECT_BINARY_DIR} --jobs ${L6470EMU_DOCS_JOBS})
-  set_tests_properties(docs PROPERTIES LABELS docs SKIP_RETURN_CODE 77 TIMEOUT 600
+  set_tests_properties(docs PROPERTIES LABELS docs SKIP_RETURN_CODE 77 TIMEOUT 600 COST 36
                        ENVIRONMENT "PYTHONDONTWRITEBYTECODE=1")
 endif()
 

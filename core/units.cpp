@@ -250,16 +250,17 @@ FieldValue to_register(const UnitScale& s, double x, OutOfRange out_of_range) {
   };
   if (std::isnan(x)) return fail("not a number");
   const std::int64_t top = s.max_finite_field();
-  const std::string low = to_physical(s, 0).decimal() + " " + unit + " (" + hex_field(s, 0) + ")";
-  const std::string high = to_physical(s, static_cast<std::uint32_t>(top)).decimal() + " " + unit + " (" +
-                           hex_field(s, static_cast<std::uint32_t>(top)) + ")";
-  const std::string infinite_hint =
-      s.top_is_infinite ? "; " + hex_field(s, s.max_field()) + " (inf) selects infinite acceleration" : "";
+  // The ends, in words: only for a refusal's message (the accepted path builds no string).
+  const auto low = [&] { return to_physical(s, 0).decimal() + " " + unit + " (" + hex_field(s, 0) + ")"; };
+  const auto high = [&] {
+    return to_physical(s, static_cast<std::uint32_t>(top)).decimal() + " " + unit + " (" +
+           hex_field(s, static_cast<std::uint32_t>(top)) + ")" +
+           (s.top_is_infinite ? "; " + hex_field(s, s.max_field()) + " (inf) selects infinite acceleration" : "");
+  };
   if (std::isinf(x)) {
     if (x > 0 && s.top_is_infinite) return ok(s.max_field());
     if (out_of_range == OutOfRange::saturate) return ok(x > 0 ? static_cast<std::uint32_t>(top) : 0);
-    return fail(std::string(x > 0 ? "inf is above the largest value, " + high + infinite_hint
-                                  : "-inf is below the smallest value, " + low));
+    return fail(x > 0 ? "inf is above the largest value, " + high() : "-inf is below the smallest value, " + low());
   }
   // mid(k): the value halfway between fields k and k + 1, exact in a double (its numerator
   // stays below 2^53 and the denominator is a power of two).
@@ -274,11 +275,11 @@ FieldValue to_register(const UnitScale& s, double x, OutOfRange out_of_range) {
   while (k >= 0 && x < mid(k - 1)) --k;     // nearer k - 1
   if (k < 0) {
     if (out_of_range == OutOfRange::saturate) return ok(0);
-    return fail(shown(x) + " " + unit + " is below the smallest value, " + low);
+    return fail(shown(x) + " " + unit + " is below the smallest value, " + low());
   }
   if (k > top) {
     if (out_of_range == OutOfRange::saturate) return ok(static_cast<std::uint32_t>(top));
-    return fail(shown(x) + " " + unit + " is above the largest value, " + high + infinite_hint);
+    return fail(shown(x) + " " + unit + " is above the largest value, " + high());
   }
   return ok(static_cast<std::uint32_t>(k));
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # A bounded fuzz pass: sets up (Debian packages and a clang build in build-fuzz, through
-# scripts/setup.sh), replays tests/fuzz/regressions/<harness>/ (inputs that once crashed),
+# scripts/setup.sh; or, with L6470EMU_FUZZ_TREE=DIR, the harnesses of a tree configured with
+# -DL6470EMU_FUZZ=ON, as the test command's sanitized tree is), replays tests/fuzz/regressions/<harness>/ (inputs that once crashed),
 # then runs every libFuzzer harness of tests/fuzz for SECONDS_PER_HARNESS seconds (default 60), as
 # many at a time as there are cores (L6470EMU_FUZZ_JOBS),
 # from its seed corpus tests/fuzz/corpus/<harness>/, new inputs going to a scratch directory.
@@ -15,11 +16,20 @@ cd "$(dirname "$0")/.."
 
 seconds=${1:-60}
 harnesses=(spi_chain native saleae sigrok umockdev ftrace config protocol sketch ctl_reply scenario coverage)
-build=build-fuzz
+build=${L6470EMU_FUZZ_TREE:-build-fuzz}
 
-echo "== fuzz: setting up $build (clang, libFuzzer, ASan + UBSan)"
-CC=clang CXX=clang++ scripts/setup.sh "$build" -DL6470EMU_FUZZ=ON -DL6470EMU_TESTS=OFF -DL6470EMU_BENCH=OFF \
-  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g"
+if [ -n "${L6470EMU_FUZZ_TREE:-}" ]; then
+  if ! grep -q '^L6470EMU_FUZZ:BOOL=ON$' "$build/CMakeCache.txt" 2>/dev/null; then
+    echo "fuzz: L6470EMU_FUZZ_TREE=$build is not a build tree configured with -DL6470EMU_FUZZ=ON" >&2
+    exit 2
+  fi
+  echo "== fuzz: the harnesses of $build"
+  cmake --build "$build" -j"$(nproc)" --target fuzz
+else
+  echo "== fuzz: setting up $build (clang, libFuzzer, ASan + UBSan)"
+  CC=clang CXX=clang++ scripts/setup.sh "$build" -DL6470EMU_FUZZ=ON -DL6470EMU_TESTS=OFF -DL6470EMU_BENCH=OFF \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g"
+fi
 
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
