@@ -61,18 +61,20 @@ case "$what" in
     # both compilers at no extra stage, and clang's UBSan also checks float-to-integer overflow.
     # One tree serves the tests and the fuzzers: its libraries carry libFuzzer's coverage
     # (L6470EMU_FUZZ) and the harnesses are built beside the tests. Debug (-O0, line tables), but
-    # the chip model's core at -O1 (CMakeLists.txt).
+    # the chip model's core at -O1 (CMakeLists.txt); linked by lld, four times faster than ld.bfd
+    # at these programs with their sanitizer runtimes.
     stage "build with AddressSanitizer + UndefinedBehaviorSanitizer (clang), tests and fuzzers" \
       scripts/setup.sh build-asan -DL6470EMU_SANITIZE=ON -DL6470EMU_FUZZ=ON -DL6470EMU_TEST_SHARDS=ON \
       -DCMAKE_BUILD_TYPE=Debug -DL6470EMU_BENCH=OFF -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
-      -DCMAKE_CXX_FLAGS_DEBUG=-gline-tables-only -DCMAKE_C_FLAGS_DEBUG=-gline-tables-only
+      -DCMAKE_CXX_FLAGS_DEBUG=-gline-tables-only -DCMAKE_C_FLAGS_DEBUG=-gline-tables-only \
+      -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_SHARED_LINKER_FLAGS=-fuse-ld=lld -DCMAKE_MODULE_LINKER_FLAGS=-fuse-ld=lld
     sanitized_tests() {
       ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
         tests build-asan -LE '^docs$'  # the site: built once, above
     }
     stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer" sanitized_tests
-    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, every harness 45 s, $(nproc) at a time)" \
-      env L6470EMU_FUZZ_TREE=build-asan scripts/fuzz.sh 45
+    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, every harness 35 s, $(nproc) at a time)" \
+      env L6470EMU_FUZZ_TREE=build-asan scripts/fuzz.sh 35
     ;;
   *)
     echo "usage: scripts/quickstart.sh demo|test" >&2

@@ -10,7 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
   zlib1g-dev gcc python3 python3-spidev python3-libgpiod gpiod libgpiod-dev umockdev
-  sigrok-cli clang libclang-rt-14-dev
+  sigrok-cli clang libclang-rt-14-dev lld
   python3-dev pybind11-dev python3-pybind11 python3-pytest python3-pytest-xdist python3-numpy python3-matplotlib help2man man-db dpkg-dev lintian
   libfuse3-dev qemu-system-x86 busybox-static cpio kmod
   libyaml-cpp-dev spi-tools golang-go
