@@ -137,7 +137,9 @@ extern "C" void on_run_stop_signal(int sig) { g_stop_signal.store(sig); }
 struct ProgramEnd {
   pid_t pid = 0;
   int wstatus = 0;
-  bool wall_timeout = false;  // killed at the wall-clock limit by run itself
+  bool wall_timeout = false;  // killed at the simulated time limit, counted on the host's clock (wall time)
+  std::chrono::nanoseconds wall_guard_limit{};  // --wall-timeout: how long run waits, whatever the program does
+  bool wall_guard = false;    // killed by that guard
   int stopped_by = 0;         // the signal run was stopped by and passed on to the program (0: none)
   std::vector<RunReport> blocks;
 };
@@ -171,41 +173,45 @@ bool spawn_program(const std::vector<std::string>& program, std::vector<std::str
   return false;
 }
 
-// Waits for the program; in wall time a limit in simulated seconds is limit / scale seconds of
-// real time, after which run kills it.
+// Waits for the program. In wall time a limit in simulated seconds is limit / scale seconds of
+// real time, after which run kills it. In any time, the wall-clock guard (--wall-timeout) ends a
+// program that waits where virtual time cannot see it (pause(), a read on its own pipe, a lock no
+// thread releases) or simply runs too long. A SIGINT or SIGTERM to run is passed on to the
+// program, which gets 5 s to end before SIGKILL; run then writes its reports with the program
+// marked as stopped.
 void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config) {
-  if (timeout && !config.time.virtual_time) {
-    const auto deadline =
-        std::chrono::steady_clock::now() +
-        std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 / config.time.scale));
-    while (true) {
-      const pid_t r = waitpid(run.pid, &run.wstatus, WNOHANG);
-      if (r == run.pid) return;
-      if (std::chrono::steady_clock::now() >= deadline) {
-        run.wall_timeout = true;
-        kill(run.pid, SIGKILL);
-        waitpid(run.pid, &run.wstatus, 0);
-        return;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  std::optional<Clock::time_point> limit_at;
+  if (timeout && !config.time.virtual_time)
+    limit_at = start + std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 /
+                                                                           config.time.scale));
+  const auto guard_at = start + run.wall_guard_limit;
+  const auto kill_now = [&run](bool& why) {
+    why = true;
+    kill(run.pid, SIGKILL);
+    while (waitpid(run.pid, &run.wstatus, 0) < 0 && errno == EINTR) {
     }
-  }
-  // A SIGINT or SIGTERM to run is passed on to the program, which gets 5 s to end before SIGKILL;
-  // run then writes its reports with the program marked as stopped.
-  std::optional<std::chrono::steady_clock::time_point> kill_at;
+  };
+  Clock::time_point kill_at{};  // once a signal was passed on: when SIGKILL follows
+  bool signalled = false;
   while (true) {
-    const pid_t r = waitpid(run.pid, &run.wstatus, kill_at ? WNOHANG : 0);
+    const pid_t r = waitpid(run.pid, &run.wstatus, WNOHANG);
     if (r == run.pid || (r < 0 && errno != EINTR)) return;
+    const auto now = Clock::now();
+    if (limit_at && now >= *limit_at) return kill_now(run.wall_timeout);
+    if (now >= guard_at && !run.stopped_by) return kill_now(run.wall_guard);
     if (const int sig = g_stop_signal.load(); sig && !run.stopped_by) {
       run.stopped_by = sig;
       kill(run.pid, sig);
-      kill_at = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+      kill_at = now + std::chrono::seconds(5);
+      signalled = true;
     }
-    if (kill_at && std::chrono::steady_clock::now() >= *kill_at) {
+    if (signalled && now >= kill_at) {
       kill(run.pid, SIGKILL);
-      kill_at.reset();
+      signalled = false;
     }
-    if (kill_at) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
 
@@ -373,7 +379,7 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_ = app.add_subcommand("run", "run a program against an emulated board with a scenario, and judge it");
   cmd_->footer(
       "Exit status: 0 passed, 1 an expectation failed, 2 usage/board/scenario/output error (the program never started), "
-      "3 simulated time limit reached, 4 deadlock in virtual time, 5 driver sanitizer error, 6 the program exited "
+      "3 simulated time limit reached (or the wall-clock guard), 4 deadlock in virtual time, 5 driver sanitizer error, 6 the program exited "
       "non-zero or was killed, 7 the program could not be started or left no report. docs/scenarios.md");
   auto* board = cmd_->add_option("--board", board_file_, "board description file (as L6470EMU_CONFIG)");
   auto* chain = cmd_->add_option("--chain", chain_, "board description text (as L6470EMU_CHAIN), e.g. 'chips=L6470 axis.0=...', or a bare chain ('L6470', '3', '2*L6470,L6480')");
@@ -382,6 +388,9 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_->add_option("--time", time_, "the program's clock: virtual (default: the board's time) or wall")
       ->check(CLI::IsMember({"virtual", "wall"}));
   cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
+  cmd_->add_option("--wall-timeout", wall_timeout_,
+                   "wall-clock guard: after this long on the host's clock the program is killed and the run ends "
+                   "with status 3, whatever its clock (seconds, or 250ms, 2min, ...; default 3600)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
   cmd_->add_option("--html", html_, "write the run's report page to this file (docs/report.md; with --record, from that trace)");
@@ -500,9 +509,14 @@ std::optional<int> RunCommand::run() {
     if (!timeout || *timeout == 0)
       return usage("l6470emu run: --timeout " + quoted_text(timeout_) + " is not a duration (30, 2.5s, 250ms, 1min)");
   }
+  const std::optional<Tick> wall_guard = parse_scenario_duration(wall_timeout_);
+  if (!wall_guard || *wall_guard == 0)
+    return usage("l6470emu run: --wall-timeout " + quoted_text(wall_timeout_) + " is not a duration (30, 2.5s, 250ms, 1min)");
   // 3. The program: under the preload (the board in its own process), or as it is against the
   // kernel's nodes of a board in this process.
   ProgramEnd run;
+  // At most a century: the deadline stays within the steady clock's range.
+  run.wall_guard_limit = std::chrono::nanoseconds(std::min<Tick>(*wall_guard, Tick{100} * 365 * 86400 * 4'000'000)) * 250;
   const int started = kernel ? run_on_kernel_nodes(config, scenario, !scenario_file_.empty(), timeout, program_, run)
                              : run_under_preload(config, scenario, timeout, program_, run);
   if (started >= 0) return started;
@@ -519,7 +533,7 @@ std::optional<int> RunCommand::run() {
       cause = b.end;
       cause_block = &b;
     }
-  if (wall_timeout) cause = RunEnd::timeout;
+  if (wall_timeout || run.wall_guard) cause = RunEnd::timeout;
   std::vector<const RunReport*> judged;
   for (const RunReport& b : blocks)
     if (b.devices && b.scenario) judged.push_back(&b);
@@ -543,7 +557,11 @@ std::optional<int> RunCommand::run() {
   const int code = exited ? WEXITSTATUS(wstatus) : -1;
   const int signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;
   std::string ended;
-  if (cause == RunEnd::timeout)
+  if (run.wall_guard)
+    ended = "was stopped by the wall-clock guard after " + seconds_text(*wall_guard) +
+            " of the host's time (--wall-timeout): it waited where virtual time cannot see (pause(), a read on its "
+            "own pipe, a lock no thread releases) or ran longer than that";
+  else if (cause == RunEnd::timeout)
     ended = "stopped at the simulated time limit " + seconds_text(*timeout);
   else if (cause == RunEnd::deadlock)
     ended = "deadlocked in virtual time";
@@ -579,7 +597,8 @@ std::optional<int> RunCommand::run() {
   // Without a report (killed by a signal, _exit()) nothing says when it ended: no "at 0 s".
   const bool when_known = !judged.empty() || cause_block || wall_timeout;
   out << "l6470emu run: " << program_[0] << " " << ended
-      << (when_known ? " at " + seconds_text(end_tick) + (config.time.virtual_time ? " of virtual time" : " of board time")
+      << (run.wall_guard ? std::string()
+          : when_known ? " at " + seconds_text(end_tick) + (config.time.virtual_time ? " of virtual time" : " of board time")
                      : std::string(" (when, in virtual time, is unknown: it left no report)"))
       << "\n";
   if (cause_block)

@@ -19,7 +19,7 @@ class RunCommand {
  private:
   CLI::App* cmd_ = nullptr;
   std::string board_file_, chain_, scenario_file_, time_ = "virtual", nodes_ = "preload", timeout_, junit_, record_, outcome_, coverage_,
-      html_;
+      html_, wall_timeout_ = "3600";
   bool verbose_ = false;
   std::vector<std::string> program_;
 };

@@ -207,6 +207,35 @@ TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
       << r.err;
 }
 
+TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClockGuard) {
+  // pause() waits for a signal: nothing in the board or the program can end it, and virtual time
+  // does not see it. The guard ends it, with the simulated time limit's status and its own words.
+  for (const std::vector<std::string>& time : {std::vector<std::string>{}, {"--time", "wall"}}) {
+    std::vector<std::string> args = time;
+    for (const char* a : {"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"}) args.push_back(a);
+    const RunResult r = run(args, python("import signal\nsignal.pause()\n"));
+    EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+    EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s of the host's time (--wall-timeout)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("of virtual time"), std::string::npos) << r.err;  // when, in board time, nobody knows
+  }
+}
+
+TEST_F(RunCommand, TheWallClockGuardIsADurationAndLeavesAProgramThatEndsInTimeAlone) {
+  const auto program = python("print(hex(status()))\n");
+  RunResult r = run({"--chain", "chips=L6470", "--wall-timeout", "0"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_EQ(r.err, "l6470emu run: --wall-timeout '0' is not a duration (30, 2.5s, 250ms, 1min)\n");
+  r = run({"--chain", "chips=L6470", "--wall-timeout", "later"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  r = run({"--chain", "chips=L6470", "--wall-timeout", "1000000000000"}, program);  // a century at most: no overflow
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  r = run({"--chain", "chips=L6470", "--wall-timeout", "30"}, program);
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "0x7c03\n") << r.err;
+}
+
 TEST_F(RunCommand, ADeadlockIsItsOwnStatusAndAScenarioStepToComeIsAWakeUp) {
   // The client waits for a BUSY edge an idle chip never makes; the scenario's step at 1 s is a
   // wake-up, so the deadlock is found only after it.
