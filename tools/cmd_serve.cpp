@@ -10,6 +10,7 @@
 #include "linux/board_config_file.hpp"
 #include "linux/device_paths.hpp"
 #include "linux/serve/control.hpp"
+#include "linux/serve/control_words.hpp"
 #include "linux/serve/daemon.hpp"
 #include "tools/install_paths.hpp"
 #include "tools/output_check.hpp"
@@ -156,8 +157,8 @@ std::optional<int> ServeCommands::run() {
     // The daemon runs elsewhere: a relative trace file is meant from here.
     if (all.size() >= 3 && all[0] == "trace" && all[1] == "start" && !all[2].empty() && all[2][0] != '/' && all[2][0] != '-')
       all[2] = absolute_path(all[2]);
-    std::string command;
-    for (const auto& w : all) command += (command.empty() ? "" : " ") + w;
+    // A word with a blank in it (a trace file "run 1.bin") stays one word on the daemon's side.
+    const std::string command = join_control_words(all);
     if (command == "help" || command == "--help") {
       // The daemon's help says how it numbers chips; without a daemon, the general text.
       std::ostringstream help, quiet;

@@ -1,5 +1,6 @@
 // `ctl` commands: status, get, sw, pin, fault, adc, axis, dump, chains, time, advance, trace.
 #include "linux/serve/control.hpp"
+#include "linux/serve/control_words.hpp"
 
 #include <charconv>
 #include <climits>
@@ -137,12 +138,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
 }
 
 int run_control(DeviceBoard& board, const std::string& command, std::string& out) {
-  std::vector<std::string> all;
-  {
-    std::istringstream in(command);
-    std::string w;
-    while (in >> w) all.push_back(w);
-  }
+  const std::vector<std::string> all = split_control_words(command);
   std::ostringstream o;
   if (all.empty() || all[0] == "help" || all[0] == "--help") {
     out = control_help(board.numbering());
@@ -417,10 +413,17 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       out = "ctl: advance: " + error + "\n";
       return 2;
     }
-    if (!board.advance(ticks)) {
+    if (!board.time().is_virtual()) {
       out = "ctl: the daemon runs on the wall clock; `advance` needs `serve --virtual-time`\n";
       return 1;
     }
+    // The clock ends one tick before kNever (about 146 000 years): it never wraps round to the start.
+    if (const Tick now = board.time().now(); ticks > kNever - 1 - now) {
+      out = "ctl: advance: the board's clock is at " + std::to_string(now) + " ticks and ends at " +
+            std::to_string(kNever - 1) + ": it cannot move on by " + std::to_string(ticks) + " ticks\n";
+      return 1;
+    }
+    board.advance(ticks);
     o << "advanced " << a.words[0] << " ms (" << ticks << (ticks == 1 ? " tick)\n" : " ticks)\n");
   } else if (cmd == "trace") {
     // One native trace per chain; without --chain, `stop` ends every recording.

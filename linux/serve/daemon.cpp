@@ -30,6 +30,7 @@
 #include "linux/device_board.hpp"
 #include "linux/protocol.hpp"
 #include "linux/serve/control.hpp"
+#include "linux/serve/control_words.hpp"
 #include "linux/serve/ctl_reply.hpp"
 #include "linux/terminal_text.hpp"
 #include "linux/shm_channel.hpp"
@@ -297,14 +298,15 @@ int run_daemon(const BoardConfig& config, const std::string& socket_path, std::o
   std::mutex control_mutex;  // ctl commands one at a time
   const ControlHandler control = [&](const std::string& command, std::string& text) {
     std::lock_guard lock(control_mutex);
-    std::istringstream words(command);
-    std::string first, more, from;
-    // `clients` names no chip, so ctl's --number-from (passed after the command word) changes nothing.
-    const auto only_numbering = [&] {
-      if (!(words >> more)) return true;
-      return more == "--number-from" && words >> from && number_from_named(from) && !(words >> more);
-    };
-    if (words >> first && first == "clients" && only_numbering()) {
+    const std::vector<std::string> words = split_control_words(command);
+    if (!words.empty() && words[0] == "clients") {
+      // `clients` names no chip, so ctl's --number-from (passed after the command word) changes nothing.
+      const bool only_numbering =
+          words.size() == 1 || (words.size() == 3 && words[1] == "--number-from" && number_from_named(words[2]));
+      if (!only_numbering) {
+        text = "ctl: usage: clients (it lists every connected program: no --chip, --chain or other word)\n";
+        return 2;
+      }
       std::lock_guard l(connections_mutex);
       text = describe_clients(connections);
       return 0;

@@ -227,6 +227,22 @@ TEST_F(RecordingDaemon, CtlTraceStartAndStopRecordWhatHappensInBetween) {
   EXPECT_EQ(d.status, 0) << d.err;
 }
 
+TEST_F(RecordingDaemon, ATracePathWithBlanksInItIsOneFileAndClientsTakesNoChip) {
+  start({"--virtual-time"});
+  const std::string spaced = trace_ + " run 1.trace";
+  const RunResult s = ctl({"trace", "start", spaced});
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_NE(s.out.find("recording to " + spaced + "\n"), std::string::npos) << s.out;
+  ASSERT_EQ(ctl({"trace", "stop"}).status, 0);
+  EXPECT_TRUE(replays_clean(spaced));
+  std::remove(spaced.c_str());
+  // `clients` lists every program: a chip makes no sense there, and the answer says so.
+  const RunResult c = ctl({"clients", "--chip", "1"});
+  EXPECT_EQ(c.status, 2);
+  EXPECT_EQ(c.err, "ctl: usage: clients (it lists every connected program: no --chip, --chain or other word)\n");
+  EXPECT_EQ(ctl({"clients"}).status, 0);
+}
+
 TEST_F(RecordingDaemon, ATracePathThatIsAFifoALinkOrADeviceIsRefusedAndTheDaemonServesOn) {
   start({});
   const std::string fifo = trace_ + ".fifo", link = trace_ + ".link", target = trace_ + ".target";
