@@ -1,4 +1,5 @@
-// Reading a board description file: stat first (a device is refused before it is opened), then
+// Reading a board description file: opened by spi/input_file.hpp (a device is refused before it
+// is opened, a FIFO waited for a bounded time), then
 // at most kMaxConfigBytes + 1 bytes, then board/board_config.cpp's parser.
 #include "linux/board_config_file.hpp"
 
@@ -9,19 +10,18 @@
 #include <cerrno>
 #include <cstring>
 
+#include "spi/input_file.hpp"
+
 namespace l6470emu {
 
 ParseResult load_board_config_file(const std::string& path) {
   const std::string where = "l6470emu: config file " + shown_text(path, 200) + ": ";
   auto failed = [&](const std::string& what) { return ParseResult{std::nullopt, {where + what}}; };
-  // stat first: opening a device can block or have effects; a FIFO (a shell's <(...)) is fine.
-  struct stat st{};
-  if (::stat(path.c_str(), &st) != 0) return failed(std::string("cannot be read (") + std::strerror(errno) + ")");
-  if (S_ISDIR(st.st_mode)) return failed("is a directory (give the board description file)");
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return failed("is a device, not a board description file");
-  if (!S_ISREG(st.st_mode) && !S_ISFIFO(st.st_mode)) return failed("is not a regular file");
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
-  if (fd < 0) return failed(std::string("cannot be read (") + std::strerror(errno) + ")");
+  // A FIFO (a shell's <(...)) is fine once its writer writes; a device, a directory or a FIFO
+  // nobody writes to is refused (spi/input_file.hpp).
+  std::string why;
+  const int fd = open_input_file(path, why);
+  if (fd < 0) return failed(why + (why == "is a directory" ? " (give the board description file)" : ""));
   std::string text(kMaxConfigBytes + 1, '\0');
   std::size_t got = 0;
   while (got < text.size()) {

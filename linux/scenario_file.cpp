@@ -1,6 +1,8 @@
 // Scenario files: YAML through yaml-cpp, checked key by key against docs/scenarios.md's schema.
 #include "linux/scenario_file.hpp"
 
+#include <unistd.h>
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "board/board_config.hpp"
+#include "spi/input_file.hpp"
 
 namespace l6470emu {
 namespace {
@@ -531,16 +534,31 @@ ScenarioParse parse_scenario_yaml(std::string_view text, std::string_view file) 
 }
 
 ScenarioParse load_scenario_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  // A device, a directory or a FIFO nobody writes to is refused (spi/input_file.hpp); at most
+  // kMaxScenarioBytes + 1 bytes are read, and the parser says when that is too many.
+  std::string why;
+  const int fd = open_input_file(path, why);
+  const auto failed = [&](const std::string& what) {
     ScenarioParse out;
-    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": cannot be read (" + std::strerror(errno) + ")";
+    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": " + what;
     return out;
+  };
+  if (fd < 0) return failed(why);
+  std::string text(kMaxScenarioBytes + 1, '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int e = errno;
+      ::close(fd);
+      return failed(std::string("cannot be read (") + std::strerror(e) + ")");
+    }
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
   }
-  std::string text;
-  text.resize(kMaxScenarioBytes + 1);
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  ::close(fd);
+  text.resize(got);
   return parse_scenario_yaml(text, path);
 }
 

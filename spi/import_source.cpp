@@ -137,6 +137,7 @@ std::vector<bool> ImportSource::contains(std::span<const std::string_view> needl
   std::string window;
   std::vector<char> chunk(kChunk);
   std::size_t left = needles.size();
+  std::size_t since_newline = 0;  // bytes read since the last newline
   while (left > 0) {
     std::size_t got = 0;
     try {
@@ -145,6 +146,12 @@ std::vector<bool> ImportSource::contains(std::span<const std::string_view> needl
       break;  // the pass that reads the lines says where the damage is
     }
     if (got == 0) break;
+    // A line longer than any reader takes ends the look: the pass that reads the lines says so
+    // (an endless stream without a newline, such as <(cat /dev/zero), ends here too).
+    const std::string_view read(chunk.data(), got);
+    const std::size_t last_nl = read.rfind('\n');
+    since_newline = last_nl == std::string_view::npos ? since_newline + got : got - 1 - last_nl;
+    if (since_newline > kMaxTraceLineBytes) break;
     const std::size_t tail = longest > 0 ? std::min(window.size(), longest - 1) : 0;
     window.erase(0, window.size() - tail);
     window.append(chunk.data(), got);

@@ -3,6 +3,8 @@
 // that is killed stays readable up to its last flush.
 #include "spi/trace_file.hpp"
 
+#include "spi/input_file.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -14,6 +16,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "spi/input_file.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -47,14 +50,12 @@ std::string_view without_gz(std::string_view path) {
 // ---------------------------------------------------------------- reader
 
 TraceFileReader::TraceFileReader(const std::string& path) : path_(path) {
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd_ < 0) throw TraceError(path, 0, "cannot open: " + errno_text());
+  // A device (/dev/zero) or a FIFO nobody writes to would block or never end: refused.
+  std::string why;
+  fd_ = open_input_file(path, why);
+  if (fd_ < 0) throw TraceError(path, 0, errno ? "cannot open: " + errno_text() : "cannot read: it " + why);
   struct stat st {};
   if (fstat(fd_, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) size_on_disk_ = static_cast<std::uint64_t>(st.st_size);
-  if (S_ISDIR(st.st_mode)) {
-    ::close(fd_);
-    throw TraceError(path, 0, "cannot read: it is a directory");
-  }
   // The magic, without consuming it (pread leaves the offset alone; pipes are read plain).
   char magic[2];
   const ssize_t got = pread(fd_, magic, 2, 0);

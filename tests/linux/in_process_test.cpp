@@ -116,7 +116,7 @@ TEST_F(InProcess, AMalformedConfigGivesOneClearErrorLineAndANonZeroExit) {
   for (const auto& [file, error] : std::vector<std::pair<std::string, std::string>>{
            {"/nonexistent.conf", "cannot be read (No such file or directory)"},
            {"/tmp", "is a directory (give the board description file)"},
-           {"/dev/zero", "is a device, not a board description file"}}) {
+           {"/dev/zero", "is a device, not a file: it could block or never end"}}) {
     const RunResult r = run_program({"/bin/true"}, {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CONFIG", file}});
     EXPECT_EQ(r.status, 2);
     EXPECT_EQ(r.err, "l6470emu: config file " + file + ": " + error + "\n");

@@ -78,6 +78,21 @@ TEST_F(RunCommand, AFailedExpectationIsStatusOneAndSaysWhatWhenWhichChipExpected
   EXPECT_NE(r.err.find("2 expectations, 1 failed; exit 1: an expectation failed"), std::string::npos) << r.err;
 }
 
+TEST_F(RunCommand, AScenarioOrBoardThatIsADeviceOrADirectoryIsOneLineAndTheProgramNeverStarts) {
+  const std::string marker = path("started");
+  const std::vector<std::string> program{"/bin/sh", "-c", "touch " + marker};
+  RunResult r = run({"--chain", "chips=L6470", "--scenario", "/dev/zero"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_EQ(r.err, "l6470emu: scenario /dev/zero: is a device, not a file: it could block or never end\n");
+  r = run({"--chain", "chips=L6470", "--scenario", dir_.string()}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_EQ(r.err, "l6470emu: scenario " + dir_.string() + ": is a directory\n");
+  r = run({"--board", "/dev/zero"}, program);
+  EXPECT_EQ(r.status, kRunUsage);
+  EXPECT_EQ(r.err, "l6470emu: config file /dev/zero: is a device, not a file: it could block or never end\n");
+  EXPECT_FALSE(fs::exists(marker));
+}
+
 TEST_F(RunCommand, AReportThatCannotBeWrittenOrWouldOverwriteAnInputEndsTheRunBeforeTheProgramStarts) {
   const std::string scenario = file("s.yaml", kSwitchScenario);
   const std::string marker = path("started");

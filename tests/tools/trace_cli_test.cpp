@@ -314,6 +314,16 @@ TEST(TraceCommands, GiveOneLineForEmptyBinaryAndNonTraceFiles) {
   }
 }
 
+TEST(TraceCommands, RefuseADeviceInEveryFormatInsteadOfReadingItForEver) {
+  // /dev/zero never ends: before, `replay --format ftrace /dev/zero` looked for its events for ever.
+  for (const std::string format : {"", "--format ftrace ", "--format native ", "--format sigrok "}) {
+    const RunResult r = l6470emu("replay --chain L6470 " + format + "/dev/zero");
+    EXPECT_EQ(r.status, 2) << format << r.out;
+    EXPECT_EQ(r.out, "l6470emu replay: /dev/zero: cannot read: it is a device, not a file: it could block or never end\n")
+        << format;
+  }
+}
+
 TEST(TraceCommands, NameTheChainItemThatIsWrong) {
   const RunResult r = l6470emu("decode --chain 2,3* " + fixture_path("three_chips.trace"));
   EXPECT_EQ(r.status, 2);
