@@ -65,6 +65,11 @@ constexpr std::array<RuleInfo, kRuleCount> kRules{{
     {Rule::STANDBY_BYTE, "STANDBY_BYTE", "a command byte reaches a chip held in standby (STBY\\RST low): it is lost",
      "§6.12 Reset and standby",
      "UNCONFIRMED (the datasheet says the logic is reset in standby, not what a byte then does)"},
+    {Rule::RESERVED_BITS, "RESERVED_BITS",
+     "SetParam sets a bit the datasheet reserves: STEP_MODE bit 3 (L6470, L6480), CONFIG bit 6",
+     "§9.1.19 Table 17 note 1 (STEP_MODE bit 3 written 0); §9.1.21 Table 22 (CONFIG bit 6 RESERVED)",
+     "CONFIRMED that the L6470's STEP_MODE bit 3 is to be written 0; UNCONFIRMED what a 1 there or in CONFIG bit 6 does "
+     "(the model stores it)"},
 }};
 
 std::string upper(std::string_view s) {

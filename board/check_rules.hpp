@@ -39,6 +39,7 @@ enum class Rule : std::uint8_t {
   UNUSED_BITS,         ///< a value with bits its register or argument does not have
   ANSWER_LOST,         ///< a GetParam/GetStatus answer replaced before all its bytes were clocked out
   STANDBY_BYTE,        ///< a command byte sent to a chip held in standby
+  RESERVED_BITS,       ///< SetParam setting a bit the datasheet reserves (to be written 0)
   count
 };
 

@@ -274,6 +274,7 @@ void ChainChecker::check_decode(std::size_t k, const Chip& chip, std::uint8_t by
   const std::size_t len = static_cast<std::size_t>(frame_bytes_);
   if (chip.arguments_missing() == 1) {
     check_unused_bits(k, chip, (chip.arguments_so_far() << 8) | byte, decoded_at(len, k));
+    check_reserved_bits(k, chip, (chip.arguments_so_far() << 8) | byte, decoded_at(len, k));
     return;
   }
   // Only GetParam (0x20-0x3F), GetStatus and ResetDevice drop an answer.
@@ -328,6 +329,20 @@ void ChainChecker::check_unused_bits(std::size_t k, const Chip& chip, std::uint3
                          name + " value " + hex_value(arg & all, 8 * bytes) + " has bits above the " +
                              std::to_string(bits) + " " + what + " (" + hex_value(extra, 8 * bytes) +
                              "): the chip keeps " + hex_value(arg & mask, 8 * bytes)));
+}
+
+void ChainChecker::check_reserved_bits(std::size_t k, const Chip& chip, std::uint32_t arg,
+                                       std::optional<std::uint64_t> where) {
+  const Opcode& op = chip.collecting_opcode();
+  if (op.command != Command::SetParam) return;
+  const RegisterInfo* r = chip.registers().at_address(op.param);
+  if (r == nullptr) return;
+  for (const ReservedBit& b : chip.variant().reserved_bits)
+    if (b.reg == r->id && ((arg >> b.bit) & 1u) != 0)
+      sanitizer_.report(make(Rule::RESERVED_BITS, k, where,
+                             "SetParam(" + std::string(r->name) + ") value " + hex_value(arg, 8 * op.arg_bytes) +
+                                 " sets bit " + std::to_string(b.bit) + ", which is to be written 0: " +
+                                 std::string(b.source)));
 }
 
 void ChainChecker::check_split() {

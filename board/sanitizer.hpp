@@ -161,6 +161,7 @@ class ChainChecker {
   void check_decode(std::size_t chip, const Chip& c, std::uint8_t byte);
   std::optional<std::uint64_t> decoded_at(std::size_t frame_len, std::size_t chip) const;
   void check_unused_bits(std::size_t chip, const Chip& c, std::uint32_t arg, std::optional<std::uint64_t> byte);
+  void check_reserved_bits(std::size_t chip, const Chip& c, std::uint32_t arg, std::optional<std::uint64_t> byte);
 
   Sanitizer& sanitizer_;
   const Chain& chain_;

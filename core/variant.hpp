@@ -13,6 +13,13 @@
 
 namespace l6470emu {
 
+/// A register bit the datasheet reserves, to be written 0 (the driver sanitizer's RESERVED_BITS).
+struct ReservedBit {
+  Reg reg;
+  std::uint8_t bit;
+  std::string_view source;  ///< where it is stated: "§9.1.19 Table 17, note 1: write 0"
+};
+
 /// Everything that distinguishes one family member from another.
 struct Variant {
   std::string_view name;                   ///< "L6470", ...
@@ -35,6 +42,8 @@ struct Variant {
   /// Every opcode byte decoded for this variant: SetParam/GetParam of an address the
   /// variant lacks is Unknown, SetParam carries the register's SPI length.
   std::array<Opcode, 256> opcodes{};
+  /// Bits to be written 0 (STEP_MODE bit 3 on the L6470/L6480, CONFIG bit 6), for the sanitizer.
+  std::span<const ReservedBit> reserved_bits{};
 
   /// The register at `address`, or nullptr when the variant has none there.
   constexpr const RegisterInfo* at_address(std::uint8_t address) const {

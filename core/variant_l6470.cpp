@@ -22,8 +22,17 @@ constexpr AlarmLayout kL6470Alarms{
     Alarm::overcurrent, Alarm::thermal_shutdown, Alarm::thermal_warning, Alarm::uvlo,
     Alarm::stall_a,     Alarm::stall_b,          Alarm::switch_turn_on,  Alarm::command_error};
 
-constexpr Variant kL6470 = make_variant("L6470", kL6470Registers, kL6470Status, kL6470Alarms,
-                                        /*max_step_sel=*/7, /*infinite_acceleration=*/true);
+constexpr ReservedBit kL6470Reserved[] = {
+    {Reg::STEP_MODE, 3, "§9.1.19 Table 17, note 1: bit 3 is written 0"},
+    {Reg::CONFIG, 6, "§9.1.21 Table 22: bit 6 RESERVED (0 in the reset value 0x2E88)"},
+};
+
+constexpr Variant kL6470 = [] {
+  Variant v = make_variant("L6470", kL6470Registers, kL6470Status, kL6470Alarms,
+                           /*max_step_sel=*/7, /*infinite_acceleration=*/true);
+  v.reserved_bits = kL6470Reserved;
+  return v;
+}();
 
 static_assert(kL6470.find(Reg::ABS_POS)->spi_bytes() == 3);
 static_assert(kL6470.find(Reg::EL_POS)->spi_bytes() == 2);

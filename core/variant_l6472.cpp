@@ -33,9 +33,14 @@ constexpr std::string_view kUnconfirmedChoices[] = {
     "ACC = 0xFFF is reserved on the L6472: the emulator treats it as an ordinary acceleration",
 };
 
+constexpr ReservedBit kReserved[] = {
+    {Reg::CONFIG, 6, "CONFIG bit 6 reserved (the one L6472 header's layout; 0 in the reset value 0x2E88)"},
+};
+
 constexpr Variant kVariant = [] {
   Variant v = make_variant("L6472", kRegisters, kStatus, kAlarms, /*max_step_sel=*/4, /*infinite_acceleration=*/false);
   v.unconfirmed = kUnconfirmedChoices;
+  v.reserved_bits = kReserved;
   return v;
 }();
 

@@ -18,9 +18,15 @@ constexpr std::string_view kUnconfirmedChoices[] = {
     "UVLO_ADC, TH_STATUS and CMD_ERROR latch like the L6470 flags until GetStatus",
 };
 
+constexpr ReservedBit kReserved[] = {
+    {Reg::STEP_MODE, 3, "L6480 datasheet, STEP_MODE register: bit 3 is written 0 (as on the L6470)"},
+    {Reg::CONFIG, 6, "CONFIG bit 6 reserved (as on the L6470; 0 in the reset value 0x2C88)"},
+};
+
 constexpr Variant kVariant = [] {
   Variant v = make_variant("L6480", kRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
   v.unconfirmed = kUnconfirmedChoices;
+  v.reserved_bits = kReserved;
   return v;
 }();
 

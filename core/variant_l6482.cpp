@@ -34,9 +34,15 @@ constexpr std::string_view kUnconfirmedChoices[] = {
     "an access to a hole (0x0D, 0x11, 0x14) is an unknown command, like any missing address",
 };
 
+// STEP_MODE bit 3 is not here: ST's cSPIN says write 1, its own defaults write 0 (CONFLICT).
+constexpr ReservedBit kReserved[] = {
+    {Reg::CONFIG, 6, "CONFIG bit 6 reserved (ST cSPIN's L6482 layout; 0 in the reset value 0x2C88)"},
+};
+
 constexpr Variant kVariant = [] {
   Variant v = make_variant("L6482", kRegisters, kStatus, kAlarms, /*max_step_sel=*/4, /*infinite_acceleration=*/true);
   v.unconfirmed = kUnconfirmedChoices;
+  v.reserved_bits = kReserved;
   return v;
 }();
 

@@ -31,10 +31,16 @@ constexpr std::string_view kUnconfirmedChoices[] = {
     "1/128 microstepping in both modes",
 };
 
+// STEP_MODE bit 3 is CM_VM here (voltage or current mode), not reserved.
+constexpr ReservedBit kReserved[] = {
+    {Reg::CONFIG, 6, "CONFIG bit 6 reserved (ST's powerSTEP01 code; 0 in the reset value 0x2C88)"},
+};
+
 constexpr Variant kCurrentMode = [] {
   Variant v = make_variant("powerSTEP01", kCurrentModeRegisters, kGateDriverStatus, kGateDriverAlarms, 7, true);
   v.reset_device_needs_hiz = true;
   v.unconfirmed = kUnconfirmedChoices;
+  v.reserved_bits = kReserved;
   return v;
 }();
 
@@ -43,6 +49,7 @@ constexpr Variant kVoltageMode = [] {
   v.current_mode = &kCurrentMode;
   v.reset_device_needs_hiz = true;
   v.unconfirmed = kUnconfirmedChoices;
+  v.reserved_bits = kReserved;
   return v;
 }();
 

@@ -68,6 +68,9 @@ const std::vector<Case>& cases() {
        "import gpiod\nline = gpiod.Chip('gpiochip0').find_line('STBY_RST')\n"
        "line.request(consumer='t', type=gpiod.LINE_REQ_DIR_OUT, default_vals=[0])\nb(0xD0)\n",
        {"STANDBY_BYTE on spidev0.0, chip 0, frame 1, byte 0", "the command byte 0xD0 is lost", "§6.12"}},
+      {"RESERVED_BITS", "L6470", "b(0x16, 0x0F)\n",
+       {"RESERVED_BITS on spidev0.0, chip 0, frame 2, byte 0",
+        "SetParam(STEP_MODE) value 0x0F sets bit 3, which is to be written 0: §9.1.19 Table 17, note 1"}},
   };
   return all;
 }
