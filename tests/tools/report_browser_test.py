@@ -7,8 +7,8 @@ instant (typed into the page's time box, as a person would) shows the ABS_POS an
 `decode` shows there, the arrow keys move it frame by frame and + zooms; `run --html` and
 `campaign --html` write such pages too. A board of two chains gives one page with a section per
 chain: each chain's timeline holds that chain's frames, and the cursor typed to a time on the
-second chain shows the ABS_POS and STATUS `decode` shows in that chain's trace. Takes the screenshot
-docs/report.md shows (L6470EMU_UPDATE_DOCS=1 writes it to docs/report.png).
+second chain shows the ABS_POS and STATUS `decode` shows in that chain's trace. Takes the screenshots
+docs/report.md shows (L6470EMU_UPDATE_DOCS=1 writes them to docs/report.png and docs/report-chains.png).
 
 Usage: report_browser_test.py L6470EMU SOURCE_DIR WORK_DIR CAMPAIGN_DRIVER
 Exit 77 (skipped, with the reason) when chromium, chromedriver or selenium is missing."""
@@ -207,8 +207,8 @@ os.makedirs(two)
 with open(os.path.join(two, "driver.py"), "w") as f:
     f.write(TWO_CHAIN_DRIVER)
 page = os.path.join(two, "two-chains.html")
-r = run("run", "--chain", "bus=0 cs=0 chips=L6470; bus=0 cs=1 chips=2xL6470", "--record", os.path.join(two, "run.trace"),
-        "--html", page, "--", "/usr/bin/python3", os.path.join(two, "driver.py"))
+r = run("run", "--chain", "bus=0 cs=0 chips=L6470; bus=0 cs=1 chips=2xL6470", "--record", "run.trace", "--html", "two-chains.html",
+        "--", "/usr/bin/python3", "driver.py", cwd=two)
 check(r.returncode == 0 and os.path.exists(page), "run --html on two chains writes the page (%s)" % r.stderr.strip().splitlines()[-1:])
 if os.path.exists(page):
     name = "two chains"
@@ -244,6 +244,19 @@ if os.path.exists(page):
     cur = browser.execute_script("return l6470emuReport.cursor()")
     check(cur["chain"] == 1 and cur["frame"] == max(before - 1, 0), "%s: ← moves the cursor on the chain last used (%s)" % (name, cur))
     check(not errors(), "%s: still no JavaScript error" % name)
+    # The screenshot docs/report.md shows of it: the second chain's section, the cursor on its Moves.
+    goto(0.000210 + 0.5e-6, "chain1-goto-time")
+    for _ in range(12):
+        body.send_keys("+")
+    browser.execute_script("document.getElementById('chain1').scrollIntoView()")
+    shot = os.path.join(work, "report-chains.png")
+    browser.set_window_size(1280, 1000)
+    browser.save_screenshot(shot)
+    browser.set_window_size(1280, 900)
+    check(os.path.getsize(shot) > 10000, "screenshot taken: " + shot)
+    if os.environ.get("L6470EMU_UPDATE_DOCS") == "1":
+        shutil.copyfile(shot, os.path.join(source_dir, "docs", "report-chains.png"))
+        print("wrote docs/report-chains.png")
 
 # The screenshot the docs show: three chips, the cursor on the Move commands, zoomed in.
 page = os.path.join(work, "docs.html")
