@@ -224,7 +224,9 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
   cmd_->add_option("--shard", shard_, "run only shard K of N (K/N): reruns K-1, K-1+N, ...; join with campaign merge");
   cmd_->add_option("--json", json_, "write the report as JSON (reproducing scenarios are written beside it)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report: one testcase per fault and chip");
-  cmd_->add_option("--html", html_, "write the report page (docs/report.md): the clean run's traces (every chain it used) with the matrix");
+  cmd_->add_option("--html", html_,
+                   "write the report page (docs/report.md): the clean run's traces (every chain it used) with the "
+                   "matrix");
   cmd_->add_option("--fail-on", fail_on_,
                    "verdicts that fail the campaign (default silent_failure,hang,deadlock,crash; also detected, survived, "
                    "survived-unread)");
@@ -686,8 +688,9 @@ int CampaignCommand::run_campaign() {
     for (std::size_t c = 0; c < config.chains.size(); ++c)
       if (fs::exists(trace_of(clean_trace, c))) {  // (a chain the program never opened has no recording)
         page.traces.push_back(trace_of(clean_trace, c));
-        page.traces_shown.push_back(config.chains.size() == 1 ? "(the clean run's recording)"
-                                                              : "(the clean run's recording of " + probe.chain_name(c) + ")");
+        page.traces_shown.push_back(config.chains.size() == 1
+                                        ? "(the clean run's recording)"
+                                        : "(the clean run's recording of " + probe.chain_name(c) + ")");
       }
     if (!coverage_.empty()) page.coverage = {coverage_};
     page.campaign_report = report;

@@ -131,8 +131,11 @@ int run_report(const ReportArgs& args, std::ostream& err, const std::string& who
     if (const std::uint64_t findings = data.findings(); findings) err << ", " << counted(findings, "finding");
     for (const ReportChain& c : data.chains)
       if (!c.first_divergence.empty())
-        err << ", DIVERGED " << (data.chains.size() > 1 ? "on " + c.name + " " : std::string()) << "at " << c.first_divergence;
-    if (data.summarised()) err << " (summarised: the " << (data.chains.size() > 1 ? "run" : "trace") << " is longer than a page shows one by one)";
+        err << ", DIVERGED " << (data.chains.size() > 1 ? "on " + c.name + " " : std::string()) << "at "
+            << c.first_divergence;
+    if (data.summarised())
+      err << " (summarised: the " << (data.chains.size() > 1 ? "run" : "trace")
+          << " is longer than a page shows one by one)";
     err << " -> " << args.output << " (" << size << " MB)\n";
     return kTraceOk;
   } catch (const std::exception& e) {

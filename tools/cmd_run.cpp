@@ -385,8 +385,9 @@ RunCommand::RunCommand(CLI::App& app) {
   cmd_->add_option("--timeout", timeout_, "simulated time limit (seconds, or 250ms, 2min, ...; default: the scenario's timeout:, else none)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
-  cmd_->add_option("--html", html_, "write the run's report page to this file (docs/report.md): every chain the program used on one page; "
-                  "with --record, from those traces");
+  cmd_->add_option("--html", html_,
+                   "write the run's report page to this file (docs/report.md): every chain the program used on one "
+                   "page; with --record, from those traces");
   cmd_->add_option("--coverage", coverage_,
                    "collect interface coverage and merge it into this file (every process of the program; docs/coverage.md)");
   cmd_->add_option("--nodes", nodes_,

@@ -861,7 +861,8 @@ std::vector<ReportLimits> share_limits(const ReportLimits& limits, const std::ve
   std::size_t all_chips = 0;
   for (std::size_t c : chips) all_chips += std::max<std::size_t>(1, c);
   std::vector<std::size_t> wanted;  // rows a chain could use: at most one per frame
-  for (std::uint64_t f : frames) wanted.push_back(static_cast<std::size_t>(std::min<std::uint64_t>(f, limits.timeline_rows)));
+  for (std::uint64_t f : frames)
+    wanted.push_back(static_cast<std::size_t>(std::min<std::uint64_t>(f, limits.timeline_rows)));
   const std::vector<std::size_t> rows = water_fill(wanted, limits.timeline_rows);
   std::vector<ReportLimits> out(n, limits);
   for (std::size_t k = 0; k < n; ++k) {

@@ -33,7 +33,8 @@ std::vector<ChainRecording> find_run_recordings(const std::string& path) {
   const std::size_t at = marked.find('\x01');
   const std::string before = marked.substr(0, at), after = marked.substr(at + 1);
   const std::size_t slash = before.rfind('/');
-  const fs::path folder = slash == std::string::npos ? fs::path(".") : fs::path(slash == 0 ? "/" : before.substr(0, slash));
+  const fs::path folder =
+      slash == std::string::npos ? fs::path(".") : fs::path(slash == 0 ? "/" : before.substr(0, slash));
   const std::string prefix = slash == std::string::npos ? before : before.substr(slash + 1);
   struct Found {
     unsigned bus, cs;

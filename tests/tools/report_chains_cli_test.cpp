@@ -54,7 +54,8 @@ class ReportChainsCommand : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!report_page_available()) GTEST_SKIP() << "built without libjs-dygraphs";
-    if (run_command("/usr/bin/python3 -c 'import spidev'").status != 0) GTEST_SKIP() << "python3-spidev is not installed";
+    if (run_command("/usr/bin/python3 -c 'import spidev'").status != 0)
+      GTEST_SKIP() << "python3-spidev is not installed";
     driver_ = dir_.write("driver.py", kDriver);
   }
   std::string run_html(const std::string& extra) {
@@ -102,8 +103,9 @@ TEST_F(ReportChainsCommand, TheSameTwoChainRunGivesTheSamePageByteForByte) {
 
 TEST_F(ReportChainsCommand, CampaignHtmlOnATwoChainBoardShowsBothChainsOfTheCleanRunWithTheMatrix) {
   const std::string page = dir_.file("campaign.html");
-  const auto r = run_command("cd " + dir_.file("") + " && TMPDIR=" + tmp_ + " " + L6470EMU_BINARY + " campaign --chain " +
-                             kTwoChains + " --faults ocd -j 1 --html " + page + " -- /usr/bin/python3 " + driver_ + " </dev/null");
+  const auto r = run_command("cd " + dir_.file("") + " && TMPDIR=" + tmp_ + " " + L6470EMU_BINARY +
+                             " campaign --chain " + kTwoChains + " --faults ocd -j 1 --html " + page +
+                             " -- /usr/bin/python3 " + driver_ + " </dev/null");
   EXPECT_NE(r.out.find("campaign --html: 14 frames, 3 chips, 2 chains"), std::string::npos) << r.out;
   const nlohmann::json d = page_data(page);
   ASSERT_EQ(d["chains"].size(), 2u) << r.out;
