@@ -224,7 +224,9 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
   cmd_->add_option("--shard", shard_, "run only shard K of N (K/N): reruns K-1, K-1+N, ...; join with campaign merge");
   cmd_->add_option("--json", json_, "write the report as JSON (reproducing scenarios are written beside it)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report: one testcase per fault and chip");
-  cmd_->add_option("--html", html_, "write the report page (docs/report.md): the clean run's trace with the matrix");
+  cmd_->add_option("--html", html_,
+                   "write the report page (docs/report.md): the clean run's traces (every chain it used) with the "
+                   "matrix");
   cmd_->add_option("--fail-on", fail_on_,
                    "verdicts that fail the campaign (default silent_failure,hang,deadlock,crash; also detected, survived, "
                    "survived-unread)");
@@ -334,7 +336,6 @@ int CampaignCommand::run_campaign() {
   if (!html_.empty()) {
     if (const std::string why = output_problem(html_, inputs); !why.empty()) return usage("cannot write " + quoted_text(html_) + ": " + why);
     if (html_ == json_ || html_ == junit_) return usage("--html names the same file as another output");
-    if (config.chains.size() != 1) return usage("--html shows one chain: the board has " + std::to_string(config.chains.size()));
   }
   // Coverage: the clean run's only (L6470EMU_COVERAGE asks the same); the faulted reruns collect none.
   if (const char* env = std::getenv(kCoverageEnv); env && *env && cmd_->count("--coverage") == 0) coverage_ = env;
@@ -684,13 +685,21 @@ int CampaignCommand::run_campaign() {
   }
   if (!html_.empty()) {  // the clean run's page with the matrix
     ReportArgs page;
-    page.trace.path = clean_trace;
+    for (std::size_t c = 0; c < config.chains.size(); ++c)
+      if (fs::exists(trace_of(clean_trace, c))) {  // (a chain the program never opened has no recording)
+        page.traces.push_back(trace_of(clean_trace, c));
+        page.traces_shown.push_back(config.chains.size() == 1
+                                        ? "(the clean run's recording)"
+                                        : "(the clean run's recording of " + probe.chain_name(c) + ")");
+      }
     if (!coverage_.empty()) page.coverage = {coverage_};
     page.campaign_report = report;
     page.output = html_;
     page.title = "campaign: " + program_.front();
-    page.trace_shown = "(the clean run's recording)";
-    if (run_report(page, std::cerr, "campaign --html") != 0) status = kRunUsage;
+    if (page.traces.empty())
+      std::cerr << "l6470emu campaign --html: no page: the clean run never used a chain (nothing was recorded)\n";
+    else if (run_report(page, std::cerr, "campaign --html") != 0)
+      status = kRunUsage;
   }
   if (g_stop.load()) {
     std::cerr << "l6470emu campaign: stopped by signal " << g_stop.load() << " after " << report.reruns.size() << " of "

@@ -34,6 +34,7 @@
 #include "linux/serve/daemon.hpp"
 #include "linux/virtual_scheduler.hpp"
 #include "tools/cmd_report.hpp"
+#include "tools/run_recordings.hpp"
 #include "tools/kernel_nodes.hpp"
 #include "tools/output_check.hpp"
 #include "tools/xml_text.hpp"
@@ -393,7 +394,9 @@ RunCommand::RunCommand(CLI::App& app) {
                    "with status 3, whatever its clock (seconds, or 250ms, 2min, ...; default 3600)");
   cmd_->add_option("--junit", junit_, "write a JUnit XML report to this file");
   cmd_->add_option("--record", record_, "record the run into this native trace (one file per chain when several)");
-  cmd_->add_option("--html", html_, "write the run's report page to this file (docs/report.md; with --record, from that trace)");
+  cmd_->add_option("--html", html_,
+                   "write the run's report page to this file (docs/report.md): every chain the program used on one "
+                   "page; with --record, from those traces");
   cmd_->add_option("--coverage", coverage_,
                    "collect interface coverage and merge it into this file (every process of the program; docs/coverage.md)");
   cmd_->add_option("--nodes", nodes_,
@@ -434,22 +437,23 @@ std::optional<int> RunCommand::run() {
     text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   if (text.find("check=") == std::string::npos) config.check.level = CheckLevel::error;
-  // --html without --record: the run is recorded into a temporary trace for the page.
+  // --html without --record: the run is recorded into a temporary trace for the page (a board
+  // of several chains into one beside it per chain, named after it: run_recordings).
   struct TempTrace {
-    std::string path;
+    std::vector<std::string> paths;
     ~TempTrace() {
-      if (!path.empty()) unlink(path.c_str());
+      for (const std::string& path : paths) unlink(path.c_str());
     }
   } temp_trace;
-  if (!html_.empty()) {
-    if (config.chains.size() != 1) return usage("l6470emu run: --html shows one chain: the board has " + std::to_string(config.chains.size()));
-    if (record_.empty()) {
-      try {
-        temp_trace.path = record_ = temp_file("trace", "");
-      } catch (const std::exception& e) {
-        return usage(std::string("l6470emu run: --html: ") + e.what());
-      }
+  if (!html_.empty() && record_.empty()) {
+    try {
+      record_ = temp_file("trace", "");
+    } catch (const std::exception& e) {
+      return usage(std::string("l6470emu run: --html: ") + e.what());
     }
+    temp_trace.paths.push_back(record_);
+    for (const ChainRecording& r : run_recordings(config, record_))
+      if (r.path != record_) temp_trace.paths.push_back(r.path);
   }
   if (!record_.empty()) config.trace = record_;
   // The reports, checked before the program starts: one that cannot be written, or that is an
@@ -706,16 +710,22 @@ std::optional<int> RunCommand::run() {
       return kRunUsage;
     }
   }
-  if (!html_.empty()) {  // the page of what was recorded (nothing is when the program never opened the chain)
+  if (!html_.empty()) {  // the page of what was recorded: every chain the program opened
     ReportArgs page;
-    page.trace.path = record_;
+    const bool several = config.chains.size() > 1;
+    for (const ChainRecording& r : run_recordings(config, record_)) {
+      struct stat st {};
+      if (stat(r.path.c_str(), &st) != 0 || st.st_size == 0) continue;  // a chain the program never opened
+      page.traces.push_back(r.path);
+      if (cmd_->count("--record") == 0)
+        page.traces_shown.push_back(several ? "(the run's recording of " + r.chain + ")" : "(the run's recording)");
+    }
     if (!coverage_.empty() && std::filesystem::exists(coverage_)) page.coverage = {coverage_};
     page.output = html_;
     page.title = "run: " + program_.front();
-    if (cmd_->count("--record") == 0) page.trace_shown = "(the run's recording)";
-    struct stat st {};
-    if (stat(record_.c_str(), &st) != 0 || st.st_size == 0)
-      std::cerr << "l6470emu run: no page: the program never used the chain (nothing was recorded)\n";
+    if (page.traces.empty())
+      std::cerr << "l6470emu run: no page: the program never used " << (several ? "any chain" : "the chain")
+                << " (nothing was recorded)\n";
     else if (run_report(page, std::cerr, "run --html") != 0)
       return kRunUsage;
   }

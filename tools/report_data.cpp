@@ -1,18 +1,22 @@
-// make_report_data: five passes over the trace, each through a fresh chain of the world: its
-// end, the motion series (sample_motion), the frames and the chips' state (ProtocolTracker,
+// make_report_chain: five passes over a chain's trace, each through a fresh chain of the world:
+// its end, the motion series (sample_motion), the frames and the chips' state (ProtocolTracker,
 // DivergenceWatch), the sanitizer's rules (ChainChecker on the frames as the bus gives them) and
-// the divergences (replay_trace). Each keeps within ReportLimits as it goes.
+// the divergences (replay_trace). Each keeps within ReportLimits as it goes. make_report_data:
+// the chains of a run, the limits shared among them (share_limits).
 #include "tools/report_data.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cstdio>
 #include <deque>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <tuple>
 
+#include "board/board_chain.hpp"
 #include "board/coverage_report.hpp"
 #include "board/sanitizer.hpp"
 #include "core/counted.hpp"
@@ -270,7 +274,7 @@ std::vector<std::size_t> water_fill(const std::vector<std::size_t>& counts, std:
 /// counting keeper only counts each slice's rows.
 class Keeper {
  public:
-  Keeper(ReportData& data, std::size_t reserve, Tick end, const std::vector<std::size_t>* shares,
+  Keeper(ReportChain& data, std::size_t reserve, Tick end, const std::vector<std::size_t>* shares,
          std::vector<std::size_t>* counts)
       : data_(data), reserve_(reserve), end_(end), shares_(shares), counts_(counts) {}
 
@@ -326,7 +330,7 @@ class Keeper {
     gap_.reset();
   }
 
-  ReportData& data_;
+  ReportChain& data_;
   std::size_t reserve_, reserve_used_ = 0;
   Tick end_;
   const std::vector<std::size_t>* shares_;
@@ -340,7 +344,7 @@ class FramePass {
  public:
   /// `shares`: the timeline's row share of each time slice (nullptr: keep every row). With
   /// `counts`, the pass only counts each slice's rows (for water_fill) and extracts nothing else.
-  FramePass(ReportData& data, Chain& chain, const ReportOptions& o, const std::string& name, Tick end, Tick shown_to,
+  FramePass(ReportChain& data, Chain& chain, const ReportOptions& o, const std::string& name, Tick end, Tick shown_to,
             const std::vector<std::size_t>* shares = nullptr, std::vector<std::size_t>* counts = nullptr)
       : data_(data),
         chain_(chain),
@@ -662,7 +666,7 @@ class FramePass {
     std::array<bool, 32> known{};
   };
 
-  ReportData& data_;
+  ReportChain& data_;
   Chain& chain_;
   const ReportOptions& options_;
   ChipNumbering numbering_;
@@ -743,11 +747,25 @@ Finding divergence_finding(const Divergence& d) {
   return f;
 }
 
+/// The chain a recording is of: its device node's name and its bus and chip select, from the
+/// trace's board lines (whatever world it is run through); else the file's name.
+std::pair<std::string, std::string> chain_name_of(const TraceFile& file) {
+  const TraceHeader& h = file.header();
+  if (!h.board.empty()) {
+    const ChainDescription d = parse_chain_description(h.board, h.name);
+    if (d.board) {
+      const ChainConfig& c = d.chain();
+      return {c.path.substr(c.path.rfind('/') + 1), "bus " + std::to_string(c.bus) + ", cs " + std::to_string(c.cs)};
+    }
+  }
+  return {file.path().substr(file.path().rfind('/') + 1), ""};
+}
+
 }  // namespace
 
-ReportData make_report_data(const TraceFile& file, const TraceWorld& world, const ReportOptions& options) {
-  ReportData data;
-  data.title = options.title.empty() ? file.path() : options.title;
+ReportChain make_report_chain(const TraceFile& file, const TraceWorld& world, const ReportOptions& options) {
+  ReportChain data;
+  std::tie(data.name, data.where) = chain_name_of(file);
   data.trace_path = file.path();
   data.trace_format = file.header().format;
   data.chain = world.summary() + " (" + world.how + ")";
@@ -784,7 +802,7 @@ ReportData make_report_data(const TraceFile& file, const TraceWorld& world, cons
     std::vector<std::size_t> counts(kSlices);
     auto in = file.read();
     Chain chain = world.make_chain();
-    ReportData scratch;
+    ReportChain scratch;
     FramePass pass(scratch, chain, options, in->header().name, data.end_tick, data.shown_to, nullptr, &counts);
     TraceEvent e;
     while (in->next(e)) {
@@ -833,6 +851,96 @@ ReportData make_report_data(const TraceFile& file, const TraceWorld& world, cons
   data.findings_dropped = total > data.findings.size() ? total - data.findings.size() : 0;
   std::stable_sort(data.findings.begin(), data.findings.end(),
                    [](const Finding& a, const Finding& b) { return a.tick < b.tick; });
+  return data;
+}
+
+std::vector<ReportLimits> share_limits(const ReportLimits& limits, const std::vector<std::uint64_t>& frames,
+                                       const std::vector<std::size_t>& chips) {
+  const std::size_t n = frames.size();
+  if (n <= 1) return std::vector<ReportLimits>(n, limits);
+  std::size_t all_chips = 0;
+  for (std::size_t c : chips) all_chips += std::max<std::size_t>(1, c);
+  std::vector<std::size_t> wanted;  // rows a chain could use: at most one per frame
+  for (std::uint64_t f : frames)
+    wanted.push_back(static_cast<std::size_t>(std::min<std::uint64_t>(f, limits.timeline_rows)));
+  const std::vector<std::size_t> rows = water_fill(wanted, limits.timeline_rows);
+  std::vector<ReportLimits> out(n, limits);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t mine = std::max<std::size_t>(1, k < chips.size() ? chips[k] : 1);
+    auto per_chip = [&](std::size_t limit) { return std::max<std::size_t>(1, limit * mine / all_chips); };
+    ReportLimits& l = out[k];
+    // Frames beyond the chain's share are summarised: the share is exact where the chain has
+    // fewer frames than it (all of them shown), a level the larger chains share otherwise.
+    l.timeline_rows = std::max<std::size_t>(1, rows[k]);
+    l.motion_points = per_chip(limits.motion_points);
+    l.state_samples = per_chip(limits.state_samples);
+    l.phase_samples = per_chip(limits.phase_samples);
+    l.input_edges = per_chip(limits.input_edges);
+    l.register_changes = per_chip(limits.register_changes);
+    l.findings = std::max<std::size_t>(1, limits.findings / n);
+  }
+  return out;
+}
+
+std::uint64_t ReportData::frames() const {
+  std::uint64_t n = 0;
+  for (const ReportChain& c : chains) n += c.frames;
+  return n;
+}
+
+std::size_t ReportData::chips() const {
+  std::size_t n = 0;
+  for (const ReportChain& c : chains) n += c.chips.size();
+  return n;
+}
+
+std::uint64_t ReportData::findings() const {
+  std::uint64_t n = 0;
+  for (const ReportChain& c : chains) n += c.diagnostics + c.sanitizer_findings;
+  return n;
+}
+
+bool ReportData::summarised() const {
+  return std::any_of(chains.begin(), chains.end(), [](const ReportChain& c) { return c.summarised; });
+}
+
+ReportData make_report_data(const std::vector<ReportRecording>& recordings, const ReportOptions& options) {
+  // A run records each chain once: two recordings of one chain are two runs, or a file twice.
+  for (std::size_t a = 0; a < recordings.size(); ++a)
+    for (std::size_t b = a + 1; b < recordings.size(); ++b) {
+      const std::string& pa = recordings[a].file.path();
+      const std::string& pb = recordings[b].file.path();
+      std::error_code ec;
+      if (pa == pb || std::filesystem::equivalent(pa, pb, ec))
+        throw std::invalid_argument(quoted_text(pb) + " is given twice: give each chain's recording once");
+      const auto na = chain_name_of(recordings[a].file), nb = chain_name_of(recordings[b].file);
+      if (!na.second.empty() && na == nb)
+        throw std::invalid_argument(quoted_text(pa) + " and " + quoted_text(pb) + " both record " + na.first + " (" +
+                                    na.second + "): a page shows one run, with one recording per chain");
+    }
+  ReportData data;
+  std::vector<ReportLimits> limits(recordings.size(), options.limits);
+  if (recordings.size() > 1) {
+    std::vector<std::uint64_t> frames;
+    std::vector<std::size_t> chips;
+    for (const ReportRecording& r : recordings) {
+      auto in = r.file.read();
+      std::uint64_t count = 0;
+      TraceEvent e;
+      while (in->next(e)) count += e.kind == TraceEventKind::frame;
+      frames.push_back(count);
+      chips.push_back(r.world.chain().chips.size());
+    }
+    limits = share_limits(options.limits, frames, chips);
+  }
+  for (std::size_t k = 0; k < recordings.size(); ++k) {
+    ReportOptions o = options;
+    o.limits = limits[k];
+    data.chains.push_back(make_report_chain(recordings[k].file, recordings[k].world, o));
+  }
+  data.title = options.title;
+  if (data.title.empty())
+    for (std::size_t k = 0; k < recordings.size(); ++k) data.title += (k ? ", " : "") + recordings[k].file.path();
   return data;
 }
 
@@ -928,14 +1036,15 @@ Json campaign_page_json(const CampaignReport& r) {
 
 }  // namespace
 
-std::string report_json(const ReportData& d) {
+namespace {
+
+Json chain_json(const ReportChain& d) {
   StringTable strings;
   Json j;
-  j["format"] = "l6470emu-report 1";
-  j["title"] = d.title;
+  j["name"] = d.name;
+  j["where"] = d.where;
   j["trace"] = {{"path", d.trace_path}, {"format", d.trace_format}, {"chain", d.chain}, {"numbering", d.numbering},
                 {"notes", d.notes}};
-  j["tick_ns"] = 250;
   j["frames"] = d.frames;
   j["end"] = d.end_tick;
   j["shown_to"] = d.shown_to;
@@ -1024,10 +1133,30 @@ std::string report_json(const ReportData& d) {
                  {"divergent_pins", d.divergent_pins},
                  {"findings_dropped", d.findings_dropped}};
   j["first_divergence"] = d.first_divergence;
+  j["strings"] = strings.json();
+  return j;
+}
+
+std::string dumped(const Json& j) { return j.dump(-1, ' ', false, Json::error_handler_t::replace); }
+
+}  // namespace
+
+std::string report_chain_json(const ReportChain& chain) { return dumped(chain_json(chain)); }
+
+std::string report_json(const ReportData& d) {
+  Json j;
+  j["format"] = "l6470emu-report 2";
+  j["title"] = d.title;
+  j["tick_ns"] = 250;
+  Tick shown_to = 0;
+  for (const ReportChain& c : d.chains) shown_to = std::max(shown_to, c.shown_to);
+  j["shown_to"] = shown_to;
+  Json chains = Json::array();
+  for (const ReportChain& c : d.chains) chains.push_back(chain_json(c));
+  j["chains"] = std::move(chains);
   j["coverage"] = d.coverage ? coverage_json(*d.coverage) : Json();
   j["campaign"] = d.campaign ? campaign_page_json(*d.campaign) : Json();
-  j["strings"] = strings.json();
-  return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+  return dumped(j);
 }
 
 }  // namespace l6470emu

@@ -1,8 +1,10 @@
-// What the report page shows of a trace, extracted with the existing views over it: the frames
-// and what each chip made of them (ProtocolTracker, as `decode`), the motion (sample_motion, as
-// `plot`), the registers and phase drive as the emulated chips have them after each event, the
-// sanitizer's findings (board/sanitizer.hpp) and the divergences (replay_trace). Data only, in
-// bounded amounts; tools/report_page.hpp writes the page. No model of its own.
+// What the report page shows of a run, extracted with the existing views over its recordings:
+// the frames and what each chip made of them (ProtocolTracker, as `decode`), the motion
+// (sample_motion, as `plot`), the registers and phase drive as the emulated chips have them
+// after each event, the sanitizer's findings (board/sanitizer.hpp) and the divergences
+// (replay_trace). A run of several chains has a recording per chain (trace_path_for_chain):
+// each is read on its own into a ReportChain, and the page's bounds are shared among them. Data
+// only, in bounded amounts; tools/report_page.hpp writes the page. No model of its own.
 #pragma once
 
 #include <cstdint>
@@ -20,10 +22,10 @@
 
 namespace l6470emu {
 
-/// How much of a trace a page keeps. A trace within these limits is shown whole; a longer one
-/// is summarised: the timeline keeps its rows per time slice and stands the rest as summarised
-/// spans (their frames counted exactly), and each series keeps, per time slice, its first and
-/// last sample and those with the extremes.
+/// How much of a run a page keeps, all its chains together. A run within these limits is shown
+/// whole; a longer one is summarised: the timeline keeps its rows per time slice and stands the
+/// rest as summarised spans (their frames counted exactly), and each series keeps, per time
+/// slice, its first and last sample and those with the extremes.
 struct ReportLimits {
   std::size_t timeline_rows = 100'000;   ///< frame rows kept in full, a repeated group counted once per row
   std::size_t motion_points = 60'000;   ///< position/speed samples, all chips together (sample_motion)
@@ -41,7 +43,7 @@ struct ReportOptions {
   /// While a chip moves its phase drive is looked at this often at least (fewer when the
   /// trace is long: the samples stay within limits.phase_samples).
   Tick phase_step = ticks_from_us(10);
-  std::string title;  ///< the page's title ("" = the trace's name)
+  std::string title;  ///< the page's title ("" = the traces' names)
 };
 
 /// One frame as a row of the timeline: when, its bytes, what each chip made of it.
@@ -154,9 +156,12 @@ struct Finding {
   std::string detail;       ///< more lines (a divergence's full report, the datasheet's place)
 };
 
-/// The page's data.
-struct ReportData {
-  std::string title;
+/// One chain of the run, from its recording: its frames, chips and findings.
+struct ReportChain {
+  /// The chain's name as the board names it: its device node's ("spidev0.1", from the trace's
+  /// board lines), or the trace's file name when the trace does not say.
+  std::string name;
+  std::string where;        ///< "bus 0, cs 1" ("" when the trace does not say)
   std::string trace_path, trace_format;
   std::string chain;        ///< "3*L6470 (from the trace's chain line)"
   std::string numbering;    ///< describe_numbering
@@ -173,16 +178,51 @@ struct ReportData {
   std::uint64_t findings_dropped = 0;
   std::string first_divergence;  ///< one line ("" = the emulator reproduces the trace)
   bool summarised = false;       ///< something was left out (ReportLimits)
-  std::optional<CoverageData> coverage;
-  std::optional<CampaignReport> campaign;
 };
 
-/// Reads `file` through the chain of `world` and extracts the page's data (several passes over
-/// the trace). Throws TraceError for malformed input and std::invalid_argument for a trace the
-/// chain cannot run (events naming chips outside it).
-ReportData make_report_data(const TraceFile& file, const TraceWorld& world, const ReportOptions& options = {});
+/// The page's data: every chain of the run, and what belongs to the run as a whole.
+struct ReportData {
+  std::string title;
+  std::vector<ReportChain> chains;  ///< in the order their recordings were given
+  std::optional<CoverageData> coverage;
+  std::optional<CampaignReport> campaign;
 
-/// The data as JSON, the page's script reads it (deterministic: the same data, the same bytes).
+  std::uint64_t frames() const;    ///< all chains together
+  std::size_t chips() const;       ///< all chains together
+  std::uint64_t findings() const;  ///< diagnostics and sanitizer findings, all chains together
+  bool summarised() const;         ///< some chain was summarised
+};
+
+/// A recording of one chain to read: the trace and the world it runs through.
+struct ReportRecording {
+  const TraceFile& file;
+  const TraceWorld& world;
+};
+
+/// Each chain's share of the page's `limits` when the chains' recordings hold `frames` frames
+/// and `chips` chips: the series and the per-chip lists in proportion to the chips, the
+/// timeline's rows shared as the time slices share them (a chain with fewer frames than an
+/// equal share keeps them all, the others share the rest equally), the findings equally. One
+/// chain keeps `limits` as they are.
+std::vector<ReportLimits> share_limits(const ReportLimits& limits, const std::vector<std::uint64_t>& frames,
+                                       const std::vector<std::size_t>& chips);
+
+/// Reads `file` through the chain of `world` and extracts what the page shows of it, within
+/// `options.limits` (several passes over the trace). Throws TraceError for malformed input and
+/// std::invalid_argument for a trace the chain cannot run (events naming chips outside it).
+ReportChain make_report_chain(const TraceFile& file, const TraceWorld& world, const ReportOptions& options = {});
+
+/// The page's data of a run from its chains' recordings (one or more), within
+/// `options.limits` all together (share_limits; with several chains each recording is read once
+/// more first, to count its frames). The title is `options.title`, else the traces' names.
+/// Throws as make_report_chain.
+ReportData make_report_data(const std::vector<ReportRecording>& recordings, const ReportOptions& options = {});
+
+/// One chain as JSON (its own string table; deterministic: the same data, the same bytes).
+std::string report_chain_json(const ReportChain& chain);
+
+/// The page's data as JSON, the page's script reads it: the title, every chain
+/// (report_chain_json), the coverage and the campaign. Deterministic.
 std::string report_json(const ReportData& data);
 
 }  // namespace l6470emu

@@ -66,6 +66,10 @@ void finish(int status) {
 void add_trace_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("TRACE", a.path, "trace file: native, Saleae CSV, umockdev .ioctl, ftrace text, sigrok JSON, VCD or .sr")
       ->required();
+  add_trace_reading_options(sub, a);
+}
+
+void add_trace_reading_options(CLI::App* sub, TraceArgs& a) {
   sub->add_option("--format", a.format, "input format (default: recognised from the content)")
       ->check(one_of({"auto", "native", "saleae", "umockdev", "ftrace", "sigrok", "vcd"}));
   sub->add_option("--chain", a.chain,

@@ -86,6 +86,8 @@ int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err);
 /// Adds the options every trace subcommand takes (TRACE, --format, --chain, --board, --select,
 /// --framing, --sigrok-decoder, --max-frames) to `sub`, into `a`.
 void add_trace_options(CLI::App* sub, TraceArgs& a);
+/// The same without TRACE (a subcommand that takes its traces its own way, as `report`).
+void add_trace_reading_options(CLI::App* sub, TraceArgs& a);
 /// Adds --number-from to `sub`, into `value`.
 void add_number_from_option(CLI::App* sub, std::string& value);
 

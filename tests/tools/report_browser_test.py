@@ -5,8 +5,10 @@ file and its campaign's JSON report. For each page: no JavaScript error and noth
 anywhere, the timeline holds as many frames as `decode` counts, the cursor moved to a known
 instant (typed into the page's time box, as a person would) shows the ABS_POS and STATUS that
 `decode` shows there, the arrow keys move it frame by frame and + zooms; `run --html` and
-`campaign --html` write such pages too. Takes the screenshot
-docs/report.md shows (L6470EMU_UPDATE_DOCS=1 writes it to docs/report.png).
+`campaign --html` write such pages too. A board of two chains gives one page with a section per
+chain: each chain's timeline holds that chain's frames, and the cursor typed to a time on the
+second chain shows the ABS_POS and STATUS `decode` shows in that chain's trace. Takes the screenshots
+docs/report.md shows (L6470EMU_UPDATE_DOCS=1 writes them to docs/report.png and docs/report-chains.png).
 
 Usage: report_browser_test.py L6470EMU SOURCE_DIR WORK_DIR CAMPAIGN_DRIVER
 Exit 77 (skipped, with the reason) when chromium, chromedriver or selenium is missing."""
@@ -96,8 +98,8 @@ def errors():
     return [e for e in browser.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
 
 
-def goto(seconds):
-    box = browser.find_element(By.ID, "goto-time")
+def goto(seconds, box_id="goto-time"):
+    box = browser.find_element(By.ID, box_id)
     box.clear()
     box.send_keys("%.7f" % seconds, Keys.ENTER)
 
@@ -183,6 +185,78 @@ if os.path.exists(page):
     open_page(page)
     check(not errors(), "campaign --html: no JavaScript error")
     check(len(browser.find_elements(By.CSS_SELECTOR, "table.matrix a[href^='#rerun-']")) > 0, "campaign --html: the matrix is on the page")
+
+# A board of two chains (one chip on spidev0.0, two on spidev0.1): one page, a section per chain.
+TWO_CHAIN_DRIVER = """import spidev, time
+def dev(cs):
+    s = spidev.SpiDev(); s.open(0, cs); s.mode = 3; s.max_speed_hz = 1000000; return s
+a, b = dev(0), dev(1)
+x = lambda s, *frames: [s.xfer2(list(f)) for f in frames]
+x(a, [0xD0], [0], [0])
+x(b, [0xD0, 0xD0], [0, 0], [0, 0])
+x(b, [0x41, 0x41], [0, 0], [0x0C, 0x06], [0x80, 0x40])
+x(a, [0x21], [0], [0], [0])
+time.sleep(1)
+x(b, [0x21, 0x21], [0, 0], [0, 0], [0, 0])
+x(b, [0xD0, 0xD0], [0, 0], [0, 0])
+x(a, [0xD0], [0], [0])
+"""
+two = os.path.join(work, "two-chains")
+shutil.rmtree(two, ignore_errors=True)
+os.makedirs(two)
+with open(os.path.join(two, "driver.py"), "w") as f:
+    f.write(TWO_CHAIN_DRIVER)
+page = os.path.join(two, "two-chains.html")
+r = run("run", "--chain", "bus=0 cs=0 chips=L6470; bus=0 cs=1 chips=2xL6470", "--record", "run.trace", "--html", "two-chains.html",
+        "--", "/usr/bin/python3", "driver.py", cwd=two)
+check(r.returncode == 0 and os.path.exists(page), "run --html on two chains writes the page (%s)" % r.stderr.strip().splitlines()[-1:])
+if os.path.exists(page):
+    name = "two chains"
+    traces = [os.path.join(two, "run.spidev0.0.trace"), os.path.join(two, "run.spidev0.1.trace")]
+    facts = [decode_facts(t) for t in traces]
+    body = open_page(page)
+    check(not errors(), "%s: no JavaScript error (%s)" % (name, errors() or "none"))
+    loaded = browser.execute_script("return performance.getEntriesByType('resource').length")
+    check(loaded == 0, "%s: the page loads nothing (%d resources)" % (name, loaded))
+    check(browser.execute_script("return l6470emuReport.chains()") == 2, "%s: the page has two chains" % name)
+    total = sum(f[0] for f in facts)
+    check(text("frame-count") == "%d frames" % total, "%s: the page holds %d frames (%s)" % (name, total, text("frame-count")))
+    for k, (frames, _, _) in enumerate(facts):
+        shown = text("chain%d-frame-count" % k)
+        check(shown == "%d frames" % frames, "%s: chain %d's timeline holds its %d frames (%s)" % (name, k, frames, shown))
+        counted = browser.execute_script("return l6470emuReport.chainFrames(%d)" % k)
+        check(counted == frames, "%s: the script counts %d frames on chain %d (%s)" % (name, frames, k, counted))
+    check(text("chain1").startswith("Chain spidev0.1 (bus 0, cs 1)"), "%s: the second section is spidev0.1 (%s)" % (name, text("chain1")))
+    _, pos, status = facts[1]
+    check(any(v != 0 for _, v in pos.values()), "%s: the second chain's chips moved (%s)" % (name, pos))
+    for chip, (t, value) in sorted(pos.items()):
+        goto(t + 0.5e-6, "chain1-goto-time")
+        shown = text("chain1-reg-%d-ABS_POS" % chip)
+        check(shown == str(value), "%s: at t=%.6f s spidev0.1 chip %d ABS_POS is %d (shown %s)" % (name, t, chip, value, shown))
+        check(browser.execute_script("return l6470emuReport.cursor().chain") == 1, "%s: the second chain's box moves its cursor" % name)
+        check(text("chain0-reg-0-ABS_POS") == "0", "%s: spidev0.0 at that instant shows its own chip (ABS_POS %s)" % (name, text("chain0-reg-0-ABS_POS")))
+    for chip, (t, value) in sorted(status.items()):
+        goto(t + 0.5e-6, "chain1-goto-time")
+        shown = text("chain1-status-%d" % chip)
+        check(shown == value, "%s: at t=%.6f s spidev0.1 chip %d STATUS is %s (shown %s)" % (name, t, chip, value, shown))
+    before = browser.execute_script("return l6470emuReport.cursor().frame")
+    body.send_keys(Keys.ARROW_LEFT)
+    cur = browser.execute_script("return l6470emuReport.cursor()")
+    check(cur["chain"] == 1 and cur["frame"] == max(before - 1, 0), "%s: ← moves the cursor on the chain last used (%s)" % (name, cur))
+    check(not errors(), "%s: still no JavaScript error" % name)
+    # The screenshot docs/report.md shows of it: the second chain's section, the cursor on its Moves.
+    goto(0.000210 + 0.5e-6, "chain1-goto-time")
+    for _ in range(12):
+        body.send_keys("+")
+    browser.execute_script("document.getElementById('chain1').scrollIntoView()")
+    shot = os.path.join(work, "report-chains.png")
+    browser.set_window_size(1280, 1000)
+    browser.save_screenshot(shot)
+    browser.set_window_size(1280, 900)
+    check(os.path.getsize(shot) > 10000, "screenshot taken: " + shot)
+    if os.environ.get("L6470EMU_UPDATE_DOCS") == "1":
+        shutil.copyfile(shot, os.path.join(source_dir, "docs", "report-chains.png"))
+        print("wrote docs/report-chains.png")
 
 # The screenshot the docs show: three chips, the cursor on the Move commands, zoomed in.
 page = os.path.join(work, "docs.html")

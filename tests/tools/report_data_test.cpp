@@ -33,7 +33,7 @@ struct Frame {
 };
 
 /// Every frame the timeline stands for, entries expanded (gaps as frames with no bytes).
-std::vector<Frame> expand(const ReportData& d) {
+std::vector<Frame> expand(const ReportChain& d) {
   std::vector<Frame> out;
   std::size_t g = 0;
   auto gaps_before = [&](std::uint64_t frame) {
@@ -51,9 +51,9 @@ std::vector<Frame> expand(const ReportData& d) {
   return out;
 }
 
-ReportData data_of(const std::string& path, const ReportOptions& o = {}) {
+ReportChain data_of(const std::string& path, const ReportOptions& o = {}) {
   const TraceFile file(path, TraceInputOptions{});
-  return make_report_data(file, world_for_trace({}, file), o);
+  return make_report_chain(file, world_for_trace({}, file), o);
 }
 
 std::string save(const Trace& t, const TempDir& dir, const std::string& name) {
@@ -81,7 +81,7 @@ const char* const kFixtures[] = {"three_chips.trace", "polling_host.trace", "sin
 TEST(ReportData, TheTimelineHoldsEveryFrameOfEachFixture) {
   for (const char* name : kFixtures) {
     SCOPED_TRACE(name);
-    const ReportData d = data_of(fixture_path(name));
+    const ReportChain d = data_of(fixture_path(name));
     const TraceFile file(fixture_path(name), TraceInputOptions{});
     auto in = file.read();
     std::vector<TraceEvent> frames;
@@ -111,7 +111,7 @@ TEST(ReportData, TheTimelineHoldsEveryFrameOfEachFixture) {
 }
 
 TEST(ReportData, RepeatedPollingCollapsesIntoRuns) {
-  const ReportData d = data_of(fixture_path("polling_host.trace"));
+  const ReportChain d = data_of(fixture_path("polling_host.trace"));
   EXPECT_EQ(d.frames, 3607u);
   EXPECT_LT(d.entries.size(), 200u) << "GetStatus every millisecond on two chips: runs, not 3607 rows";
   EXPECT_TRUE(std::any_of(d.entries.begin(), d.entries.end(), [](const ReportEntry& e) { return e.repetitions > 100; }));
@@ -120,7 +120,7 @@ TEST(ReportData, RepeatedPollingCollapsesIntoRuns) {
 TEST(ReportData, EachChipsTextsAreWhatDecodeSays) {
   for (const char* name : kFixtures) {
     SCOPED_TRACE(name);
-    const ReportData d = data_of(fixture_path(name));
+    const ReportChain d = data_of(fixture_path(name));
     const TraceFile file(fixture_path(name), TraceInputOptions{});
     Chain chain = world_for_trace({}, file).make_chain();
     auto in = file.read();
@@ -151,7 +151,7 @@ TEST(ReportData, TheRegistersAfterAFrameAreTheChips) {
   const std::int32_t pos = static_cast<std::int32_t>(s.host.get_param(0, Reg::ABS_POS));
   const std::uint16_t status = s.host.get_status(0);
   TempDir dir;
-  const ReportData d = data_of(save(s.trace, dir, "t.trace"));
+  const ReportChain d = data_of(save(s.trace, dir, "t.trace"));
   ASSERT_EQ(d.chips.size(), 2u);
   const ReportChip& c0 = d.chips[0];
   EXPECT_EQ(c0.states.back().abs_pos, pos);
@@ -177,7 +177,7 @@ TEST(ReportData, ThePhaseDriveWalksTheFullStepPoints) {
   s.host.wait_ms(1500);
   s.host.get_status(0);
   TempDir dir;
-  const ReportData d = data_of(save(s.trace, dir, "t.trace"));
+  const ReportChain d = data_of(save(s.trace, dir, "t.trace"));
   std::set<std::pair<int, int>> points;
   for (const PhaseSample& p : d.chips[0].phase)
     if (p.coil_a != 0 || p.coil_b != 0) points.insert({p.coil_a, p.coil_b});
@@ -205,7 +205,7 @@ TEST(ReportData, ALongRunStaysWithinTheLimitsWithItsExtremesKept) {
   o.limits.state_samples = 300;
   o.limits.phase_samples = 300;
   o.limits.motion_points = 300;
-  const ReportData d = data_of(save(s.trace, dir, "t.trace"), o);
+  const ReportChain d = data_of(save(s.trace, dir, "t.trace"), o);
   EXPECT_TRUE(d.summarised);
   EXPECT_FALSE(d.gaps.empty());
   std::size_t rows = 0;
@@ -233,7 +233,7 @@ TEST(ReportData, FindingsNameTheirFrames) {
                                      "0.00100000 frame 1.75us D0 | 00\n"
                                      "0.00200000 frame 1.75us EB | 7C\n"
                                      "0.00300000 frame 1.75us 00 | 55\n");
-  const ReportData d = data_of(path);
+  const ReportChain d = data_of(path);
   auto find = [&](const std::string& kind, const std::string& name) {
     return std::find_if(d.findings.begin(), d.findings.end(),
                         [&](const Finding& f) { return f.kind == kind && f.name == name; });
@@ -254,8 +254,8 @@ TEST(ReportData, FindingsNameTheirFrames) {
 }
 
 TEST(ReportData, TheJsonIsDeterministicAndCountsTheFrames) {
-  const ReportData d = data_of(fixture_path("three_chips.trace"));
-  const std::string a = report_json(d), b = report_json(data_of(fixture_path("three_chips.trace")));
+  const ReportChain d = data_of(fixture_path("three_chips.trace"));
+  const std::string a = report_chain_json(d), b = report_chain_json(data_of(fixture_path("three_chips.trace")));
   EXPECT_EQ(a, b);
   const auto j = nlohmann::json::parse(a);
   EXPECT_EQ(j["frames"], 30);
@@ -267,7 +267,8 @@ TEST(ReportData, TheJsonIsDeterministicAndCountsTheFrames) {
 
 TEST(ReportPage, IsOneFileThatLoadsNothing) {
   if (!report_page_available()) GTEST_SKIP() << "built without libjs-dygraphs";
-  ReportData d = data_of(fixture_path("three_chips.trace"));
+  ReportData d;
+  d.chains.push_back(data_of(fixture_path("three_chips.trace")));
   d.title = "</script><script>alert(1)</script>";
   std::ostringstream page;
   write_report_page(d, page);
