@@ -104,7 +104,8 @@ struct Group {
 
 class Lexer {
  public:
-  explicit Lexer(std::string_view original) : spliced_(splice(original, original.size() - without_bom(original).size())) {}
+  explicit Lexer(std::string_view original)
+      : spliced_(splice(original, original.size() - without_bom(original).size())) {}
 
   std::vector<Token> run() {
     const std::string_view s = spliced_.text;
@@ -143,12 +144,14 @@ class Lexer {
         std::size_t j = i;
         while (j < s.size() && ident_char(s[j])) ++j;
         const std::string_view word = s.substr(i, j - i);
-        if (j < s.size() && s[j] == '"' && (word == "R" || word == "u8R" || word == "uR" || word == "UR" || word == "LR")) {
+        if (j < s.size() && s[j] == '"' &&
+            (word == "R" || word == "u8R" || word == "uR" || word == "UR" || word == "LR")) {
           emit("\"", i);
           i = skip_raw(s, j);
           continue;
         }
-        if (j < s.size() && (s[j] == '"' || s[j] == '\'') && (word == "u8" || word == "u" || word == "U" || word == "L")) {
+        if (j < s.size() && (s[j] == '"' || s[j] == '\'') &&
+            (word == "u8" || word == "u" || word == "U" || word == "L")) {
           emit(std::string(1, s[j]), i);
           i = skip_quoted(s, j);
           continue;

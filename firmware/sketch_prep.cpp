@@ -6,20 +6,20 @@
 // the original text): for someone who builds sketches in CI, that pipeline would make
 // universal-ctags a build dependency of every project using l6470emu_add_sketch, installed
 // package included, and l6470emu-ino would need the target's compiler, include directories and
-// definitions before the target compiles, and start two programs per sketch (tens of
-// milliseconds of CPU, more on a loaded machine, where this takes microseconds); its result would hang on a program that libFuzzer
-// cannot run in-process, so what decides which prototypes exist would go unfuzzed. What the three
-// failures of issue 35 needed from the compiler is the part of translation phases 1-4 that is
-// fully specified without the macros: the byte-order mark (dropped, as arduino-cli drops it),
-// backslash-newline (spliced before lexing, so signatures and identifiers join as the compiler
-// joins them) and conditional groups whose condition is a constant (`#if 0`: skipped, so an
-// unbalanced brace there counts for nothing and no prototype or #line lands inside it). Groups on
-// macros (`#ifdef ESP32`) are what only the compiler can decide; each of their branches is read
-// from the brace depth the group began at, the first branch's depth going on after #endif, and
-// every branch's functions get prototypes. That is the difference left from arduino-cli, which
-// declares only the branch compiled: a function in such a group needs its parameter types
-// declared whether or not it is compiled, and one whose signature is only partly inside such a
-// group gets no prototype.
+// definitions before the target compiles, and start two programs per sketch (tens of milliseconds
+// of CPU, more on a loaded machine, where this takes microseconds); its result would hang on a
+// program that libFuzzer cannot run in-process, so what decides which prototypes exist would go
+// unfuzzed. What the three failures of issue 35 needed from the compiler is the part of
+// translation phases 1-4 that is fully specified without the macros: the byte-order mark
+// (dropped, as arduino-cli drops it), backslash-newline (spliced before lexing, so signatures and
+// identifiers join as the compiler joins them) and conditional groups whose condition is a
+// constant (`#if 0`: skipped, so an unbalanced brace there counts for nothing and no prototype or
+// #line lands inside it). Groups on macros (`#ifdef ESP32`) are what only the compiler can
+// decide; each of their branches is read from the brace depth the group began at, the first
+// branch's depth going on after #endif, and every branch's functions get prototypes. That is the
+// difference left from arduino-cli, which declares only the branch compiled: a function in such a
+// group needs its parameter types declared whether or not it is compiled, and one whose signature
+// is only partly inside such a group gets no prototype.
 #include "firmware/sketch_prep.hpp"
 
 #include <algorithm>
@@ -82,7 +82,9 @@ struct OpenGroup {
   std::optional<Reading> first_end;
 };
 
-bool plain_word(const std::string& w) { return !w.empty() && (std::isalpha(static_cast<unsigned char>(w[0])) || w[0] == '_' || (w[0] & 0x80)); }
+bool plain_word(const std::string& w) {
+  return !w.empty() && (std::isalpha(static_cast<unsigned char>(w[0])) || w[0] == '_' || (w[0] & 0x80));
+}
 
 // The prototype of the statement `stmt` (token indices) that a '{' at file level follows, if it
 // is a free function's definition.

@@ -20,10 +20,18 @@ std::string shape(std::string_view text) {
   for (const sketch::Token& t : sketch::tokenize_sketch(text)) {
     if (!out.empty()) out += ' ';
     switch (t.kind) {
-      case TokenKind::Word: out += t.text; break;
-      case TokenKind::OpenGroup: out += '<'; break;
-      case TokenKind::OtherBranch: out += '|'; break;
-      case TokenKind::CloseGroup: out += '>'; break;
+      case TokenKind::Word:
+        out += t.text;
+        break;
+      case TokenKind::OpenGroup:
+        out += '<';
+        break;
+      case TokenKind::OtherBranch:
+        out += '|';
+        break;
+      case TokenKind::CloseGroup:
+        out += '>';
+        break;
     }
   }
   return out;
@@ -31,13 +39,15 @@ std::string shape(std::string_view text) {
 
 TEST(SketchLexer, OffsetsPointIntoTheOriginalTextAcrossSplicesAndAByteOrderMark) {
   std::vector<std::pair<std::string, std::size_t>> seen;
-  for (const sketch::Token& t : sketch::tokenize_sketch("\xEF\xBB\xBFint lo\\\nng_name;\n")) seen.emplace_back(t.text, t.offset);
+  for (const sketch::Token& t : sketch::tokenize_sketch("\xEF\xBB\xBFint lo\\\nng_name;\n"))
+    seen.emplace_back(t.text, t.offset);
   EXPECT_EQ(seen, (std::vector<std::pair<std::string, std::size_t>>{{"int", 3}, {"long_name", 7}, {";", 18}}));
 }
 
 TEST(SketchLexer, OnlyTheBranchesKeptAreMarkedAndSkippedOnesGiveNoTokens) {
-  EXPECT_EQ(shape("#ifdef A\nx\n#else\ny\n#endif\n#if 0\nz {\n#elif B\nw\n#else\nv\n#endif\n#if 1\nu\n#else\nt\n#endif\n"),
-            "< x | y > < w | v > < u >");
+  EXPECT_EQ(
+      shape("#ifdef A\nx\n#else\ny\n#endif\n#if 0\nz {\n#elif B\nw\n#else\nv\n#endif\n#if 1\nu\n#else\nt\n#endif\n"),
+      "< x | y > < w | v > < u >");
   const auto tokens = sketch::tokenize_sketch("a\n  #ifdef A\nb\n#endif\n");
   ASSERT_EQ(tokens.size(), 4u);
   EXPECT_EQ(tokens[1].offset, 4u);  // a mark is at its '#'
