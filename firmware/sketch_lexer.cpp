@@ -216,28 +216,34 @@ class Lexer {
     std::size_t e = n;
     while (e < line.size() && ident_char(line[e])) ++e;
     const std::string name = line.substr(n, e - n);
-    const std::string_view rest = std::string_view(line).substr(e);
+    std::string_view rest = std::string_view(line).substr(e);
+    while (!rest.empty() && std::isspace(static_cast<unsigned char>(rest.back()))) rest.remove_suffix(1);
     if (name == "if" || name == "ifdef" || name == "ifndef") {
       groups_.push_back({skipping()});
-      branch(name == "if" ? evaluate(rest) : Condition::Undecided, at);
+      branch(name == "if" ? evaluate(rest) : Condition::Undecided, name, rest, at);
     } else if (!groups_.empty() && (name == "elif" || name == "elifdef" || name == "elifndef")) {
-      branch(name == "elif" ? evaluate(rest) : Condition::Undecided, at);
+      branch(name == "elif" ? evaluate(rest) : Condition::Undecided, name, rest, at);
     } else if (!groups_.empty() && name == "else") {
-      branch(Condition::True, at);
+      branch(Condition::True, name, "", at);
     } else if (!groups_.empty() && name == "endif") {
-      if (groups_.back().marked) emit("", at, TokenKind::CloseGroup);
+      if (groups_.back().marked) emit("#endif", at, TokenKind::CloseGroup);
       groups_.pop_back();
     }
     return i;
   }
 
-  // A branch of the innermost group begins at `at`.
-  void branch(Condition condition, std::size_t at) {
+  // A branch of the innermost group begins at `at`, with the directive `name` `rest`.
+  void branch(Condition condition, const std::string& name, std::string_view rest, std::size_t at) {
     Group& g = groups_.back();
     g.skipped = g.outer_skipped || g.taken || condition == Condition::False;
     if (g.skipped) return;
     g.taken = condition == Condition::True;
-    emit("", at, g.marked ? TokenKind::OtherBranch : TokenKind::OpenGroup);
+    if (g.marked) {
+      emit("#" + name + std::string(rest), at, TokenKind::OtherBranch);
+    } else {  // the first branch kept opens the group as the compiler sees it: #elif X as #if X
+      const std::string opening = name == "else" ? "if 1" : name.substr(0, 4) == "elif" ? name.substr(2) : name;
+      emit("#" + opening + std::string(rest), at, TokenKind::OpenGroup);
+    }
     g.marked = true;
   }
 

@@ -20,7 +20,11 @@ enum class TokenKind {
 };
 
 struct Token {
-  std::string text;           ///< as the compiler reads it: backslash-newlines removed; empty for marks
+  /// As the compiler reads it: backslash-newlines removed. A mark's is its directive on one line,
+  /// comments left out, as it would open the branch kept: "#ifdef X", "#elif X > 1", "#else",
+  /// "#endif"; the first branch kept of a group is given as an #if ("#elif X" as "#if X", an
+  /// #else after skipped branches only as "#if 1").
+  std::string text;
   std::size_t offset = 0;     ///< of its first character in the original text; a mark's is its '#'
   TokenKind kind = TokenKind::Word;
 };

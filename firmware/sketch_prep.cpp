@@ -1,5 +1,7 @@
 // The sketch preprocessor: finds the function definitions at file level in the tokens of the
-// lexer (firmware/sketch_lexer_internal.hpp) and writes their prototypes before the first one.
+// lexer (firmware/sketch_lexer_internal.hpp) and writes their prototypes before the first one
+// outside every conditional group (before the first of all when there is none, as in a sketch
+// inside an include guard).
 //
 // Why a lexer of our own and not the Arduino builder's pipeline (the joined sketch through the
 // compiler's -E, Universal Ctags listing the definitions of its output, the prototypes put into
@@ -15,11 +17,15 @@
 // identifiers join as the compiler joins them) and conditional groups whose condition is a
 // constant (`#if 0`: skipped, so an unbalanced brace there counts for nothing and no prototype or
 // #line lands inside it). Groups on macros (`#ifdef ESP32`) are what only the compiler can
-// decide; each of their branches is read from the brace depth the group began at, the first
-// branch's depth going on after #endif, and every branch's functions get prototypes. That is the
-// difference left from arduino-cli, which declares only the branch compiled: a function in such a
-// group needs its parameter types declared whether or not it is compiled, and one whose signature
-// is only partly inside such a group gets no prototype.
+// decide. Each of their branches is read from the brace depth the group began at, the first
+// branch's depth going on after #endif; a function inside one gets its prototype inside the same
+// conditions, written again around it; and the prototypes go before the first function outside
+// every group, so that a group the compiler leaves out takes none of them with it (and the #line
+// after them stays outside it). What differs from arduino-cli, which sees only the branch
+// compiled: the conditions are evaluated where the prototypes stand, not where the function is (a
+// macro defined in between counts differently); a function whose signature is only partly inside
+// a group gets no prototype; and a function in a group above the first one outside every group is
+// not declared before calls it makes to later ones.
 #include "firmware/sketch_prep.hpp"
 
 #include <algorithm>
@@ -42,9 +48,28 @@ bool is_keyword_start(const std::string& t) {
   return std::find(std::begin(kWords), std::end(kWords), t) != std::end(kWords);
 }
 
+constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
 struct Definition {
   std::string prototype;
   std::size_t offset = 0;  // of its first token
+  std::size_t branch = 0;  // the branch of a conditional group it is in (Branch), or kNone
+};
+
+// A branch kept of a conditional group, in the tree the groups make.
+struct Branch {
+  std::size_t parent = 0;  // the branch the group is in, or kNone at file level
+  std::size_t before = 0;  // the branch kept before it in the same group, or kNone for the first
+  std::size_t token = 0;   // its mark (the directive's text)
+  std::size_t depth = 0;   // 1 for a group at file level
+  std::size_t group = 0;   // its group's first branch kept
+};
+
+// The definitions found in a text and what their prototypes' conditions are made of.
+struct Found {
+  std::vector<Token> tokens;
+  std::vector<Branch> branches;
+  std::vector<Definition> definitions;
 };
 
 // The statements being read share their beginnings (the text before a group is the beginning
@@ -54,7 +79,6 @@ struct Link {
   std::size_t token = 0;  // index in the tokens
   std::size_t before = 0;  // the link of the token before, or kNone
 };
-constexpr std::size_t kNone = static_cast<std::size_t>(-1);
 // No signature is this long; a longer statement gets no prototype, so that reading one costs at
 // most this much per brace whatever the input.
 constexpr std::size_t kMaxSignatureTokens = 1024;
@@ -127,9 +151,11 @@ std::optional<std::string> prototype_of(const std::vector<Token>& tokens, const 
   return proto + ";";
 }
 
-std::vector<Definition> find_definitions(std::string_view text) {
-  const std::vector<Token> tokens = sketch::tokenize_sketch(text);
-  std::vector<Definition> found;
+Found find_definitions(std::string_view text) {
+  Found f{sketch::tokenize_sketch(text), {}, {}};
+  const std::vector<Token>& tokens = f.tokens;
+  std::vector<Definition>& found = f.definitions;
+  std::size_t here = kNone;  // the branch being read
   std::vector<OpenGroup> groups;
   std::vector<Link> links;
   Reading r;
@@ -144,14 +170,19 @@ std::vector<Definition> find_definitions(std::string_view text) {
     switch (tok.kind) {
       case TokenKind::OpenGroup:
         groups.push_back({r, std::nullopt});
+        f.branches.push_back({here, kNone, k, here == kNone ? 1 : f.branches[here].depth + 1, f.branches.size()});
+        here = f.branches.size() - 1;
         continue;
       case TokenKind::OtherBranch:
         if (groups.empty()) continue;  // the lexer gives none outside a group
         if (!groups.back().first_end) groups.back().first_end = r;
         r = groups.back().at_open;
+        f.branches.push_back({f.branches[here].parent, here, k, f.branches[here].depth, f.branches[here].group});
+        here = f.branches.size() - 1;
         continue;
       case TokenKind::CloseGroup:
         if (groups.empty()) continue;
+        here = f.branches[here].parent;
         if (groups.back().first_end) r = *groups.back().first_end;
         // A statement that began inside the group, or grew there, reads differently with other
         // macros: its prototype could name what another branch does not declare.
@@ -191,10 +222,69 @@ std::vector<Definition> find_definitions(std::string_view text) {
     }
     ++r.depth;
     if (!r.conditional && r.length <= kMaxSignatureTokens)
-      if (auto proto = prototype_of(tokens, statement())) found.push_back({std::move(*proto), r.begins_at});
+      if (auto proto = prototype_of(tokens, statement())) found.push_back({std::move(*proto), r.begins_at, here});
     r.clear();
   }
-  return found;
+  return f;
+}
+
+// The prototypes, each inside the conditions of the branch it is defined in when `wrap`: the
+// branches' directives as the source has them, each written once, so that a prototype is
+// declared where its function is compiled and nowhere else (its types may exist only there).
+std::string prototype_block(const Found& f, bool wrap) {
+  std::string out;
+  std::vector<std::size_t> open;  // the branches written and not closed, outermost first
+  // The directives of a group from the branch after `from` (kNone: its first) to `to`.
+  auto directives = [&](std::size_t from, std::size_t to) {
+    std::vector<std::size_t> seq;
+    for (std::size_t b = to; b != from && b != kNone; b = f.branches[b].before) seq.push_back(b);
+    for (auto b = seq.rbegin(); b != seq.rend(); ++b) out += f.tokens[f.branches[*b].token].text + "\n";
+  };
+  for (const Definition& d : f.definitions) {
+    if (wrap) {
+      // Up from its branch to one written (or to a branch of a group written, or file level).
+      std::vector<std::size_t> chain;
+      std::size_t b = d.branch;
+      bool sibling = false;
+      for (; b != kNone; b = f.branches[b].parent) {
+        const std::size_t depth = f.branches[b].depth;
+        if (depth <= open.size() && open[depth - 1] == b) break;
+        if (depth <= open.size() && f.branches[open[depth - 1]].group == f.branches[b].group) {
+          sibling = true;
+          break;
+        }
+        chain.push_back(b);
+      }
+      const std::size_t keep = b == kNone ? 0 : f.branches[b].depth;
+      for (; open.size() > keep; open.pop_back()) out += "#endif\n";
+      if (sibling) {
+        directives(open.back(), b);
+        open.back() = b;
+      }
+      for (auto c = chain.rbegin(); c != chain.rend(); ++c) {
+        directives(kNone, *c);
+        open.push_back(*c);
+      }
+    }
+    out += d.prototype + "\n";
+  }
+  for (; !open.empty(); open.pop_back()) out += "#endif\n";
+  return out;
+}
+
+// Where prepare_sketch puts the prototypes: before the first function defined outside every
+// conditional group, all of them in their groups' conditions (a group on a macro may be left
+// out by the compiler, and with it whatever it holds, prototypes included); when every function
+// is inside a group (a sketch in an include guard), before the first, unconditionally.
+struct Placement {
+  std::size_t offset = 0;
+  bool wrap = false;
+};
+
+Placement place(const Found& f) {
+  for (const Definition& d : f.definitions)
+    if (d.branch == kNone) return {d.offset, true};
+  return {f.definitions.front().offset, false};
 }
 
 // The line (1-based) of `offset` in `text`.
@@ -215,8 +305,13 @@ std::string quoted(const std::string& path) {
 
 std::vector<std::string> sketch_prototypes(std::string_view text) {
   std::vector<std::string> out;
-  for (const Definition& d : find_definitions(text)) out.push_back(d.prototype);
+  for (const Definition& d : find_definitions(text).definitions) out.push_back(d.prototype);
   return out;
+}
+
+std::string sketch_prototype_block(std::string_view text) {
+  const Found f = find_definitions(text);
+  return f.definitions.empty() ? "" : prototype_block(f, place(f).wrap);
 }
 
 std::string prepare_sketch(const std::vector<SketchFile>& files) {
@@ -234,11 +329,12 @@ std::string prepare_sketch(const std::vector<SketchFile>& files) {
     joined += sketch::without_bom(f.text);
     if (joined.empty() || joined.back() != '\n') joined += '\n';
   }
-  const std::vector<Definition> defs = find_definitions(joined);
+  const Found found = find_definitions(joined);
   std::string out = "#include <Arduino.h>\n";
-  if (defs.empty()) return out + joined;
-  // Insert before the first definition, at the start of its line when only blanks precede it.
-  std::size_t at = defs.front().offset;
+  if (found.definitions.empty()) return out + joined;
+  // Insert at the start of the line when only blanks precede the place.
+  const Placement place_at = place(found);
+  std::size_t at = place_at.offset;
   const std::size_t line_begin = joined.rfind('\n', at == 0 ? 0 : at - 1);
   const std::size_t bol = line_begin == std::string::npos ? 0 : line_begin + 1;
   bool blank_before = true;
@@ -246,7 +342,7 @@ std::string prepare_sketch(const std::vector<SketchFile>& files) {
     if (!std::isspace(static_cast<unsigned char>(joined[i]))) blank_before = false;
   std::string insertion = blank_before ? "" : "\n";
   if (blank_before) at = bol;
-  for (const Definition& d : defs) insertion += d.prototype + "\n";
+  insertion += prototype_block(found, place_at.wrap);
   const Segment* seg = &segments.front();
   for (const Segment& s : segments)
     if (s.begin <= at) seg = &s;

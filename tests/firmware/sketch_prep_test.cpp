@@ -136,5 +136,33 @@ TEST(SketchPrototypes, EachBranchOfAGroupOnAMacroCountsFromTheDepthTheGroupBegan
             (Protos{"void dump();", "void g();"}));
 }
 
+// The same failure on a group the preprocessor cannot decide: an ISR for one platform above the
+// functions took the prototypes and the #line into its #ifdef, lost on every other platform.
+TEST(SketchPreparation, AFunctionInAGroupOnAMacroIsDeclaredInsideTheSameConditionsAfterIt) {
+  const std::string main = "#ifdef ESP32\nvoid IRAM_ATTR on_flag() {}\n#endif\nvoid setup() { helper(); }\n"
+                           "void helper() {}\n";
+  EXPECT_EQ(prepare_sketch({{"m.ino", main}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\n#ifdef ESP32\nvoid IRAM_ATTR on_flag() {}\n#endif\n"
+            "#ifdef ESP32\nvoid IRAM_ATTR on_flag();\n#endif\nvoid setup();\nvoid helper();\n#line 4 \"m.ino\"\n"
+            "void setup() { helper(); }\nvoid helper() {}\n");
+}
+
+TEST(SketchPreparation, NestedGroupsAndTheirBranchesAreWrittenOnceEachAsTheSourceHasThem) {
+  const std::string text = "void setup() {}\n#ifdef A\nvoid a() {}\n#ifdef B // b\nvoid b() {}\n#endif\nvoid a2() {}\n"
+                           "#elif defined(C)\nvoid c() {}\n#else\nvoid d() {}\n#endif\n"
+                           "#if 0\nvoid z() {}\n#elif X > 1\nvoid x() {}\n#else\n#endif\n#ifdef A\nvoid a3() {}\n#endif\n";
+  EXPECT_EQ(sketch_prototype_block(text),
+            "void setup();\n#ifdef A\nvoid a();\n#ifdef B\nvoid b();\n#endif\nvoid a2();\n#elif defined(C)\nvoid c();\n"
+            "#else\nvoid d();\n#endif\n#if X > 1\nvoid x();\n#endif\n#ifdef A\nvoid a3();\n#endif\n");
+}
+
+TEST(SketchPreparation, WhenEveryFunctionIsInAGroupThePrototypesGoBeforeTheFirstUnconditionally) {
+  // A sketch in an include guard: the guard's condition, written again after its #define, would
+  // be false.
+  EXPECT_EQ(prepare_sketch({{"m.ino", "#ifndef M_INO\n#define M_INO\nvoid setup() { go(); }\nvoid go() {}\n#endif\n"}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\n#ifndef M_INO\n#define M_INO\nvoid setup();\nvoid go();\n"
+            "#line 3 \"m.ino\"\nvoid setup() { go(); }\nvoid go() {}\n#endif\n");
+}
+
 }  // namespace
 }  // namespace l6470emu::test

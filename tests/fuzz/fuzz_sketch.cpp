@@ -1,9 +1,9 @@
 // libFuzzer harness of the sketch preprocessor (firmware/sketch_prep.hpp, what l6470emu-ino does
 // to .ino files): any text, split into two files at its first NUL byte, gives a translation unit
 // that begins with #include <Arduino.h>, holds every file's text (without a leading byte-order
-// mark) unchanged and in order, and grows by at most the prototypes (each no longer than three
-// times the text it came from). Its lexer's tokens stay in order inside the text, and its
-// conditional groups' marks nest.
+// mark) unchanged and in order, and grows by at most the prototypes and the conditions written
+// around them (linearly). Its lexer's tokens stay in order inside the text, and its conditional
+// groups' marks nest.
 #include <string>
 #include <string_view>
 
@@ -58,8 +58,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     joined += "#line 1 \"" + f.path + "\"\n" + std::string(sketch::without_bom(f.text));
     if (joined.back() != '\n') joined += '\n';  // as prepare_sketch ends a file: one newline, none doubled
   }
-  std::string block;
-  for (const std::string& p : sketch_prototypes(joined)) block += p + "\n";
+  std::string block = sketch_prototype_block(joined);
+  std::size_t prototypes = 0;
+  for (const std::string& p : sketch_prototypes(joined)) {
+    FUZZ_CHECK(block.find(p + "\n") != std::string::npos, "the prototype %s is not in the block", p.c_str());
+    ++prototypes;
+  }
+  FUZZ_CHECK((prototypes == 0) == block.empty(), "a block of %zu bytes for %zu prototypes", block.size(), prototypes);
   bool inserted = block.empty();  // no prototypes: nothing is inserted anywhere
   block += "#line ";
   std::size_t at = 0;
