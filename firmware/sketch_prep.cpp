@@ -1,114 +1,45 @@
-// The sketch preprocessor: a small C++ tokenizer (comments, strings, character and raw string
-// literals and preprocessor lines skipped) that finds function definitions at file level.
+// The sketch preprocessor: finds the function definitions at file level in the tokens of the
+// lexer (firmware/sketch_lexer_internal.hpp) and writes their prototypes before the first one
+// outside every conditional group (before the first of all when there is none, as in a sketch
+// inside an include guard).
+//
+// Why a lexer of our own and not the Arduino builder's pipeline (the joined sketch through the
+// compiler's -E, Universal Ctags listing the definitions of its output, the prototypes put into
+// the original text): for someone who builds sketches in CI, that pipeline would make
+// universal-ctags a build dependency of every project using l6470emu_add_sketch, installed
+// package included, and l6470emu-ino would need the target's compiler, include directories and
+// definitions before the target compiles, and start two programs per sketch (tens of milliseconds
+// of CPU, more on a loaded machine, where this takes microseconds); its result would hang on a
+// program that libFuzzer cannot run in-process, so what decides which prototypes exist would go
+// unfuzzed. What the three failures of issue 35 needed from the compiler is the part of
+// translation phases 1-4 that is fully specified without the macros: the byte-order mark
+// (dropped, as arduino-cli drops it), backslash-newline (spliced before lexing, so signatures and
+// identifiers join as the compiler joins them) and conditional groups whose condition is a
+// constant (`#if 0`: skipped, so an unbalanced brace there counts for nothing and no prototype or
+// #line lands inside it). Groups on macros (`#ifdef ESP32`) are what only the compiler can
+// decide. Each of their branches is read from the brace depth the group began at, the first
+// branch's depth going on after #endif; a function inside one gets its prototype inside the same
+// conditions, written again around it; and the prototypes go before the first function outside
+// every group, so that a group the compiler leaves out takes none of them with it (and the #line
+// after them stays outside it). What differs from arduino-cli, which sees only the branch
+// compiled: the conditions are evaluated where the prototypes stand, not where the function is (a
+// macro defined in between counts differently); a function whose signature is only partly inside
+// a group gets no prototype; and a function in a group above the first one outside every group is
+// not declared before calls it makes to later ones.
 #include "firmware/sketch_prep.hpp"
 
 #include <algorithm>
 #include <cctype>
 #include <cstddef>
+#include <optional>
+
+#include "firmware/sketch_lexer_internal.hpp"
 
 namespace l6470emu {
 namespace {
 
-struct Token {
-  std::string text;
-  std::size_t offset = 0;  // of its first character
-};
-
-bool ident_start(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || (c & 0x80); }
-bool ident_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || (c & 0x80); }
-
-// Past the end of a quoted literal starting at `i` (on the quote).
-std::size_t skip_quoted(std::string_view s, std::size_t i) {
-  const char q = s[i++];
-  while (i < s.size() && s[i] != q && s[i] != '\n') i += s[i] == '\\' ? 2 : 1;
-  return std::min(s.size(), i + 1);
-}
-
-// Past the end of a raw string literal R"delim(...)delim" whose '"' is at `i`.
-std::size_t skip_raw(std::string_view s, std::size_t i) {
-  const std::size_t open = s.find('(', i);
-  if (open == std::string_view::npos || open - i > 17) return skip_quoted(s, i);
-  const std::string close = ")" + std::string(s.substr(i + 1, open - i - 1)) + "\"";
-  const std::size_t end = s.find(close, open);
-  return end == std::string_view::npos ? s.size() : end + close.size();
-}
-
-std::vector<Token> tokenize(std::string_view s) {
-  std::vector<Token> tokens;
-  bool line_start = true;  // only blanks since the last newline: a '#' starts a directive
-  std::size_t i = 0;
-  while (i < s.size()) {
-    const char c = s[i];
-    if (c == '\n') {
-      line_start = true;
-      ++i;
-      continue;
-    }
-    if (std::isspace(static_cast<unsigned char>(c))) {
-      ++i;
-      continue;
-    }
-    if (c == '/' && i + 1 < s.size() && s[i + 1] == '/') {
-      while (i < s.size() && s[i] != '\n') i += (s[i] == '\\' && i + 1 < s.size() && s[i + 1] == '\n') ? 2 : 1;
-      continue;
-    }
-    if (c == '/' && i + 1 < s.size() && s[i + 1] == '*') {
-      const std::size_t end = s.find("*/", i + 2);
-      i = end == std::string_view::npos ? s.size() : end + 2;
-      continue;
-    }
-    if (c == '#' && line_start) {
-      // A directive runs to the end of its logical line (backslash-newline continues it).
-      while (i < s.size() && s[i] != '\n') {
-        if (s[i] == '\\' && i + 1 < s.size() && s[i + 1] == '\n') ++i;
-        ++i;
-      }
-      continue;
-    }
-    line_start = false;
-    if (c == '"' || c == '\'') {
-      tokens.push_back({std::string(1, c), i});  // a literal: its text does not matter here
-      i = skip_quoted(s, i);
-      continue;
-    }
-    if (ident_start(c)) {
-      std::size_t j = i;
-      while (j < s.size() && ident_char(s[j])) ++j;
-      const std::string_view word = s.substr(i, j - i);
-      if (j < s.size() && s[j] == '"' && (word == "R" || word == "u8R" || word == "uR" || word == "UR" || word == "LR")) {
-        tokens.push_back({"\"", i});
-        i = skip_raw(s, j);
-        continue;
-      }
-      if (j < s.size() && (s[j] == '"' || s[j] == '\'') && (word == "u8" || word == "u" || word == "U" || word == "L")) {
-        tokens.push_back({std::string(1, s[j]), i});
-        i = skip_quoted(s, j);
-        continue;
-      }
-      tokens.push_back({std::string(word), i});
-      i = j;
-      continue;
-    }
-    if (std::isdigit(static_cast<unsigned char>(c))) {
-      std::size_t j = i;
-      while (j < s.size() && (ident_char(s[j]) || s[j] == '.' || s[j] == '\'')) ++j;
-      tokens.push_back({std::string(s.substr(i, j - i)), i});
-      i = j;
-      continue;
-    }
-    for (const std::string_view p : {"...", "::", "->", "&&", "||"}) {
-      if (s.substr(i, p.size()) == p) {
-        tokens.push_back({std::string(p), i});
-        i += p.size();
-        goto next;
-      }
-    }
-    tokens.push_back({std::string(1, c), i});
-    ++i;
-  next:;
-  }
-  return tokens;
-}
+using sketch::Token;
+using sketch::TokenKind;
 
 bool is_keyword_start(const std::string& t) {
   static const char* const kWords[] = {"struct", "class", "union", "enum", "namespace", "typedef", "template",
@@ -117,78 +48,243 @@ bool is_keyword_start(const std::string& t) {
   return std::find(std::begin(kWords), std::end(kWords), t) != std::end(kWords);
 }
 
+constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+
 struct Definition {
   std::string prototype;
-  std::size_t offset = 0;  // where its statement starts
+  std::size_t offset = 0;  // of its first token
+  std::size_t branch = 0;  // the branch of a conditional group it is in (Branch), or kNone
 };
 
-std::vector<Definition> find_definitions(std::string_view text) {
-  const std::vector<Token> tokens = tokenize(text);
-  std::vector<Definition> found;
-  int depth = 0;            // braces
-  int parens = 0;           // parentheses and brackets at brace depth 0
-  std::size_t start = 0;    // the first token of the statement at depth 0
-  for (std::size_t k = 0; k < tokens.size(); ++k) {
-    const std::string& t = tokens[k].text;
-    if (depth > 0) {
-      if (t == "{") ++depth;
-      if (t == "}" && --depth == 0) start = k + 1;
-      continue;
-    }
-    if (t == "(" || t == "[") ++parens;
-    if ((t == ")" || t == "]") && parens > 0) --parens;
-    if (parens > 0) continue;
-    if (t == ";") {
-      start = k + 1;
-      continue;
-    }
-    if (t == "}") {  // a stray brace: resynchronise
-      start = k + 1;
-      continue;
-    }
-    if (t != "{") continue;
-    ++depth;
-    // tokens[start, k) is what stands before this brace.
-    if (k == start) continue;
-    bool plain = true;
-    for (std::size_t j = start; j < k; ++j)
-      if (is_keyword_start(tokens[j].text) || tokens[j].text == "=" || tokens[j].text == "\"") plain = false;
-    if (!plain) continue;
-    // The parameter list: the last ')' before the brace (after it only noexcept/const may stand).
-    std::size_t close = k;
-    while (close > start && tokens[close - 1].text != ")") {
-      const std::string& after = tokens[close - 1].text;
-      if (after != "noexcept" && after != "const") break;
-      --close;
-    }
-    if (close == start || tokens[close - 1].text != ")") continue;
-    const std::size_t close_paren = close - 1;
-    int level = 0;
-    std::size_t open = close_paren + 1;
-    bool defaults = false;
-    for (std::size_t j = close_paren + 1; j-- > start;) {
-      if (tokens[j].text == ")") ++level;
-      if (tokens[j].text == "(" && --level == 0) {
-        open = j;
-        break;
-      }
-      if (tokens[j].text == "=" && level == 1) defaults = true;
-    }
-    if (open > close_paren || open == start || defaults) continue;
-    const std::string& name = tokens[open - 1].text;
-    if (!ident_start(name[0]) || open - 1 == start) continue;  // no return type: a macro call such as ISR(...)
-    if (open >= 2 && tokens[open - 2].text == "::") continue;  // A::f: a member defined outside its class
-    // The tokens joined, spaced as people write them: "static unsigned long *at(const char *s)".
-    auto glue_before = [](const std::string& w) { return w == "(" || w == ")" || w == "," || w == "[" || w == "]" || w == "::"; };
-    auto glue_after = [](const std::string& w) { return w == "(" || w == "[" || w == "*" || w == "&" || w == "&&" || w == "::"; };
-    std::string proto = tokens[start].text;
-    for (std::size_t j = start + 1; j <= close_paren; ++j) {
-      if (!glue_before(tokens[j].text) && !glue_after(tokens[j - 1].text)) proto += ' ';
-      proto += tokens[j].text;
-    }
-    found.push_back({proto + ";", tokens[start].offset});
+// A branch kept of a conditional group, in the tree the groups make.
+struct Branch {
+  std::size_t parent = 0;  // the branch the group is in, or kNone at file level
+  std::size_t before = 0;  // the branch kept before it in the same group, or kNone for the first
+  std::size_t token = 0;   // its mark (the directive's text)
+  std::size_t depth = 0;   // 1 for a group at file level
+  std::size_t group = 0;   // its group's first branch kept
+};
+
+// The definitions found in a text and what their prototypes' conditions are made of.
+struct Found {
+  std::vector<Token> tokens;
+  std::vector<Branch> branches;
+  std::vector<Definition> definitions;
+};
+
+// The statements being read share their beginnings (the text before a group is the beginning
+// of each of its branches): each is a chain of links back to its first token, so that keeping
+// the reading at a group's #if costs nothing, whatever the length of the statement.
+struct Link {
+  std::size_t token = 0;  // index in the tokens
+  std::size_t before = 0;  // the link of the token before, or kNone
+};
+// No signature is this long; a longer statement gets no prototype, so that reading one costs at
+// most this much per brace whatever the input.
+constexpr std::size_t kMaxSignatureTokens = 1024;
+
+// Where the reading of the tokens at file level stands.
+struct Reading {
+  int depth = 0;                 // braces
+  int parens = 0;                // parentheses and brackets at brace depth 0
+  std::size_t last = kNone;      // the statement at depth 0 so far: its last link
+  std::size_t length = 0;        // and its number of tokens
+  std::size_t begins_at = 0;     // its first token's offset
+  std::size_t level = 0;         // the groups open when it began
+  bool conditional = false;      // part of it is inside a group it outlived: its text depends on macros
+  bool empty() const { return length == 0; }
+  void clear() {
+    last = kNone;
+    length = 0;
   }
-  return found;
+};
+
+// A conditional group being read: where the reading stood at its #if, and at the end of its
+// first branch kept (which goes on after #endif).
+struct OpenGroup {
+  Reading at_open;
+  std::optional<Reading> first_end;
+};
+
+bool plain_word(const std::string& w) {
+  return !w.empty() && (std::isalpha(static_cast<unsigned char>(w[0])) || w[0] == '_' || (w[0] & 0x80));
+}
+
+// The prototype of the statement `stmt` (token indices) that a '{' at file level follows, if it
+// is a free function's definition.
+std::optional<std::string> prototype_of(const std::vector<Token>& tokens, const std::vector<std::size_t>& stmt) {
+  auto text = [&](std::size_t j) -> const std::string& { return tokens[stmt[j]].text; };
+  const std::size_t n = stmt.size();
+  if (n == 0) return std::nullopt;
+  for (std::size_t j = 0; j < n; ++j)
+    if (is_keyword_start(text(j)) || text(j) == "=" || text(j) == "\"") return std::nullopt;
+  // The parameter list: the last ')' before the brace (after it only noexcept/const may stand).
+  std::size_t close = n;
+  while (close > 0 && text(close - 1) != ")") {
+    if (text(close - 1) != "noexcept" && text(close - 1) != "const") break;
+    --close;
+  }
+  if (close == 0 || text(close - 1) != ")") return std::nullopt;
+  const std::size_t close_paren = close - 1;
+  int level = 0;
+  std::size_t open = close_paren + 1;
+  bool defaults = false;
+  for (std::size_t j = close_paren + 1; j-- > 0;) {
+    if (text(j) == ")") ++level;
+    if (text(j) == "(" && --level == 0) {
+      open = j;
+      break;
+    }
+    if (text(j) == "=" && level == 1) defaults = true;
+  }
+  if (open > close_paren || open == 0 || defaults) return std::nullopt;
+  if (!plain_word(text(open - 1)) || open - 1 == 0) return std::nullopt;  // no return type: a macro call such as ISR(...)
+  if (open >= 2 && text(open - 2) == "::") return std::nullopt;          // A::f: a member defined outside its class
+  // The tokens joined, spaced as people write them: "static unsigned long *at(const char *s)".
+  auto glue_before = [](const std::string& w) { return w == "(" || w == ")" || w == "," || w == "[" || w == "]" || w == "::"; };
+  auto glue_after = [](const std::string& w) { return w == "(" || w == "[" || w == "*" || w == "&" || w == "&&" || w == "::"; };
+  std::string proto = text(0);
+  for (std::size_t j = 1; j <= close_paren; ++j) {
+    if (!glue_before(text(j)) && !glue_after(text(j - 1))) proto += ' ';
+    proto += text(j);
+  }
+  return proto + ";";
+}
+
+Found find_definitions(std::string_view text) {
+  Found f{sketch::tokenize_sketch(text), {}, {}};
+  const std::vector<Token>& tokens = f.tokens;
+  std::vector<Definition>& found = f.definitions;
+  std::size_t here = kNone;  // the branch being read
+  std::vector<OpenGroup> groups;
+  std::vector<Link> links;
+  Reading r;
+  auto statement = [&] {  // the token indices of r's statement, in order
+    std::vector<std::size_t> out(r.length);
+    std::size_t l = r.last;
+    for (std::size_t j = r.length; j-- > 0; l = links[l].before) out[j] = links[l].token;
+    return out;
+  };
+  for (std::size_t k = 0; k < tokens.size(); ++k) {
+    const Token& tok = tokens[k];
+    switch (tok.kind) {
+      case TokenKind::OpenGroup:
+        groups.push_back({r, std::nullopt});
+        f.branches.push_back({here, kNone, k, here == kNone ? 1 : f.branches[here].depth + 1, f.branches.size()});
+        here = f.branches.size() - 1;
+        continue;
+      case TokenKind::OtherBranch:
+        if (groups.empty()) continue;  // the lexer gives none outside a group
+        if (!groups.back().first_end) groups.back().first_end = r;
+        r = groups.back().at_open;
+        f.branches.push_back({f.branches[here].parent, here, k, f.branches[here].depth, f.branches[here].group});
+        here = f.branches.size() - 1;
+        continue;
+      case TokenKind::CloseGroup:
+        if (groups.empty()) continue;
+        here = f.branches[here].parent;
+        if (groups.back().first_end) r = *groups.back().first_end;
+        // A statement that began inside the group, or grew there, reads differently with other
+        // macros: its prototype could name what another branch does not declare.
+        if (!r.empty() && (r.level >= groups.size() || r.last != groups.back().at_open.last))
+          r.conditional = true;
+        groups.pop_back();
+        continue;
+      case TokenKind::Word:
+        break;
+    }
+    const std::string& t = tok.text;
+    if (r.depth > 0) {
+      if (t == "{") ++r.depth;
+      if (t == "}" && --r.depth == 0) r.clear();
+      continue;
+    }
+    if (r.empty()) {
+      r.begins_at = tok.offset;
+      r.level = groups.size();
+      r.conditional = false;
+    }
+    if (t == ";" && r.parens == 0) {
+      r.clear();
+      continue;
+    }
+    if (t == "}" && r.parens == 0) {  // a stray brace: resynchronise
+      r.clear();
+      continue;
+    }
+    if (t == "(" || t == "[") ++r.parens;
+    if ((t == ")" || t == "]") && r.parens > 0) --r.parens;
+    if (t != "{" || r.parens > 0) {
+      links.push_back({k, r.last});
+      r.last = links.size() - 1;
+      ++r.length;
+      continue;
+    }
+    ++r.depth;
+    if (!r.conditional && r.length <= kMaxSignatureTokens)
+      if (auto proto = prototype_of(tokens, statement())) found.push_back({std::move(*proto), r.begins_at, here});
+    r.clear();
+  }
+  return f;
+}
+
+// The prototypes, each inside the conditions of the branch it is defined in when `wrap`: the
+// branches' directives as the source has them, each written once, so that a prototype is
+// declared where its function is compiled and nowhere else (its types may exist only there).
+std::string prototype_block(const Found& f, bool wrap) {
+  std::string out;
+  std::vector<std::size_t> open;  // the branches written and not closed, outermost first
+  // The directives of a group from the branch after `from` (kNone: its first) to `to`.
+  auto directives = [&](std::size_t from, std::size_t to) {
+    std::vector<std::size_t> seq;
+    for (std::size_t b = to; b != from && b != kNone; b = f.branches[b].before) seq.push_back(b);
+    for (auto b = seq.rbegin(); b != seq.rend(); ++b) out += f.tokens[f.branches[*b].token].text + "\n";
+  };
+  for (const Definition& d : f.definitions) {
+    if (wrap) {
+      // Up from its branch to one written (or to a branch of a group written, or file level).
+      std::vector<std::size_t> chain;
+      std::size_t b = d.branch;
+      bool sibling = false;
+      for (; b != kNone; b = f.branches[b].parent) {
+        const std::size_t depth = f.branches[b].depth;
+        if (depth <= open.size() && open[depth - 1] == b) break;
+        if (depth <= open.size() && f.branches[open[depth - 1]].group == f.branches[b].group) {
+          sibling = true;
+          break;
+        }
+        chain.push_back(b);
+      }
+      const std::size_t keep = b == kNone ? 0 : f.branches[b].depth;
+      for (; open.size() > keep; open.pop_back()) out += "#endif\n";
+      if (sibling) {
+        directives(open.back(), b);
+        open.back() = b;
+      }
+      for (auto c = chain.rbegin(); c != chain.rend(); ++c) {
+        directives(kNone, *c);
+        open.push_back(*c);
+      }
+    }
+    out += d.prototype + "\n";
+  }
+  for (; !open.empty(); open.pop_back()) out += "#endif\n";
+  return out;
+}
+
+// Where prepare_sketch puts the prototypes: before the first function defined outside every
+// conditional group, all of them in their groups' conditions (a group on a macro may be left
+// out by the compiler, and with it whatever it holds, prototypes included); when every function
+// is inside a group (a sketch in an include guard), before the first, unconditionally.
+struct Placement {
+  std::size_t offset = 0;
+  bool wrap = false;
+};
+
+Placement place(const Found& f) {
+  for (const Definition& d : f.definitions)
+    if (d.branch == kNone) return {d.offset, true};
+  return {f.definitions.front().offset, false};
 }
 
 // The line (1-based) of `offset` in `text`.
@@ -209,12 +305,18 @@ std::string quoted(const std::string& path) {
 
 std::vector<std::string> sketch_prototypes(std::string_view text) {
   std::vector<std::string> out;
-  for (const Definition& d : find_definitions(text)) out.push_back(d.prototype);
+  for (const Definition& d : find_definitions(text).definitions) out.push_back(d.prototype);
   return out;
 }
 
+std::string sketch_prototype_block(std::string_view text) {
+  const Found f = find_definitions(text);
+  return f.definitions.empty() ? "" : prototype_block(f, place(f).wrap);
+}
+
 std::string prepare_sketch(const std::vector<SketchFile>& files) {
-  // The files joined, each announced by a #line directive (which the tokenizer skips).
+  // The files joined, each announced by a #line directive (which the lexer skips), without
+  // their byte-order marks (the compiler would read one after #line as stray bytes).
   std::string joined;
   struct Segment {
     std::size_t begin = 0;  // of the file's text in `joined`
@@ -224,14 +326,15 @@ std::string prepare_sketch(const std::vector<SketchFile>& files) {
   for (const SketchFile& f : files) {
     joined += "#line 1 " + quoted(f.path) + "\n";
     segments.push_back({joined.size(), &f});
-    joined += f.text;
+    joined += sketch::without_bom(f.text);
     if (joined.empty() || joined.back() != '\n') joined += '\n';
   }
-  const std::vector<Definition> defs = find_definitions(joined);
+  const Found found = find_definitions(joined);
   std::string out = "#include <Arduino.h>\n";
-  if (defs.empty()) return out + joined;
-  // Insert before the first definition, at the start of its line when only blanks precede it.
-  std::size_t at = defs.front().offset;
+  if (found.definitions.empty()) return out + joined;
+  // Insert at the start of the line when only blanks precede the place.
+  const Placement place_at = place(found);
+  std::size_t at = place_at.offset;
   const std::size_t line_begin = joined.rfind('\n', at == 0 ? 0 : at - 1);
   const std::size_t bol = line_begin == std::string::npos ? 0 : line_begin + 1;
   bool blank_before = true;
@@ -239,7 +342,7 @@ std::string prepare_sketch(const std::vector<SketchFile>& files) {
     if (!std::isspace(static_cast<unsigned char>(joined[i]))) blank_before = false;
   std::string insertion = blank_before ? "" : "\n";
   if (blank_before) at = bol;
-  for (const Definition& d : defs) insertion += d.prototype + "\n";
+  insertion += prototype_block(found, place_at.wrap);
   const Segment* seg = &segments.front();
   for (const Segment& s : segments)
     if (s.begin <= at) seg = &s;

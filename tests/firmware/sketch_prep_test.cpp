@@ -76,5 +76,93 @@ TEST(SketchPreparation, UnterminatedTextAndStrayBracesEndWithoutACrash) {
   EXPECT_EQ(sketch_prototypes("}}}} void g() {}"), (Protos{"void g();"}));
 }
 
+// Issue 35: three sketches the Arduino IDE builds that broke the preprocessor.
+TEST(SketchPrototypes, ASignatureSplitByBackslashNewlineIsJoinedAsTheCompilerJoinsIt) {
+  EXPECT_EQ(sketch_prototypes("long add_three(long a, \\\n               long b, \\\r\n long c) { return a + b + c; }\n"
+                              "void lo\\\nop() {}\nvoid spaced(int a, \\  \n int b) {}\n"),
+            (Protos{"long add_three(long a, long b, long c);", "void loop();", "void spaced(int a, int b);"}));
+}
+
+TEST(SketchPreparation, ASplitSignatureKeepsItsTextAndTheLineOfWhatFollows) {
+  const std::string main = "int total = 1 + \\\n  2;\nvoid setup() { add(1, \\\n 2); }\nint add(int a, \\\n        int b) { return a + b; }\n";
+  EXPECT_EQ(prepare_sketch({{"m.ino", main}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\nint total = 1 + \\\n  2;\n"
+            "void setup();\nint add(int a, int b);\n#line 3 \"m.ino\"\n"
+            "void setup() { add(1, \\\n 2); }\nint add(int a, \\\n        int b) { return a + b; }\n");
+}
+
+TEST(SketchPrototypes, AnIfZeroGroupWithAnUnbalancedBraceCountsForNothing) {
+  EXPECT_EQ(sketch_prototypes("#if 0\nvoid old_version() {\n  if (x) {\n#endif\nvoid setup() { twice(2); }\n"
+                              "int twice(int x) { return 2 * x; }\n"),
+            (Protos{"void setup();", "int twice(int x);"}));
+}
+
+TEST(SketchPreparation, PrototypesAndTheirLineDirectiveGoAfterAnIfZeroGroupNeverInsideIt) {
+  const std::string main = "#include <SPI.h>\n#if 0\nvoid old_version() {\n#endif\n\nvoid setup() { twice(2); }\n"
+                           "int twice(int x) { return 2 * x; }\n";
+  EXPECT_EQ(prepare_sketch({{"m.ino", main}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\n#include <SPI.h>\n#if 0\nvoid old_version() {\n#endif\n\n"
+            "void setup();\nint twice(int x);\n#line 6 \"m.ino\"\n"
+            "void setup() { twice(2); }\nint twice(int x) { return 2 * x; }\n");
+}
+
+TEST(SketchPreparation, AByteOrderMarkAtTheStartOfAFileIsDropped) {
+  const std::string bom = "\xEF\xBB\xBF";
+  EXPECT_EQ(prepare_sketch({{"m.ino", bom + "void setup() { go(); }\n"}, {"b.ino", bom + "// b\nvoid go() {}\n"}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\nvoid setup();\nvoid go();\n#line 1 \"m.ino\"\n"
+            "void setup() { go(); }\n#line 1 \"b.ino\"\n// b\nvoid go() {}\n");
+  EXPECT_EQ(sketch_prototypes(bom + "int f() { return 1; }\n"), (Protos{"int f();"}));
+  // Only at the start: elsewhere the bytes are the sketch's own (the compiler's to refuse).
+  EXPECT_EQ(prepare_sketch({{"m.ino", "int x;" + bom + "\n"}}), "#include <Arduino.h>\n#line 1 \"m.ino\"\nint x;" + bom + "\n");
+}
+
+TEST(SketchPrototypes, ConstantConditionsDecideWhichBranchesCount) {
+  const std::string text = "#if 1\nvoid a() {}\n#else\nvoid b() {\n#endif\n"
+                           "#if false\nvoid c() {}\n#elif 0x0\nvoid d() {\n#elif (1)\nvoid e() {}\n#else\nvoid f() {\n#endif\n"
+                           "#if 0\n#ifdef X\nvoid g() {}\n#else\nvoid h() {}\n#endif\n#else\nvoid i() {}\n#endif\n"
+                           "#if 0 // off\n{\n#endif\n#if /* off */ 0\n{\n#endif\n#  if 0UL\n{\n#  endif\nvoid j() {}\n";
+  EXPECT_EQ(sketch_prototypes(text), (Protos{"void a();", "void e();", "void i();", "void j();"}));
+}
+
+TEST(SketchPrototypes, EachBranchOfAGroupOnAMacroCountsFromTheDepthTheGroupBeganAt) {
+  // Two openings of one body: every prototype after it used to be lost.
+  EXPECT_EQ(sketch_prototypes("#ifdef FAST\nvoid step(int n) {\n#elif defined(SLOW)\nvoid step(long n) {\n#else\n"
+                              "void step(short n) {\n#endif\n  go(n);\n}\nvoid after() {}\n"),
+            (Protos{"void step(int n);", "void step(long n);", "void step(short n);", "void after();"}));
+  // A function in such a group gets its prototype; one whose signature is only partly inside
+  // one gets none (with other macros it would read otherwise).
+  EXPECT_EQ(sketch_prototypes("#ifdef DEBUG\nvoid dump() {}\n#endif\n#ifdef WIDE\nlong\n#else\nint\n#endif\nvalue() {}\n"
+                              "void f(\n#ifdef WIDE\nlong x\n#else\nint x\n#endif\n) {}\n#ifdef ESP32\n#endif\nvoid g() {}\n"),
+            (Protos{"void dump();", "void g();"}));
+}
+
+// The same failure on a group the preprocessor cannot decide: an ISR for one platform above the
+// functions took the prototypes and the #line into its #ifdef, lost on every other platform.
+TEST(SketchPreparation, AFunctionInAGroupOnAMacroIsDeclaredInsideTheSameConditionsAfterIt) {
+  const std::string main = "#ifdef ESP32\nvoid IRAM_ATTR on_flag() {}\n#endif\nvoid setup() { helper(); }\n"
+                           "void helper() {}\n";
+  EXPECT_EQ(prepare_sketch({{"m.ino", main}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\n#ifdef ESP32\nvoid IRAM_ATTR on_flag() {}\n#endif\n"
+            "#ifdef ESP32\nvoid IRAM_ATTR on_flag();\n#endif\nvoid setup();\nvoid helper();\n#line 4 \"m.ino\"\n"
+            "void setup() { helper(); }\nvoid helper() {}\n");
+}
+
+TEST(SketchPreparation, NestedGroupsAndTheirBranchesAreWrittenOnceEachAsTheSourceHasThem) {
+  const std::string text = "void setup() {}\n#ifdef A\nvoid a() {}\n#ifdef B // b\nvoid b() {}\n#endif\nvoid a2() {}\n"
+                           "#elif defined(C)\nvoid c() {}\n#else\nvoid d() {}\n#endif\n"
+                           "#if 0\nvoid z() {}\n#elif X > 1\nvoid x() {}\n#else\n#endif\n#ifdef A\nvoid a3() {}\n#endif\n";
+  EXPECT_EQ(sketch_prototype_block(text),
+            "void setup();\n#ifdef A\nvoid a();\n#ifdef B\nvoid b();\n#endif\nvoid a2();\n#elif defined(C)\nvoid c();\n"
+            "#else\nvoid d();\n#endif\n#if X > 1\nvoid x();\n#endif\n#ifdef A\nvoid a3();\n#endif\n");
+}
+
+TEST(SketchPreparation, WhenEveryFunctionIsInAGroupThePrototypesGoBeforeTheFirstUnconditionally) {
+  // A sketch in an include guard: the guard's condition, written again after its #define, would
+  // be false.
+  EXPECT_EQ(prepare_sketch({{"m.ino", "#ifndef M_INO\n#define M_INO\nvoid setup() { go(); }\nvoid go() {}\n#endif\n"}}),
+            "#include <Arduino.h>\n#line 1 \"m.ino\"\n#ifndef M_INO\n#define M_INO\nvoid setup();\nvoid go();\n"
+            "#line 3 \"m.ino\"\nvoid setup() { go(); }\nvoid go() {}\n#endif\n");
+}
+
 }  // namespace
 }  // namespace l6470emu::test

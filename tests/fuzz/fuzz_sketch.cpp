@@ -1,18 +1,51 @@
 // libFuzzer harness of the sketch preprocessor (firmware/sketch_prep.hpp, what l6470emu-ino does
 // to .ino files): any text, split into two files at its first NUL byte, gives a translation unit
-// that begins with #include <Arduino.h>, holds every file's text unchanged and in order, and
-// grows by at most the prototypes (each no longer than three times the text it came from).
+// that begins with #include <Arduino.h>, holds every file's text (without a leading byte-order
+// mark) unchanged and in order, and grows by at most the prototypes and the conditions written
+// around them (linearly). Its lexer's tokens stay in order inside the text, and its conditional
+// groups' marks nest.
 #include <string>
 #include <string_view>
 
+#include "firmware/sketch_lexer_internal.hpp"
 #include "firmware/sketch_prep.hpp"
 #include "fuzz_support.hpp"
 
 using namespace l6470emu;
 
+namespace {
+
+void check_tokens(std::string_view text) {
+  std::size_t last = 0;
+  int open = 0;
+  for (const sketch::Token& t : sketch::tokenize_sketch(text)) {
+    FUZZ_CHECK(t.offset >= last && t.offset < text.size(), "a token at %zu after %zu in %zu bytes", t.offset, last,
+               text.size());
+    last = t.offset;
+    switch (t.kind) {
+      case sketch::TokenKind::Word:
+        FUZZ_CHECK(!t.text.empty() && t.text.size() <= text.size() - t.offset, "a token of %zu bytes at %zu",
+                   t.text.size(), t.offset);
+        break;
+      case sketch::TokenKind::OpenGroup:
+        ++open;
+        break;
+      case sketch::TokenKind::OtherBranch:
+        FUZZ_CHECK(open > 0, "a branch mark outside a group at %zu", t.offset);
+        break;
+      case sketch::TokenKind::CloseGroup:
+        FUZZ_CHECK(open-- > 0, "a group closed that was not open at %zu", t.offset);
+        break;
+    }
+  }
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   fuzz::count_input(size);
   const std::string_view all(reinterpret_cast<const char*>(data), size);
+  check_tokens(all);
   const std::size_t nul = all.find('\0');
   std::vector<SketchFile> files{{"main.ino", std::string(all.substr(0, nul))}};
   if (nul != std::string_view::npos) files.push_back({"more.ino", std::string(all.substr(nul + 1))});
@@ -22,11 +55,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // directives, which the tokenizer skips), make the one block it may insert.
   std::string joined;
   for (const SketchFile& f : files) {
-    joined += "#line 1 \"" + f.path + "\"\n" + f.text;
+    joined += "#line 1 \"" + f.path + "\"\n" + std::string(sketch::without_bom(f.text));
     if (joined.back() != '\n') joined += '\n';  // as prepare_sketch ends a file: one newline, none doubled
   }
-  std::string block;
-  for (const std::string& p : sketch_prototypes(joined)) block += p + "\n";
+  std::string block = sketch_prototype_block(joined);
+  std::size_t prototypes = 0;
+  for (const std::string& p : sketch_prototypes(joined)) {
+    FUZZ_CHECK(block.find(p + "\n") != std::string::npos, "the prototype %s is not in the block", p.c_str());
+    ++prototypes;
+  }
+  FUZZ_CHECK((prototypes == 0) == block.empty(), "a block of %zu bytes for %zu prototypes", block.size(), prototypes);
   bool inserted = block.empty();  // no prototypes: nothing is inserted anywhere
   block += "#line ";
   std::size_t at = 0;
@@ -36,7 +74,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     FUZZ_CHECK(begin != std::string::npos, "no #line for %s", f.path.c_str());
     at = begin + head.size();
     const std::string_view rest(out.data() + at, out.size() - at);
-    const std::string_view text(f.text);
+    const std::string_view text = sketch::without_bom(f.text);
     if (rest.substr(0, text.size()) == text && (inserted || rest.substr(text.size(), block.size()) != block)) {
       at += text.size();
       continue;
