@@ -85,6 +85,11 @@ class Decoder {
     put(t, std::move(line_), e.chip);
   }
 
+  /// The host's wire settings from this frame on (a `wire` line of the trace), on a line of their own.
+  void host_wire(double t, const TraceWire& wire) {
+    put(t, stamp(t) + "host wire: " + (wire.known ? describe_trace_wire(wire) : "not known (SPI mode 3 assumed)"));
+  }
+
   /// The banner at the first divergence: the log goes on with the emulator's model.
   void divergence(const FirstDivergence& d) {
     put(d.seconds, stamp(d.seconds) + "!!!!!!!! DIVERGED: " + d.summary + "\n" +
@@ -244,9 +249,14 @@ DecodeSummary decode_trace(TraceReader& in, Chain& chain, std::ostream& out, con
   TraceEvent e;
   std::vector<std::uint8_t> rx;
   double previous = 0;  // display time of the end of the event before (a frame's CS rising edge)
+  TraceWire shown_wire;  // the host's wire settings as the log last said them
   while (in.next(e)) {
     const bool diverged = watch.diverged();
     if (e.kind == TraceEventKind::frame) {
+      if (e.wire.known ? !shown_wire.known || !e.wire.same_as(shown_wire) : shown_wire.known) {
+        decoder.host_wire(display_seconds(e.tick, e.source_time), e.wire);
+        shown_wire = e.wire;
+      }
       previous = display_seconds(e.end(), e.source_time == e.source_time
                                               ? e.source_time + static_cast<double>(e.duration) / kTicksPerSecond
                                               : e.source_time);

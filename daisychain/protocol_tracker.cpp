@@ -60,8 +60,19 @@ void ProtocolTracker::report(ProtocolEvent&& e) {
 void ProtocolTracker::begin_frame(const TraceEvent& frame, std::span<std::uint8_t> rx) {
   frame_ = frame;
   chain_.advance_to(frame.tick);
-  chain_.select();
-  chain_.exchange(frame.mosi, rx);
+  if (!frame.wire.known) {
+    // A trace that does not say how the host drove the wire: SPI mode 3, byte by byte.
+    chain_.select();
+    chain_.exchange(frame.mosi, rx);
+  } else {
+    // As the recording's host: its mode and bit order at bit level, and (timed CS edges) a
+    // deselect shorter than t_disCS leaving the chips' answers unloaded.
+    if (frame.wire.deselect_timed)
+      chain_.select_wire();
+    else
+      chain_.select();
+    chain_.exchange_wire(frame.mosi, rx, frame.wire.settings());
+  }
   const std::size_t n = chain_.size(), len = frame.mosi.size();
   for (std::size_t k = 0; k < n; ++k) {
     ChipTrack& c = chips_[k];
@@ -156,7 +167,10 @@ std::string ProtocolTracker::origin_of(std::size_t k) const {
 void ProtocolTracker::end_frame() {
   chain_.advance_to(frame_.end());
   diagnostics_.clear();
-  chain_.deselect();
+  if (frame_.wire.known)
+    chain_.deselect_wire();  // each chip's SDO latch kept for the next frame
+  else
+    chain_.deselect();
   const std::size_t n = chain_.size(), len = frame_.mosi.size();
   if (len > 0) {
     for (std::size_t k = 0; k < n; ++k) {

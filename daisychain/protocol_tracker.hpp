@@ -84,8 +84,10 @@ class ProtocolTracker {
   ProtocolTracker(const ProtocolTracker&) = delete;
   ProtocolTracker& operator=(const ProtocolTracker&) = delete;
 
-  /// CS falls at frame.tick and the MOSI bytes are clocked; `rx` (as long as frame.mosi)
-  /// receives the emulated MISO. Captured MISO bytes of `frame` are taken as the answers.
+  /// CS falls at frame.tick and the MOSI bytes are clocked as the frame's host did
+  /// (TraceEvent::wire: a known wire through the chain's bit-level face, else SPI mode 3 byte by
+  /// byte); `rx` (as long as frame.mosi) receives the emulated MISO, as that host reads it.
+  /// Captured MISO bytes of `frame` are taken as the answers.
   /// `frame`'s bytes must stay valid until end_frame().
   void begin_frame(const TraceEvent& frame, std::span<std::uint8_t> rx);
   /// CS rises at frame.end(): the chips decode; events are reported.

@@ -101,26 +101,44 @@ void RecordingChain::advance_to(Tick tick) {
 
 void RecordingChain::select() {
   if (chain_.selected()) return;
-  start_frame();
+  start_frame(false);
   chain_.select();
 }
 
 void RecordingChain::select_wire() {
   if (chain_.selected()) return;
-  start_frame();
+  start_frame(true);
   chain_.select_wire();
 }
 
-void RecordingChain::start_frame() {
+void RecordingChain::start_frame(bool timed) {
   frame_start_ = chain_.now();
   decoded_at_select_ = chain_.decoded_bytes();
   frame_bytes_ = 0;
+  frame_timed_ = timed;
+  wire_noted_ = false;
 }
+
+namespace {
+
+/// The wire of a frame clocked through the byte face: SPI mode 3, MSB first. Untimed, that is
+/// how a trace that says nothing is replayed (no `wire` line); timed, it must be said.
+TraceWire byte_face_wire(bool timed) {
+  TraceWire w;
+  w.known = timed;
+  w.deselect_timed = timed;
+  return w;
+}
+
+}  // namespace
 
 std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
   if (!chain_.selected()) touched();  // a frame's bytes are judged when CS rises (finish_frame)
   const std::uint8_t miso = chain_.exchange(mosi);
-  if (chain_.selected()) keep({&mosi, 1}, {&miso, 1});
+  if (chain_.selected()) {
+    note_wire(byte_face_wire(frame_timed_));
+    keep({&mosi, 1}, {&miso, 1});
+  }
   return miso;
 }
 
@@ -148,14 +166,20 @@ void RecordingChain::keep(std::span<const std::uint8_t> tx, std::span<const std:
 void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) {
   if (!chain_.selected()) touched();
   chain_.exchange(tx, rx);
-  if (chain_.selected()) keep(tx, rx);
+  if (chain_.selected()) {
+    note_wire(byte_face_wire(frame_timed_));
+    keep(tx, rx);
+  }
 }
 
 void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                                    const WireSettings& wire) {
   if (!chain_.selected()) touched();
   chain_.exchange_wire(tx, rx, wire);
-  if (chain_.selected()) keep(tx, rx);
+  if (chain_.selected()) {
+    if (!wire_noted_) note_wire(trace_wire_of(wire, frame_timed_));
+    keep(tx, rx);
+  }
 }
 
 void RecordingChain::deselect() {
@@ -183,6 +207,12 @@ void RecordingChain::finish_frame() {
   e.mosi = {tx_.data(), frame_bytes_};
   // A frame of no bytes gets an empty MISO list (nothing to compare).
   e.miso = {rx_.data(), frame_bytes_};
+  if (!wire_noted_ && wire_.deselect_timed != frame_timed_) {
+    // No byte clocked: the settings stay the last frame's, the CS timing is this frame's.
+    wire_.deselect_timed = frame_timed_;
+    wire_.known = wire_.known || frame_timed_;
+  }
+  e.wire = wire_;
   emit(e);
   ++frames_;
   for (const TraceEvent& d : deferred_) emit(d);

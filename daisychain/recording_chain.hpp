@@ -39,7 +39,9 @@ class RecordingChain final : public SpiDevice {
   void exchange(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx) override;
   void deselect() override;
   bool selected() const override { return chain_.selected(); }
-  // The bit-level face: frames record the bytes as the host sent and read them.
+  // The bit-level face: frames record the bytes as the host sent and read them, and the host's
+  // wire settings (TraceEvent::wire: mode, bit order, word size and speed of the frame's first
+  // exchange_wire, and whether its CS edges were timed: select_wire() rather than select()).
   void select_wire() override;
   void exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire) override;
   void deselect_wire() override;
@@ -105,7 +107,7 @@ class RecordingChain final : public SpiDevice {
   std::uint64_t frames_recorded() const { return frames_; }
 
  private:
-  void start_frame();
+  void start_frame(bool timed);
   void finish_frame();
   void look_at_outputs();
   void keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
@@ -121,6 +123,15 @@ class RecordingChain final : public SpiDevice {
   std::vector<std::uint8_t> tx_, rx_;  // the frame's bytes so far: the first frame_bytes_ of them
   std::size_t frame_bytes_ = 0;
   TraceEvent frame_event_;  // the frame written at CS rising, kept (building one per frame cost more than the rest)
+  // How the host drives the wire: the last frame's settings, kept for a frame that clocks no byte.
+  TraceWire wire_;
+  bool frame_timed_ = false;  // this frame's CS fell through select_wire() (t_disCS applies)
+  bool wire_noted_ = false;   // this frame's first exchange set wire_
+  void note_wire(const TraceWire& wire) {
+    if (wire_noted_) return;
+    wire_noted_ = true;
+    if (!(wire_ == wire)) wire_ = wire;
+  }
   std::uint64_t decoded_at_select_ = 0;  // chain_.decoded_bytes() when CS fell
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low
   void touched() {

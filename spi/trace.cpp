@@ -100,6 +100,10 @@ void Trace::write(const TraceEvent& e) {
         s.miso = 2;
       }
     }
+    if (e.wire.known) {
+      if (wires_.empty() || !(wires_.back() == e.wire)) wires_.push_back(e.wire);
+      s.wire = static_cast<std::uint32_t>(wires_.size());
+    }
   }
   events_.push_back(s);
 }
@@ -142,6 +146,7 @@ TraceEvent Trace::operator[](std::size_t i) const {
     e.mosi = {p, s.length};
     if (s.miso >= 1) e.miso = {p + s.length, s.length};
     if (s.miso == 2) e.miso_known = {p + 2 * std::size_t{s.length}, s.length};
+    if (s.wire != 0) e.wire = wires_[s.wire - 1];
   }
   return e;
 }

@@ -14,6 +14,7 @@
 
 #include "core/axis_spec.hpp"
 #include "core/tick.hpp"
+#include "spi/trace_wire.hpp"
 
 namespace l6470emu {
 
@@ -99,6 +100,9 @@ struct TraceEvent {
   std::span<const std::uint8_t> mosi;        ///< frame: bytes sent by the host, in order
   std::span<const std::uint8_t> miso;        ///< frame: bytes received, same length as mosi; empty = none known
   std::span<const std::uint8_t> miso_known;  ///< frame: empty = every miso byte known; else 1 per known byte
+  /// frame: how the host drove the wire (SPI mode, bit order, word size, speed, CS timing), as the
+  /// trace's last `wire` line says; not known in captures and older files (mode 3, byte by byte).
+  TraceWire wire;
   std::uint16_t chip = 0;                    ///< pin/fault: chip index in the chain (0 drives MISO)
   TracePin pin = TracePin::SW;               ///< pin events
   TraceFault fault = TraceFault::UVLO;       ///< fault events
@@ -222,8 +226,10 @@ class Trace final : public TraceSink {
     std::uint8_t what;   // TracePin / TraceFault
     std::uint8_t value;
     std::uint8_t miso;   // 0 = none known, 1 = all known, 2 = with a mask
+    std::uint32_t wire;  // frames: 0 = not known, else wires_[wire - 1]
   };
   std::vector<Stored> events_;
+  std::vector<TraceWire> wires_;  // the frames' wire settings, each run of alike frames' once
   std::vector<std::uint8_t> bytes_;
   std::size_t frames_ = 0;
 };

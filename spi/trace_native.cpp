@@ -1,4 +1,4 @@
-// Native trace format, versions 1 and 2: parsing line by line with exact times and expanding
+// Native trace format, versions 1 to 3: parsing line by line with exact times and expanding
 // `repeat` lines, and writing with one flush per event and runs of repeated frames
 // collapsed. The grammar is in docs/trace-format.md.
 #include "spi/trace_native.hpp"
@@ -256,6 +256,7 @@ void NativeTraceReader::next_repetition(TraceEvent& e) {
   e.mosi = k.mosi;
   e.miso = k.miso;
   e.miso_known = k.known;
+  e.wire = wire_;  // (a `wire` line ends the frames a repeat line may repeat)
   e.line = repeat_line_;
   e.repetition = repeat_done_ + 1;
   if (++group_index_ == group_) {
@@ -358,7 +359,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   if (time_tok[0] < '0' || time_tok[0] > '9') {
     if (time_tok == "chain" || time_tok == "board") fail("'" + std::string(time_tok) + "' must come before the first event");
     if (looks_like_a_time(time_tok)) fail(bad_time(time_tok));
-    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply ...')");
+    fail("unknown line " + quoted(line) + " (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply|wire ...')");
   }
 
   // Time: seconds, decimal (the writer uses 8 decimals: exact ticks).
@@ -402,6 +403,18 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
          " s)");
 
   const std::string_view kind = next_token(rest);
+  if (kind == "wire") {
+    // Version 3: the host's settings for the frames from here on. Not an event of its own: the
+    // frames carry it (TraceEvent::wire).
+    if (header_.version < 3)
+      fail("'wire' lines need format version 3 (the first line says " + std::to_string(header_.version) + ")");
+    const std::string why = parse_wire_fields(rest, wire_);
+    if (!why.empty()) fail(why + " (expected " + std::string(kWireLineForm) + ")");
+    kept_count_ = 0;  // a repeat line repeats the frames after it only
+    any_event_ = true;
+    last_tick_ = tick;
+    return false;
+  }
   if (kind == "repeat") {
     parse_repeat(rest, time_tok, tick);
     // Later events come after the last repetition (an open line's time is its group's).
@@ -470,6 +483,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     e.mosi = mosi_;
     if (in_miso) e.miso = miso_;
     if (any_unknown) e.miso_known = known_;
+    e.wire = wire_;
     if (e.duration > kMaxNativeTraceTick - tick)
       fail("frame at " + as_written(time_tok, tick) + " s ends after " + max_time_words() +
            " (the latest time a native trace holds)");
@@ -618,7 +632,7 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
   } else if (kind.empty()) {
     fail("time without an event");
   } else {
-    fail("unknown event " + quoted(kind) + " (frame, repeat, pin, fault, load, advance, axis, stops or supply)");
+    fail("unknown event " + quoted(kind) + " (frame, repeat, pin, fault, load, advance, axis, stops, supply or wire)");
   }
   any_event_ = true;
   last_tick_ = tick;
@@ -849,6 +863,7 @@ void NativeTraceWriter::write(const TraceEvent& e) {
                              (e.kind == TraceEventKind::frame ? " lasting " + format_microseconds(e.duration) + " us" : "") +
                              " is beyond " + max_time_words() + ", the latest time a native trace holds");
   if (!header_written_) write_header({});
+  if (e.kind == TraceEventKind::frame && !e.wire.same_as(wire_)) write_wire_line(e);
   if (e.kind == TraceEventKind::frame && options_.compact) {
     frame(e);
   } else {
@@ -857,6 +872,19 @@ void NativeTraceWriter::write(const TraceEvent& e) {
     write_line(e);
   }
   out_->event_end();
+}
+
+/// `TIME wire ...` before `frame`, whose settings differ from the frames' before it: it ends a
+/// run (a repeat line repeats frames with nothing between them), as any other line does.
+void NativeTraceWriter::write_wire_line(const TraceEvent& frame) {
+  if (in_run_) end_run();
+  forget_recent();
+  line_.clear();
+  append_seconds(line_, frame.tick);
+  append_wire_body(line_, frame.wire);
+  line_ += '\n';
+  put(line_);
+  wire_ = frame.wire;
 }
 
 std::string NativeTraceWriter::format_repeat(Tick last_frame, std::size_t group, std::uint64_t count, Tick period) {

@@ -1,5 +1,5 @@
 // The native trace format (docs/trace-format.md): line-based text, one CS frame per
-// line, version 2 (version 1 read too), plain or gzip. Reader (streaming, for traces of any length, expanding
+// line, version 3 (versions 1 and 2 read too), plain or gzip. Reader (streaming, for traces of any length, expanding
 // `repeat` lines as it goes) and writer (flushed event by event, so a killed process leaves
 // a complete file; collapsing runs of repeated frames into `repeat` lines). No other formats here.
 #pragma once
@@ -19,9 +19,10 @@ namespace l6470emu {
 
 /// The first line of every native trace.
 inline constexpr std::string_view kNativeTraceMagic = "l6470emu-trace";
-/// The format version this code writes (it reads versions 1 and 2). Version 2 added the
-/// `board` header lines, the `load` and `advance` events and open `repeat` lines.
-inline constexpr int kNativeTraceVersion = 2;
+/// The format version this code writes (it reads versions 1 to 3). Version 2 added the
+/// `board` header lines, the `load` and `advance` events and open `repeat` lines; version 3 the
+/// `wire` lines (the host's SPI settings, spi/trace_wire.hpp).
+inline constexpr int kNativeTraceVersion = 3;
 /// The comment the writer puts under the header (after `chain`), so a reader of the file
 /// knows which end chip 0 is: the chain's own order, whatever a tool shows.
 inline constexpr std::string_view kNativeTraceNumbering =
@@ -52,7 +53,7 @@ class TraceFileReader;
 class NativeTraceReader final : public TraceReader {
  public:
   /// Opens `path` (gzip-compressed or not: recognised by its first bytes). Throws TraceError
-  /// when it cannot be read or is not a native trace of version 1 or 2.
+  /// when it cannot be read or is not a native trace of version 1 to 3.
   explicit NativeTraceReader(const std::string& path, std::uint64_t max_frames = kDefaultMaxTraceFrames);
   /// Reads `text` (kept by reference: it must outlive the reader), called `name` in messages.
   NativeTraceReader(std::string_view text, std::string name, std::uint64_t max_frames = kDefaultMaxTraceFrames);
@@ -92,6 +93,7 @@ class NativeTraceReader final : public TraceReader {
   Tick last_frame_end_ = 0;
   std::vector<std::uint8_t> mosi_, miso_, known_;
   std::string axis_text_;  // an axis event's spec
+  TraceWire wire_;         // the last `wire` line's settings: every frame from it on has them
   // `repeat` lines: the last frames (a ring), and the repetition being handed out.
   std::vector<Kept> kept_;
   std::size_t kept_next_ = 0;   // ring slot the next frame goes to
@@ -121,8 +123,10 @@ struct NativeWriteOptions {
 /// its count field is 6 characters wide. A longer run goes on with frame lines and a new run.
 inline constexpr std::uint64_t kMaxOpenRepeatCount = 999'999;
 
-/// Writes a native trace (version 2): one line per event, or per run of repeated frames (see
-/// NativeWriteOptions). A file whose name ends in ".gz" is gzip-compressed.
+/// Writes a native trace (version 3): one line per event, or per run of repeated frames (see
+/// NativeWriteOptions), and a `wire` line before a frame whose TraceEvent::wire differs from the
+/// frame's before it (an unknown wire counts as its defaults: a trace of byte-face frames has
+/// none). A file whose name ends in ".gz" is gzip-compressed.
 ///
 /// What a killed process leaves (flush_each_event): in an output that can be rewritten (a plain
 /// file), every event written, including the repetitions of a run in progress: a run is an
@@ -242,6 +246,8 @@ class NativeTraceWriter final : public TraceSink {
   std::uint64_t count_offset_ = 0;  // open line: where its count field starts in the output
   std::uint64_t count_word_ = 0;  // open line: its count field and newline as written, in memory order
   Tick checkpoint_tick_ = 0;
+  TraceWire wire_;  // the wire the file's frames have now (the last `wire` line written)
+  void write_wire_line(const TraceEvent& frame);
 };
 
 /// A native trace as text (header and every event; runs collapsed when `compact`).

@@ -153,6 +153,7 @@ inline void check_same_events(const Trace& a, const Trace& b, const char* what) 
       FUZZ_CHECK(std::equal(x.mosi.begin(), x.mosi.end(), y.mosi.begin(), y.mosi.end()), "%s: frame %zu MOSI differs",
                  what, i);
       FUZZ_CHECK(x.miso.size() == y.miso.size(), "%s: frame %zu MISO length differs", what, i);
+      FUZZ_CHECK(x.wire.same_as(y.wire), "%s: frame %zu host wire settings differ", what, i);
       for (std::size_t k = 0; k < x.miso.size(); ++k) {
         FUZZ_CHECK(x.miso_byte_known(k) == y.miso_byte_known(k), "%s: frame %zu MISO byte %zu known differs", what, i,
                    k);

@@ -59,7 +59,7 @@ TEST_F(Recording, InProcessCClientWithCsChangeMessagesIsRecordedFrameByFrameAndR
   ASSERT_EQ(r.status, 0) << r.out << r.err;
   const std::string text = read_file(trace_);
   // The header: the chain, and its whole board description (what a replay builds).
-  EXPECT_EQ(text.rfind("l6470emu-trace 2\nchain L6470\nboard bus=0 cs=0 path=/dev/spidev0.0 chips=L6470 ", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("l6470emu-trace 3\nchain L6470\nboard bus=0 cs=0 path=/dev/spidev0.0 chips=L6470 ", 0), 0u) << text;
   // GetStatus as three one-byte transfers with cs_change between them: three CS frames.
   EXPECT_NE(text.find(" frame 2.00us D0 | 00\n"), std::string::npos) << text;
   EXPECT_NE(text.find(" frame 2.00us 00 | 7C\n"), std::string::npos) << text;

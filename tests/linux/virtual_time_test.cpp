@@ -231,7 +231,7 @@ TEST_F(VirtualTime, AChildProcessGetsItsOwnClockAndLeavesTheParentsDevicesAndTra
   EXPECT_EQ(f.at("status_after"), "0x7E03");  // the same open device, after the child closed its copies
   EXPECT_EQ(f.at("elapsed_ns"), "1500072000");  // 1.5 s of sleeps and six one-byte messages
   // The child (which opened no device) did not start a trace of its own over the parent's.
-  EXPECT_EQ(trace.rfind("l6470emu-trace 2\nchain L6470\nboard ", 0), 0u) << trace;
+  EXPECT_EQ(trace.rfind("l6470emu-trace 3\nchain L6470\nboard ", 0), 0u) << trace;
   EXPECT_NE(trace.find("\nboard time=virtual idle=off\n# " + std::string(kNativeTraceNumbering) +
                        "\n0.00000000 pin 0 BUSY 1\n"),
             std::string::npos)

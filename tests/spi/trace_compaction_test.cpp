@@ -56,7 +56,7 @@ void expect_same_events(const Trace& a, const Trace& b) {
 TEST(TraceCompaction, CollapsesAPollingLoopIntoOneRepeatLine) {
   const std::string text = to_native_text(polling(1000, 4000), true);
   EXPECT_EQ(text,
-            "l6470emu-trace 2\n"
+            "l6470emu-trace 3\n"
             "chain 1\n"
             "# chip numbers count from the MISO end: chip 0 drives MISO, byte k of a frame goes to chip k\n"
             "0.00010000 frame 1.75us D0 | 00\n"

@@ -126,10 +126,10 @@ TEST(NativeTrace, IgnoresCommentsAndBlankLines) {
 
 TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
   const std::string head = "l6470emu-trace 1\n";
-  EXPECT_EQ(error_of(""), "t.trace: empty file (expected a native trace: 'l6470emu-trace 2')");
-  EXPECT_EQ(error_of("name,type\n"), "t.trace:1: not an l6470emu trace: the first line must be 'l6470emu-trace 2'");
-  EXPECT_EQ(error_of("l6470emu-trace 3\n"), "t.trace:1: format version 3 (this l6470emu reads versions 1 to 2)");
-  EXPECT_EQ(error_of("l6470emu-trace 0\n"), "t.trace:1: format version 0 (this l6470emu reads versions 1 to 2)");
+  EXPECT_EQ(error_of(""), "t.trace: empty file (expected a native trace: 'l6470emu-trace 3')");
+  EXPECT_EQ(error_of("name,type\n"), "t.trace:1: not an l6470emu trace: the first line must be 'l6470emu-trace 3'");
+  EXPECT_EQ(error_of("l6470emu-trace 4\n"), "t.trace:1: format version 4 (this l6470emu reads versions 1 to 3)");
+  EXPECT_EQ(error_of("l6470emu-trace 0\n"), "t.trace:1: format version 0 (this l6470emu reads versions 1 to 3)");
   EXPECT_EQ(error_of(head + "0 frame D0 ZZ\n"), "t.trace:2: MOSI \"ZZ\" is not a byte (two hex digits)");
   EXPECT_EQ(error_of(head + "0 frame D0 | 0xZZ\n"), "t.trace:2: MISO \"0xZZ\" is not a byte (two hex digits, or ?? for unknown)");
   EXPECT_EQ(error_of(head + "0 frame D0 00 | 00\n"), "t.trace:2: frame has 2 MOSI bytes but 1 MISO byte");
@@ -137,9 +137,9 @@ TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
             "t.trace:3: time 0.5 s goes backwards (the previous event was at 1.00000000 s)");
   EXPECT_EQ(error_of(head + "0 frame 10us D0\n0.000005 frame 00\n"),
             "t.trace:3: frame at 0.000005 s starts before the previous frame ended (0.00001000 s)");
-  EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply ...')");
+  EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply|wire ...')");
   EXPECT_EQ(error_of(head + "0 blink\n"),
-            "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load, advance, axis, stops or supply)");
+            "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load, advance, axis, stops, supply or wire)");
   EXPECT_EQ(error_of(head + "0 pin 0 RESET 1\n"), "t.trace:2: unknown pin \"RESET\" (SW, STCK, STBY, BUSY or FLAG)");
   EXPECT_EQ(error_of(head + "0 pin 300 SW 1\n"), "t.trace:2: chip \"300\" is not a chip number (0..255)");
   EXPECT_EQ(error_of(head + "0 fault 0 UVLO maybe\n"), "t.trace:2: UVLO \"maybe\" is not on or off");
@@ -222,7 +222,7 @@ TEST(NativeTrace, WriterHandsEveryEventToTheFileBeforeReturning) {
   const Bytes mosi{0xD0}, miso{0x00};
   w.write(frame_at(0, 7, mosi, miso));
   // Still open, nothing closed: the file already holds the header and the frame.
-  EXPECT_EQ(test::read_text(path), "l6470emu-trace 2\n# " + std::string(kNativeTraceNumbering) +
+  EXPECT_EQ(test::read_text(path), "l6470emu-trace 3\n# " + std::string(kNativeTraceNumbering) +
                                         "\n0.00000000 frame 1.75us D0 | 00\n");
 }
 

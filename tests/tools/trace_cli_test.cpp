@@ -136,7 +136,7 @@ TEST(ConvertCommand, WritesNativeVcdAndUmockdevFiles) {
   RunResult r = l6470emu("convert " + fixture_path("saleae_logic2.csv") + " -o " + dir.file("c.trace"));
   ASSERT_EQ(r.status, 0) << r.out;
   const std::string native = test::read_text(dir.file("c.trace"));
-  EXPECT_EQ(native.rfind("l6470emu-trace 2\n# " + std::string(kNativeTraceNumbering) + "\n# converted from ", 0), 0u)
+  EXPECT_EQ(native.rfind("l6470emu-trace 3\n# " + std::string(kNativeTraceNumbering) + "\n# converted from ", 0), 0u)
       << native;
   // The converted trace replays as the original does.
   r = l6470emu("replay --chain 1 " + dir.file("c.trace"));
@@ -262,7 +262,7 @@ TEST(ConvertCommand, KeepsWhatItWroteBeforeABadLine) {
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.out, "l6470emu convert: " + bad + ":3: MOSI \"ZZ\" is not a byte (two hex digits)\n");
   const std::string written =
-      "l6470emu-trace 2\n# " + std::string(kNativeTraceNumbering) + "\n0.00100000 frame 0.00us 00 | 00\n";
+      "l6470emu-trace 3\n# " + std::string(kNativeTraceNumbering) + "\n0.00100000 frame 0.00us 00 | 00\n";
   EXPECT_EQ(test::read_text(dir.file("out.trace")), written);
   r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert " + bad + " -o - 2>/dev/null; }");
   EXPECT_EQ(r.out, written);
