@@ -20,25 +20,11 @@ ParseResult load_board_config_file(const std::string& path) {
   // A FIFO (a shell's <(...)) is fine once its writer writes; a device, a directory or a FIFO
   // nobody writes to is refused (spi/input_file.hpp).
   std::string why;
-  const int fd = open_input_file(path, why);
-  if (fd < 0) return failed(why + (why == "is a directory" ? " (give the board description file)" : ""));
-  std::string text(kMaxConfigBytes + 1, '\0');
-  std::size_t got = 0;
-  while (got < text.size()) {
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int e = errno;
-      ::close(fd);
-      return failed(std::string("cannot be read (") + std::strerror(e) + ")");
-    }
-    if (n == 0) break;
-    got += static_cast<std::size_t>(n);
-  }
-  ::close(fd);
-  if (got > kMaxConfigBytes) return failed("longer than 1 MiB (a board description is a few lines: is this the right file?)");
-  text.resize(got);
-  return parse_board_config(text, path);
+  const std::optional<std::string> text = read_input_file(path, kMaxConfigBytes, why);
+  if (!text) return failed(why + (why == "is a directory" ? " (give the board description file)" : ""));
+  if (text->size() > kMaxConfigBytes)
+    return failed("longer than 1 MiB (a board description is a few lines: is this the right file?)");
+  return parse_board_config(*text, path);
 }
 
 }  // namespace l6470emu

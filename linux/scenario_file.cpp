@@ -1,8 +1,6 @@
 // Scenario files: YAML through yaml-cpp, checked key by key against docs/scenarios.md's schema.
 #include "linux/scenario_file.hpp"
 
-#include <unistd.h>
-
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -537,29 +535,13 @@ ScenarioParse load_scenario_file(const std::string& path) {
   // A device, a directory or a FIFO nobody writes to is refused (spi/input_file.hpp); at most
   // kMaxScenarioBytes + 1 bytes are read, and the parser says when that is too many.
   std::string why;
-  const int fd = open_input_file(path, why);
-  const auto failed = [&](const std::string& what) {
+  const std::optional<std::string> text = read_input_file(path, kMaxScenarioBytes, why);
+  if (!text) {
     ScenarioParse out;
-    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": " + what;
+    out.error = "l6470emu: scenario " + shown_text(path, 200) + ": " + why;
     return out;
-  };
-  if (fd < 0) return failed(why);
-  std::string text(kMaxScenarioBytes + 1, '\0');
-  std::size_t got = 0;
-  while (got < text.size()) {
-    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int e = errno;
-      ::close(fd);
-      return failed(std::string("cannot be read (") + std::strerror(e) + ")");
-    }
-    if (n == 0) break;
-    got += static_cast<std::size_t>(n);
   }
-  ::close(fd);
-  text.resize(got);
-  return parse_scenario_yaml(text, path);
+  return parse_scenario_yaml(*text, path);
 }
 
 }  // namespace l6470emu

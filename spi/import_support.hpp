@@ -97,6 +97,19 @@ inline std::string printable(std::string_view s) {
 /// printable(s) in double quotes.
 inline std::string quote(std::string_view s) { return '"' + printable(s) + '"'; }
 
+/// Splits off the next token of `rest`, tokens being separated by blanks, tabs and carriage
+/// returns (a native trace's fields).
+inline std::string_view next_token(std::string_view& rest) {
+  const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  std::size_t i = 0;
+  while (i < rest.size() && is_space(rest[i])) ++i;
+  std::size_t j = i;
+  while (j < rest.size() && !is_space(rest[j])) ++j;
+  const std::string_view tok = rest.substr(i, j - i);
+  rest.remove_prefix(j);
+  return tok;
+}
+
 /// Appends frames to a Trace in capture order: times become ticks counted from the first
 /// frame's start (rounded to nearest); going backwards or overlapping frames is an error.
 /// At most `max_frames` frames (0: no limit) and kMaxTraceFrameBytes bytes a frame are taken.

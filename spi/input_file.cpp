@@ -63,4 +63,25 @@ int open_input_file(const std::string& path, std::string& error, int fifo_wait_m
   return fd;
 }
 
+std::optional<std::string> read_input_file(const std::string& path, std::size_t max_bytes, std::string& error) {
+  const int fd = open_input_file(path, error);
+  if (fd < 0) return std::nullopt;
+  std::string text(max_bytes + 1, '\0');
+  std::size_t got = 0;
+  while (got < text.size()) {
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      error = std::string("cannot be read (") + std::strerror(errno) + ")";
+      ::close(fd);
+      return std::nullopt;
+    }
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  text.resize(got);
+  return text;
+}
+
 }  // namespace l6470emu

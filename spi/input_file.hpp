@@ -4,6 +4,8 @@
 // never ends, a terminal waits for a person) or a socket is refused with the reason.
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <string>
 
 namespace l6470emu {
@@ -17,5 +19,9 @@ inline constexpr int kInputFifoWaitMs = 10'000;
 /// file", "is a FIFO that nothing wrote to within 10 s". errno is then the system's error when
 /// the file could not be opened at all, 0 when what the file is was refused.
 int open_input_file(const std::string& path, std::string& error, int fifo_wait_ms = kInputFifoWaitMs);
+
+/// Opens `path` as open_input_file does and reads at most `max_bytes` + 1 bytes of it, so that
+/// the caller can tell a file longer than `max_bytes`. The text, or nothing with `error` set.
+std::optional<std::string> read_input_file(const std::string& path, std::size_t max_bytes, std::string& error);
 
 }  // namespace l6470emu

@@ -23,16 +23,7 @@ constexpr std::size_t kChunk = 1 << 20;
 
 bool is_space(char c) { return c == ' ' || c == '\t'; }
 
-/// Splits off the next whitespace-separated token of `rest`.
-std::string_view next_token(std::string_view& rest) {
-  std::size_t i = 0;
-  while (i < rest.size() && is_space(rest[i])) ++i;
-  std::size_t j = i;
-  while (j < rest.size() && !is_space(rest[j])) ++j;
-  const std::string_view tok = rest.substr(i, j - i);
-  rest.remove_prefix(j);
-  return tok;
-}
+using detail::next_token;
 
 std::string quoted(std::string_view s) { return detail::quote(s); }
 

@@ -7,17 +7,7 @@
 namespace l6470emu {
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-
-std::string_view next_token(std::string_view& rest) {
-  std::size_t i = 0;
-  while (i < rest.size() && is_space(rest[i])) ++i;
-  std::size_t j = i;
-  while (j < rest.size() && !is_space(rest[j])) ++j;
-  const std::string_view tok = rest.substr(i, j - i);
-  rest.remove_prefix(j);
-  return tok;
-}
+using detail::next_token;
 
 bool parse_number(std::string_view s, std::uint64_t max, std::uint64_t& out) {
   if (s.empty() || s.size() > 12) return false;
