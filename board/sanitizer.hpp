@@ -57,6 +57,8 @@ class Sanitizer {
 
   const CheckConfig& config() const { return config_; }
   void set_config(const CheckConfig& config) { config_ = config; }
+  /// Where the log lines go from now on (a front that also turns them into warnings of its own).
+  void set_log(LineSink log) { log_ = std::move(log); }
   CheckLevel level() const { return config_.level; }
 
   /// A broken rule: dropped when the level is off or the rule allowed; under warn a log line

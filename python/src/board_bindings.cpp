@@ -12,6 +12,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "py_board.hpp"
+#include "sanitizer_failure.hpp"
 
 namespace l6470emu::python {
 namespace {
@@ -169,6 +170,7 @@ void bind_board(py::module_& m) {
     }
     std::vector<std::uint8_t> rx(rx_len);
     const long r = s.message(chain, xfers, tx, rx);
+    warn_sanitizer_lines(s.take_check_lines());  // check=warn, as a Chain does
     if (r < 0) raise_errno(r, "SPI_IOC_MESSAGE");
     return py::bytes(reinterpret_cast<const char*>(rx.data()), rx.size());
   });

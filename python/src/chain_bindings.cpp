@@ -31,14 +31,6 @@ std::size_t chip_arg(const PyChain& c, py::handle k) {
   throw py::type_error("chip: an int index is needed (0 drives MISO)");
 }
 
-PyObject* sanitizer_warning() {
-  static PyObject* w = PyErr_NewExceptionWithDoc(
-      "l6470emu._l6470emu.SanitizerWarning",
-      "A broken rule of the chip's interface under check=\"warn\" (the sanitizer's report line).", PyExc_UserWarning,
-      nullptr);
-  return w;
-}
-
 CheckConfig check_config_from(py::object level, py::object allow) {
   CheckConfig cc;
   if (!py::isinstance<py::str>(level)) throw py::type_error("check: \"off\", \"warn\" or \"error\"");
@@ -71,8 +63,7 @@ std::int32_t position_arg(py::handle v, const char* what) {
 /// a check=error failure raises l6470emu.SanitizerError with the report.
 void after_spi(PyChain& p) {
   p.look();  // interface coverage: the flags the traffic raised
-  for (const std::string& line : p.take_check_lines())
-    if (PyErr_WarnEx(sanitizer_warning(), line.c_str(), 1) != 0) throw py::error_already_set();
+  warn_sanitizer_lines(p.take_check_lines());
   if (auto report = p.take_check_failure()) throw SanitizerFailure(*report);
 }
 
@@ -89,6 +80,19 @@ std::uint8_t level_arg(py::handle v, const char* what) {
 }
 
 }  // namespace
+
+PyObject* sanitizer_warning() {
+  static PyObject* w = PyErr_NewExceptionWithDoc(
+      "l6470emu._l6470emu.SanitizerWarning",
+      "A broken rule of the chip's interface under check=\"warn\" (the sanitizer's report line).", PyExc_UserWarning,
+      nullptr);
+  return w;
+}
+
+void warn_sanitizer_lines(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines)
+    if (PyErr_WarnEx(sanitizer_warning(), line.c_str(), 1) != 0) throw py::error_already_set();
+}
 
 void bind_chain(py::module_& m) {
   static py::exception<SanitizerFailure> error = py::register_exception<SanitizerFailure>(m, "SanitizerError", PyExc_AssertionError);

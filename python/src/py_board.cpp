@@ -30,16 +30,20 @@ PyBoard::PyBoard(const BoardConfig& config, const CoverageRequest& coverage)
     spi_.push_back(s);
   }
   users_.assign(config_.chains.size(), 0);
-  board_ = std::make_unique<Board>(
-      config_,
-      [this](std::string_view line) {
-        if (log_.size() >= kMaxLogLines) {
-          log_.pop_front();
-          ++log_dropped_;
-        }
-        log_.emplace_back(line);
-      },
-      *clock_);
+  const auto keep = [this](std::string_view line) {
+    if (log_.size() >= kMaxLogLines) {
+      log_.pop_front();
+      ++log_dropped_;
+    }
+    log_.emplace_back(line);
+  };
+  board_ = std::make_unique<Board>(config_, keep, *clock_);
+  // check=warn lines stay in the log and become l6470emu.SanitizerWarning warnings too, as a
+  // Chain's do (take_check_lines, after each message).
+  board_->sanitizer().set_log([this, keep](std::string_view line) {
+    keep(line);
+    if (check_lines_.size() < kMaxLogLines) check_lines_.emplace_back(line);
+  });
   board_->set_edge_sink([this](const PinEdge& e) { on_edge(e); });
   if (coverage.collect) {
     board_->enable_coverage();

@@ -14,6 +14,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "board/board.hpp"
@@ -71,6 +72,8 @@ class PyBoard {
 
   /// Takes the diagnostics kept so far (one line each); `dropped` gets how many were not kept.
   std::vector<std::string> take_log(std::uint64_t& dropped);
+  /// The sanitizer's check=warn lines since the last call (also in the log).
+  std::vector<std::string> take_check_lines() { return std::exchange(check_lines_, {}); }
 
   // ---- interface coverage -------------------------------------------------------------
 
@@ -93,6 +96,7 @@ class PyBoard {
   std::unique_ptr<HostClock> clock_;
   std::deque<std::string> log_;
   std::uint64_t log_dropped_ = 0;
+  std::vector<std::string> check_lines_;
   std::map<PinKey, EdgeQueue> edges_;
   std::vector<SpidevSettings> spi_;
   std::vector<unsigned> users_;

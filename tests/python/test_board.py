@@ -250,3 +250,18 @@ def test_the_python_guide_documents_every_option_of_the_fixtures():
     board = pytest_plugin.SpidevBoard(["L6470"], Path("/tmp"))
     for attribute in (a for a in vars(board) if not a.startswith("_")):
         assert f"`{attribute}`" in section, attribute
+
+
+def test_a_board_at_check_warn_gives_a_sanitizer_warning_as_a_chain_does():
+    board = l6470emu.Board("L6470", check="warn")
+    spi = board.spidev(0, 0)  # mode 0, spidev's default
+    with pytest.warns(l6470emu.SanitizerWarning, match="SPI_MODE: the host clocks in SPI mode 0"):
+        spi.xfer2([0x00])
+    assert "SPI_MODE: the host clocks in SPI mode 0" in board.log()  # and the log keeps it
+
+
+@pytest.mark.l6470_chain("L6470", check="warn")
+def test_the_board_fixture_at_check_warn_gives_a_sanitizer_warning(l6470_board):
+    spi = l6470_board.spidev(0, 0)
+    with pytest.warns(l6470emu.SanitizerWarning, match="SPI_MODE"):
+        spi.xfer2([0x00])
