@@ -74,7 +74,7 @@ class Board:
     description instead (several chains separated by ';', docs/linux.md). trace_path: record
     every chain into this native trace (trace(), decode(), replay() read it). check: the driver
     sanitizer, "error" (default: the first broken rule of the chip raises l6470emu.SanitizerError
-    with the report), "warn" (a log line) or "off"; check_allow: rule names let pass. A
+    with the report), "warn" (an l6470emu.SanitizerWarning and a log line) or "off"; check_allow: rule names let pass. A
     description or options naming check= themselves win. coverage: collect interface coverage of
     everything the board meets and merge it into this file on close(), at the end of a `with`,
     when the board is destroyed or the interpreter exits (docs/coverage-python.md); True
