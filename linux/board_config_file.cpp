@@ -1,14 +1,10 @@
-// Reading a board description file: opened by spi/input_file.hpp (a device is refused before it
-// is opened, a FIFO waited for a bounded time), then
-// at most kMaxConfigBytes + 1 bytes, then board/board_config.cpp's parser.
+// Reading a board description file: at most kMaxConfigBytes + 1 bytes through
+// spi/input_file.hpp (a device is refused before it is opened, a FIFO waited for a bounded
+// time), then board/board_config.cpp's parser.
 #include "linux/board_config_file.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
+#include <optional>
+#include <string>
 
 #include "spi/input_file.hpp"
 
