@@ -28,6 +28,7 @@
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
 #include "linux/device_board.hpp"
+#include "tools/run_judgement.hpp"
 #include "tools/run_outcome.hpp"
 #include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
@@ -524,89 +525,33 @@ std::optional<int> RunCommand::run() {
   const int started = kernel ? run_on_kernel_nodes(config, scenario, !scenario_file_.empty(), timeout, program_, run)
                              : run_under_preload(config, scenario, timeout, program_, run);
   if (started >= 0) return started;
-  const pid_t pid = run.pid;
-  const int wstatus = run.wstatus;
-  const bool wall_timeout = run.wall_timeout;
-  const std::vector<RunReport>& blocks = run.blocks;
-
   // 4. What it came to.
-  std::optional<RunEnd> cause;
-  const RunReport* cause_block = nullptr;
-  for (const RunReport& b : blocks)
-    if (b.end != RunEnd::exit && !cause) {
-      cause = b.end;
-      cause_block = &b;
-    }
-  if (wall_timeout || run.wall_guard) cause = RunEnd::timeout;
-  std::vector<const RunReport*> judged;
-  for (const RunReport& b : blocks)
-    if (b.devices && b.scenario) judged.push_back(&b);
-  if (judged.empty())
-    for (const RunReport& b : blocks)
-      if (b.pid == pid) judged.push_back(&b);
-  std::size_t expectations = 0;
-  std::vector<ScenarioFailure> failures;
-  std::vector<std::string> passed, world;
-  Tick end_tick = 0;
-  for (const RunReport* b : judged) {
-    expectations += b->outcome.judged;
-    failures.insert(failures.end(), b->outcome.failures.begin(), b->outcome.failures.end());
-    passed.insert(passed.end(), b->outcome.passed.begin(), b->outcome.passed.end());
-    world.insert(world.end(), b->outcome.log.begin(), b->outcome.log.end());
-    end_tick = std::max(end_tick, b->tick);
-  }
-  if (cause_block) end_tick = std::max(end_tick, cause_block->tick);
-  if (wall_timeout) end_tick = std::max(end_tick, *timeout);  // killed: no report of its own
-  const bool exited = WIFEXITED(wstatus);
-  const int code = exited ? WEXITSTATUS(wstatus) : -1;
-  const int signal = WIFSIGNALED(wstatus) ? WTERMSIG(wstatus) : 0;
-  std::string ended;
-  if (run.wall_guard)
-    ended = "was stopped by the wall-clock guard after " + seconds_text(*wall_guard) +
-            " of the host's time (--wall-timeout): it waited where virtual time cannot see (pause(), a read on its "
-            "own pipe, a lock no thread releases) or ran longer than that";
-  else if (cause == RunEnd::timeout)
-    ended = "stopped at the simulated time limit " + seconds_text(*timeout);
-  else if (cause == RunEnd::deadlock)
-    ended = "deadlocked in virtual time";
-  else if (cause == RunEnd::sanitizer)
-    ended = "stopped by the driver sanitizer";
-  else if (run.stopped_by)
-    ended = std::string("was stopped: l6470emu run got signal ") + std::to_string(run.stopped_by) + " (" +
-            strsignal(run.stopped_by) + ") and passed it on";
-  else if (exited)
-    ended = "exited with status " + std::to_string(code);
-  else
-    ended = std::string("was killed by signal ") + std::to_string(signal) + " (" + strsignal(signal) + ")";
-
-  int status = kRunPassed;
-  std::string why;
-  if (cause == RunEnd::timeout) status = kRunTimedOut;
-  else if (cause == RunEnd::deadlock) status = kRunDeadlocked;
-  else if (cause == RunEnd::sanitizer) status = kRunSanitizerError;
-  else if (!exited || code != 0) status = kRunProgramFailed;
-  else if (!failures.empty()) status = kRunExpectationFailed;
-  else if (judged.empty()) {  // with or without a scenario: nothing says how the run went
-    status = kRunNotStarted;
-    why = " (it left no report: it ended by _exit() or a signal before exit(), or the preload was not loaded)";
-  }
-  // Stopped by a signal to run: whatever the program did, the run did not finish (128 + N).
-  if (run.stopped_by) {
-    status = 128 + run.stopped_by;
-    why.clear();
-  }
+  ProgramExit program_exit;
+  program_exit.pid = run.pid;
+  program_exit.wstatus = run.wstatus;
+  program_exit.wall_timeout = run.wall_timeout;
+  program_exit.wall_guard = run.wall_guard;
+  program_exit.wall_guard_limit = *wall_guard;
+  program_exit.stopped_by = run.stopped_by;
+  program_exit.blocks = std::move(run.blocks);
+  const RunJudgement verdict = judge_run(program_exit, timeout);
+  const int status = verdict.status;
+  const std::string& ended = verdict.ended;
+  const std::string& why = verdict.why;
+  const std::vector<ScenarioFailure>& failures = verdict.failures;
+  const std::vector<std::string>& passed = verdict.passed;
+  const std::vector<std::string>& world = verdict.world;
+  const Tick end_tick = verdict.end_tick;
   const std::string words = run.stopped_by ? "run was stopped by a signal" : status_words(status);
 
   std::ostream& out = std::cerr;
   // Without a report (killed by a signal, _exit()) nothing says when it ended: no "at 0 s".
-  const bool when_known = !judged.empty() || cause_block || wall_timeout;
   out << "l6470emu run: " << program_[0] << " " << ended
       << (run.wall_guard ? std::string()
-          : when_known ? " at " + seconds_text(end_tick) + (config.time.virtual_time ? " of virtual time" : " of board time")
+          : verdict.when_known ? " at " + seconds_text(end_tick) + (config.time.virtual_time ? " of virtual time" : " of board time")
                      : std::string(" (when, in virtual time, is unknown: it left no report)"))
       << "\n";
-  if (cause_block)
-    for (const auto& d : cause_block->detail) out << "  " << d << "\n";
+  for (const auto& d : verdict.detail) out << "  " << d << "\n";
   if (verbose_) {
     for (const auto& w : world) out << "  world: " << w << "\n";
     for (const auto& p : passed) out << "  held: " << p << "\n";
@@ -614,28 +559,11 @@ std::optional<int> RunCommand::run() {
   for (const ScenarioFailure& f : failures)
     out << "  FAILED " << f.where << ": " << f.chip << ": " << f.what << " at " << seconds_text(f.tick) << ": expected "
         << f.expected << ", seen " << f.seen << "\n";
-  out << "l6470emu run: " << expectations << " expectation" << (expectations == 1 ? "" : "s") << ", "
+  out << "l6470emu run: " << verdict.expectations << " expectation" << (verdict.expectations == 1 ? "" : "s") << ", "
       << failures.size() << " failed; exit " << status << ": " << words << why << "\n";
 
-  if (!outcome_.empty()) {
-    RunOutcome o;
-    o.status = status;
-    o.exited = exited;
-    o.code = code;
-    o.signal = signal;
-    o.end_tick = end_tick;
-    o.ended = ended;
-    o.failures = failures;
-    if (cause_block) o.detail = cause_block->detail;
-    for (const RunReport* b : judged)
-      for (const auto& p : b->outcome.pin_reads) {
-        auto same = [&](const ScenarioOutcome::PinRead& q) { return q.chain == p.chain && q.chip == p.chip && q.pin == p.pin; };
-        const auto it = std::find_if(o.pin_reads.begin(), o.pin_reads.end(), same);
-        if (it == o.pin_reads.end()) o.pin_reads.push_back(p);
-        else it->tick = std::max(it->tick, p.tick);
-      }
-    if (!write_run_outcome(outcome_, o)) std::cerr << "l6470emu run: cannot write " << outcome_ << "\n";
-  }
+  if (!outcome_.empty() && !write_run_outcome(outcome_, verdict.outcome()))
+    std::cerr << "l6470emu run: cannot write " << outcome_ << "\n";
   if (!junit_.empty()) {
     // One testcase per expectation, in the scenario's order and named by its step and what it
     // looks at, the same whether it held or not (CI keeps a history per name); a failure
@@ -679,8 +607,7 @@ std::optional<int> RunCommand::run() {
     if (program_failed) {
       x << "\n      <error type=\"" << xml(words) << "\" message=\"" << xml(program_[0] + " " + ended + why)
         << "\">";
-      if (cause_block)
-        for (const auto& d : cause_block->detail) x << xml(d) << "\n";
+      for (const auto& d : verdict.detail) x << xml(d) << "\n";
       x << "</error>\n    ";
     }
     x << "</testcase>\n";
