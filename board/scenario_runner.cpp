@@ -95,48 +95,7 @@ ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
     uvlo_by_supply_[c].assign(board_.chip_count(c), false);
   }
   std::vector<std::pair<std::size_t, std::size_t>> busy_watch;
-  for (std::size_t i = 0; i < scenario_.steps.size(); ++i) {
-    const ScenarioStep& st = scenario_.steps[i];
-    StepState& s = state_[i];
-    const std::string& w = st.where;
-    auto bad = [&](const std::string& what) { throw std::invalid_argument(w + ": " + what); };
-    if (is_event(st.when.kind)) s.trigger_chip = resolve(st.when.chip, w);
-    const Chip* tchip = is_event(st.when.kind) ? &board_.chain(s.trigger_chip.chain).chip(s.trigger_chip.chip) : nullptr;
-    if (st.when.kind == ScenarioTrigger::Kind::true_position && !tchip->axis())
-      bad(s.trigger_chip.label + " has no axis (axis.K= in the board description) for true_position");
-    if (st.when.kind == ScenarioTrigger::Kind::command && !is_command_name(st.when.command))
-      bad(quoted_text(st.when.command) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
-    if (st.when.kind == ScenarioTrigger::Kind::busy_fall || st.when.kind == ScenarioTrigger::Kind::busy_rise)
-      busy_watch.emplace_back(s.trigger_chip.chain, s.trigger_chip.chip);
-    if (st.action) {
-      const ScenarioAction& a = *st.action;
-      s.target_chip = resolve(a.chip, w);
-      const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
-      if ((a.kind == ScenarioAction::Kind::load || a.kind == ScenarioAction::Kind::block) && !chip.axis())
-        bad(s.target_chip.label + " has no axis (axis.K= in the board description) for " +
-            std::string(to_string(a.kind)));
-      if (st.when.kind == ScenarioTrigger::Kind::end) bad("an action cannot happen at the end");
-    }
-    if (st.expect) {
-      const ScenarioExpectation& e = *st.expect;
-      s.target_chip = resolve(e.chip, w);
-      const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
-      if (e.kind == ScenarioExpectation::Kind::reg && !find_register(chip, e.name))
-        bad("the " + std::string(chip.variant().name) + " has no register " + quoted_text(e.name));
-      if (e.kind == ScenarioExpectation::Kind::true_position && !chip.axis())
-        bad(s.target_chip.label + " has no axis (axis.K= in the board description) for true_position");
-      if (e.kind == ScenarioExpectation::Kind::status)
-        for (const auto& [name, bit] : e.flags)
-          if (status_bit(chip.status_layout(), name) < 0)
-            bad("the " + std::string(chip.variant().name) + "'s STATUS has no flag " + quoted_text(name));
-      if (e.kind == ScenarioExpectation::Kind::command && !is_command_name(e.name))
-        bad(quoted_text(e.name) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
-      if (e.kind == ScenarioExpectation::Kind::busy_pulse) {
-        if (st.when.kind != ScenarioTrigger::Kind::end) bad("a BUSY pulse is judged at the end (at: end)");
-        busy_watch.emplace_back(s.target_chip.chain, s.target_chip.chip);
-      }
-    }
-  }
+  for (std::size_t i = 0; i < scenario_.steps.size(); ++i) check_step_against_board(i, busy_watch);
   for (std::size_t c = 0; c < board_.chain_count(); ++c)
     for (std::size_t k = 0; k < board_.chip_count(c); ++k)
       board_.set_command_observer(c, k, [this, c, k](const Opcode& op, std::uint32_t) {
@@ -150,6 +109,67 @@ ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
   for (const auto& [c, k] : busy_watch) {
     board_.observe_pin(c, k, Pin::BUSY, true);
     if (!board_.pin_level(c, k, Pin::BUSY)) pulses_[c][k].push_back(Pulse{board_.now(c), kNever});
+  }
+  fire_due_times(board_.time().now());
+}
+
+void ScenarioRunner::check_step_against_board(std::size_t i, std::vector<std::pair<std::size_t, std::size_t>>& busy_watch) {
+  const ScenarioStep& st = scenario_.steps[i];
+  StepState& s = state_[i];
+  const std::string& w = st.where;
+  auto bad = [&](const std::string& what) { throw std::invalid_argument(w + ": " + what); };
+  if (is_event(st.when.kind)) s.trigger_chip = resolve(st.when.chip, w);
+  const Chip* tchip = is_event(st.when.kind) ? &board_.chain(s.trigger_chip.chain).chip(s.trigger_chip.chip) : nullptr;
+  if (st.when.kind == ScenarioTrigger::Kind::true_position && !tchip->axis())
+    bad(s.trigger_chip.label + " has no axis (axis.K= in the board description) for true_position");
+  if (st.when.kind == ScenarioTrigger::Kind::command && !is_command_name(st.when.command))
+    bad(quoted_text(st.when.command) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
+  if (st.when.kind == ScenarioTrigger::Kind::busy_fall || st.when.kind == ScenarioTrigger::Kind::busy_rise)
+    busy_watch.emplace_back(s.trigger_chip.chain, s.trigger_chip.chip);
+  if (st.action) {
+    const ScenarioAction& a = *st.action;
+    s.target_chip = resolve(a.chip, w);
+    const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
+    if ((a.kind == ScenarioAction::Kind::load || a.kind == ScenarioAction::Kind::block) && !chip.axis())
+      bad(s.target_chip.label + " has no axis (axis.K= in the board description) for " +
+          std::string(to_string(a.kind)));
+    if (st.when.kind == ScenarioTrigger::Kind::end) bad("an action cannot happen at the end");
+  }
+  if (st.expect) {
+    const ScenarioExpectation& e = *st.expect;
+    s.target_chip = resolve(e.chip, w);
+    const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
+    if (e.kind == ScenarioExpectation::Kind::reg && !find_register(chip, e.name))
+      bad("the " + std::string(chip.variant().name) + " has no register " + quoted_text(e.name));
+    if (e.kind == ScenarioExpectation::Kind::true_position && !chip.axis())
+      bad(s.target_chip.label + " has no axis (axis.K= in the board description) for true_position");
+    if (e.kind == ScenarioExpectation::Kind::status)
+      for (const auto& [name, bit] : e.flags)
+        if (status_bit(chip.status_layout(), name) < 0)
+          bad("the " + std::string(chip.variant().name) + "'s STATUS has no flag " + quoted_text(name));
+    if (e.kind == ScenarioExpectation::Kind::command && !is_command_name(e.name))
+      bad(quoted_text(e.name) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
+    if (e.kind == ScenarioExpectation::Kind::busy_pulse) {
+      if (st.when.kind != ScenarioTrigger::Kind::end) bad("a BUSY pulse is judged at the end (at: end)");
+      busy_watch.emplace_back(s.target_chip.chain, s.target_chip.chip);
+    }
+  }
+}
+
+void ScenarioRunner::add_steps(const std::vector<ScenarioStep>& steps) {
+  for (const ScenarioStep& st : steps)
+    if (st.when.kind != ScenarioTrigger::Kind::time && st.when.kind != ScenarioTrigger::Kind::end)
+      throw std::invalid_argument(st.where + ": only a step at a time or at the end can join a running scenario");
+  const std::size_t first = scenario_.steps.size();
+  scenario_.steps.insert(scenario_.steps.end(), steps.begin(), steps.end());
+  state_.resize(scenario_.steps.size());
+  std::vector<std::pair<std::size_t, std::size_t>> busy_watch;
+  try {
+    for (std::size_t i = first; i < scenario_.steps.size(); ++i) check_step_against_board(i, busy_watch);
+  } catch (...) {
+    scenario_.steps.resize(first);
+    state_.resize(first);
+    throw;
   }
   fire_due_times(board_.time().now());
 }

@@ -43,6 +43,12 @@ class ScenarioRunner {
   /// pulse expectation; steps not yet fired are reported as never reached. Idempotent.
   void finish();
 
+  /// Adds `steps` to the scenario while it runs (a campaign's rerun forked from a snapshot of the
+  /// run: the fault's steps and the oracle). Only steps at a time or at the end can join: events
+  /// before now were not counted. Checked against the board as at construction (throws
+  /// std::invalid_argument, nothing added); steps due now fire at once.
+  void add_steps(const std::vector<ScenarioStep>& steps);
+
   const std::vector<ScenarioFailure>& failures() const { return failures_; }
   /// Expectations judged so far (passed and failed).
   std::size_t judged() const { return judged_; }
@@ -76,6 +82,9 @@ class ScenarioRunner {
   };
 
   Resolved resolve(const ScenarioChip& c, const std::string& where) const;
+  // Checks step i against the board (throws std::invalid_argument) and resolves its chips; BUSY
+  // pins it needs watched are added to `busy_watch`.
+  void check_step_against_board(std::size_t i, std::vector<std::pair<std::size_t, std::size_t>>& busy_watch);
   void check_step(std::size_t i);
   bool pending_events() const;
   bool pending_positions() const;

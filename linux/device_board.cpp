@@ -479,6 +479,13 @@ void DeviceBoard::set_scenario(const Scenario& scenario) {
   scenario_ = std::make_unique<ScenarioRunner>(board_, scenario);
 }
 
+bool DeviceBoard::add_scenario_steps(const std::vector<ScenarioStep>& steps) {
+  std::lock_guard lock(m_);
+  if (!scenario_) return false;
+  scenario_->add_steps(steps);
+  return true;
+}
+
 Tick DeviceBoard::scenario_next_tick() {
   std::lock_guard lock(m_);
   return scenario_ ? scenario_->next_tick() : kNever;

@@ -209,6 +209,9 @@ class DeviceBoard {
   /// steps at their ticks, SPI messages its command steps (wall time: its due steps first).
   /// Throws std::invalid_argument (one line naming the step) when it does not fit the board.
   void set_scenario(const Scenario& scenario);
+  /// Adds steps at a time or at the end to the bound scenario (ScenarioRunner::add_steps: a
+  /// campaign's rerun forked from a snapshot). Throws std::invalid_argument; false: no scenario.
+  bool add_scenario_steps(const std::vector<ScenarioStep>& steps);
   /// The tick of the scenario's next timed step (kNever: none, or no scenario).
   Tick scenario_next_tick();
   /// Ends the scenario at the board's time now (its `end` expectations judged). False: none.

@@ -129,6 +129,45 @@ TEST(ScenarioRunner, ATimedSwitchClosureReachesTheChipAtItsTickWhateverTheHostWa
   EXPECT_EQ(runner.judged(), 1u);
 }
 
+TEST(ScenarioRunner, StepsAddedWhileItRunsFireAtTheirTicksAndAreJudgedAtTheEnd) {
+  // As a campaign's rerun forked from a snapshot adds its fault and its oracle.
+  VirtualBoard v("chips=L6470; time=virtual");
+  ScenarioRunner runner(v.board, Scenario{});
+  runner.advance_to(ticks_from_ms(50));
+  ScenarioAction close;
+  close.kind = ScenarioAction::Kind::sw;
+  close.level = false;
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  ScenarioExpectation st;
+  st.kind = ScenarioExpectation::Kind::status;
+  st.flags = {{"SW_F", true}};
+  runner.add_steps({at_time(ticks_from_ms(50), close, "the fault"), expect_at(end, st, "the oracle")});
+  EXPECT_FALSE(v.board.pin_level(0, 0, Pin::SW));  // due now: fired at once
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty());
+  EXPECT_EQ(runner.judged(), 1u);
+}
+
+TEST(ScenarioRunner, OnlyStepsAtATimeOrAtTheEndCanJoinARunningScenarioAndABadOneAddsNothing) {
+  VirtualBoard v("chips=L6470; time=virtual");
+  ScenarioRunner runner(v.board, Scenario{});
+  ScenarioTrigger busy;
+  busy.kind = ScenarioTrigger::Kind::busy_fall;
+  EXPECT_THROW(runner.add_steps({expect_at(busy, reg("ABS_POS", 0))}), std::invalid_argument);
+  ScenarioTrigger end;
+  end.kind = ScenarioTrigger::Kind::end;
+  try {
+    runner.add_steps({expect_at(end, reg("ABS_POS", 0)), expect_at(end, reg("NO_SUCH", 0), "s.yaml:9")});
+    ADD_FAILURE() << "a register the chip lacks was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("s.yaml:9"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(runner.scenario().steps.empty());
+  runner.finish();
+  EXPECT_EQ(runner.judged(), 0u);
+}
+
 TEST(ScenarioRunner, APositionTriggerFiresAtTheExactTickTheRegisterReachesIt) {
   VirtualBoard v("chips=L6470; time=virtual");
   Scenario s;
