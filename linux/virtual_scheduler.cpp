@@ -477,6 +477,11 @@ int VirtualScheduler::waiting() const {
                                         [](Waiter* w) { return !w->done.load(std::memory_order_relaxed); }));
 }
 
+void VirtualScheduler::renew_wake_fd() {
+  t_wake.renew();
+  for (Waiter* w : waiters_) w->fd = t_wake.get();  // (one thread: every waiter is this thread's)
+}
+
 void VirtualScheduler::before_fork() {
   m_.lock();
   t_holds_lock = true;

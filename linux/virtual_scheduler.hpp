@@ -159,6 +159,9 @@ class VirtualScheduler {
 
   /// fork() in a threaded program: hold the lock across it (prepare / parent), and in the child,
   /// which has one thread, forget the parent's waiters and give the thread its own wake-up fd.
+  /// A snapshot's child (the preload's fork server, forked with the lock held by its one
+  /// thread): the calling thread gets a wake-up descriptor of its own, not the parent's.
+  void renew_wake_fd();
   void before_fork();
   void after_fork_parent();
   void after_fork_child();

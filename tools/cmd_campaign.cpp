@@ -1,7 +1,10 @@
 // `l6470emu campaign`: the clean run and every rerun are `l6470emu run` processes of this same
 // program (each in a process group of its own, so that a stuck one is ended whole); their
 // recordings give the injection points, whether the driver read the fault's flag and whether
-// its traffic changed. Reruns start from the beginning (no snapshot yet).
+// its traffic changed. Where the program is single-threaded at a rerun's injection tick, the rerun
+// is a fork of one more clean run taken there (a snapshot: linux/fork_plan.hpp, the preload's
+// fork_server.cpp), judged as `run` would judge it (tools/run_judgement.hpp); the others start
+// from the beginning.
 #include "tools/cmd_campaign.hpp"
 
 #include <fcntl.h>
@@ -23,6 +26,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "board/coverage_file.hpp"
 #include "board/board.hpp"
@@ -31,6 +35,7 @@
 #include "core/near_miss.hpp"
 #include "linux/board_config_file.hpp"
 #include "linux/clock.hpp"
+#include "linux/fork_plan.hpp"
 #include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
 #include "linux/scenario_yaml.hpp"
@@ -40,6 +45,7 @@
 #include "tools/output_check.hpp"
 #include "tools/campaign_report.hpp"
 #include "tools/cmd_report.hpp"
+#include "tools/run_judgement.hpp"
 #include "tools/run_outcome.hpp"
 #include "tools/trace_input.hpp"
 
@@ -236,6 +242,10 @@ CampaignCommand::CampaignCommand(CLI::App& app) {
                    "which reruns get a reproducing scenario file: failing (default: silent_failure, hang, deadlock, crash "
                    "and what --fail-on fails) or all")
       ->check(one_of({"failing", "all"}));
+  cmd_->add_option("--snapshots", snapshots_,
+                   "yes (default): a rerun forks from one more clean run at its injection tick where the program is "
+                   "single-threaded there (docs/campaigns.md, Snapshots); no: every rerun starts from the beginning")
+      ->check(one_of({"yes", "no"}));
   cmd_->add_flag("--list", list_, "run the clean run and print the faults and injection points it gives, without rerunning");
   cmd_->add_option("program", program_, "the program and its arguments (after --)");
   merge_ = cmd_->add_subcommand("merge", "join the JSON reports of a campaign's shards into the report of the whole");
@@ -402,6 +412,7 @@ int CampaignCommand::run_campaign() {
   const char* tmp = std::getenv("TMPDIR");
   std::string work = std::string(tmp && *tmp ? tmp : "/tmp") + "/l6470emu-campaign-XXXXXX";
   if (!mkdtemp(work.data())) return usage("cannot create a directory in " + fs::path(work).parent_path().string());
+  work = fs::absolute(work.c_str()).string();  // (the snapshots' plan names absolute paths)
   struct RemoveWork {
     std::string dir;
     ~RemoveWork() {
@@ -547,7 +558,12 @@ int CampaignCommand::run_campaign() {
   std::atomic<std::size_t> next{0}, done{0};
   const bool tty = isatty(2) != 0;
   std::mutex print;
-  auto one = [&](std::size_t slot) {
+  // Each rerun's directory, scenario and the steps a snapshot adds to the clean run's.
+  struct Prepared {
+    std::string name, yaml, dir, scenario_path, outcome_path, trace;
+    Scenario scenario;
+  };
+  auto prepare = [&](std::size_t slot) {
     const PlannedRerun& p = plan[mine[slot]];
     const ChipRun& chip = chips[p.chip_slot];
     std::int64_t rotor = 0;
@@ -572,15 +588,26 @@ int CampaignCommand::run_campaign() {
                p.point.name + (p.point.after_command.empty() ? "" : ", after " + p.point.after_command) + ")");
     const std::string dir = work + "/" + std::to_string(p.index);
     fs::create_directory(dir);
-    const std::string scenario_path = dir + "/" + name, outcome_path = dir + "/outcome.json", trace = dir + "/run.trace";
-    write_whole_file(scenario_path, yaml);
-    std::vector<std::string> argv{exe, "run"};
-    argv.insert(argv.end(), board_args.begin(), board_args.end());
-    argv.insert(argv.end(), {"--scenario", scenario_path, "--record", trace, "--outcome", outcome_path, "--"});
-    argv.insert(argv.end(), program_.begin(), program_.end());
-    const Ended ended = run_process(argv, dir + "/output.txt", wall_timeout_s_);
-    if (ended.stopped) return;
-    const auto outcome = read_run_outcome(outcome_path);
+    Prepared out{name, yaml, dir, dir + "/" + name, dir + "/outcome.json", dir + "/run.trace", std::move(s)};
+    write_whole_file(out.scenario_path, yaml);
+    // A snapshot's child adds what the user's scenario lacks: the fault and the oracle.
+    Scenario added;
+    added.steps.assign(out.scenario.steps.begin() + static_cast<std::ptrdiff_t>(user.steps.size()), out.scenario.steps.end());
+    write_whole_file(dir + "/" + fork_files::steps, serialize_scenario(added));
+    return out;
+  };
+  std::vector<Prepared> prepared(mine.size());
+  for (std::size_t slot = 0; slot < mine.size(); ++slot) prepared[slot] = prepare(slot);
+
+  // What a rerun came to, from its outcome and recording.
+  auto judge = [&](std::size_t slot, const std::optional<RunOutcome>& outcome, const Ended& ended) {
+    const PlannedRerun& p = plan[mine[slot]];
+    const ChipRun& chip = chips[p.chip_slot];
+    const Prepared& prep = prepared[slot];
+    const std::string& name = prep.name;
+    const std::string& yaml = prep.yaml;
+    const Scenario& s = prep.scenario;
+    const std::string& trace = prep.trace;
     RerunResult r;
     r.index = p.index;
     r.fault = p.fault->name;
@@ -636,6 +663,17 @@ int CampaignCommand::run_campaign() {
       if (write_whole_file(repro_path, yaml)) r.reproducer = repro_path;
     }
     results[slot] = std::move(r);
+  };
+  // A rerun from the beginning: `run` of its scenario.
+  auto one = [&](std::size_t slot) {
+    const Prepared& prep = prepared[slot];
+    std::vector<std::string> argv{exe, "run"};
+    argv.insert(argv.end(), board_args.begin(), board_args.end());
+    argv.insert(argv.end(), {"--scenario", prep.scenario_path, "--record", prep.trace, "--outcome", prep.outcome_path, "--"});
+    argv.insert(argv.end(), program_.begin(), program_.end());
+    const Ended ended = run_process(argv, prep.dir + "/output.txt", wall_timeout_s_);
+    if (ended.stopped) return;
+    judge(slot, read_run_outcome(prep.outcome_path), ended);
     const std::size_t n = ++done;
     if (tty) {
       std::lock_guard lock(print);
@@ -647,10 +685,89 @@ int CampaignCommand::run_campaign() {
   std::cerr << "l6470emu campaign: " << plan.size() << " reruns"
             << (shard_n > 1 ? " (shard " + std::to_string(shard_k) + "/" + std::to_string(shard_n) + ": " + std::to_string(mine.size()) + ")" : "")
             << ", " << jobs << " at a time\n";
+  // Snapshots: one more clean run, whose program forks each rerun at its injection tick (where it
+  // can: single-threaded there). The others, and all of them with --snapshots no, start from the
+  // beginning. Either way a rerun is judged the same (docs/campaigns.md, Snapshots).
+  std::vector<std::size_t> todo;  // the reruns that start from the beginning
+  std::vector<bool> forked(mine.size(), false);
+  if (snapshots_ == "yes" && !mine.empty() && work.find('\n') == std::string::npos) {
+    const std::string server = work + "/snapshots";
+    fs::create_directory(server);
+    ForkPlan fp;
+    fp.children = jobs;
+    fp.wall_ns = static_cast<std::int64_t>(wall_timeout_s_ * 1e9);
+    const std::string server_trace = server + "/run.trace";
+    for (std::size_t c = 0; c < config.chains.size(); ++c) fp.recordings.push_back(trace_of(server_trace, c));
+    std::vector<std::size_t> by_tick(mine.size());
+    for (std::size_t slot = 0; slot < mine.size(); ++slot) by_tick[slot] = slot;
+    std::stable_sort(by_tick.begin(), by_tick.end(),
+                     [&](std::size_t a, std::size_t b) { return plan[mine[a]].point.tick < plan[mine[b]].point.tick; });
+    for (const std::size_t slot : by_tick) fp.jobs.push_back(ForkPlan::Job{plan[mine[slot]].point.tick, prepared[slot].dir});
+    const std::string plan_path = server + "/plan";
+    write_whole_file(plan_path, format_fork_plan(fp));
+    std::vector<std::string> argv{exe, "run"};
+    argv.insert(argv.end(), board_args.begin(), board_args.end());
+    if (!scenario_file_.empty()) argv.insert(argv.end(), {"--scenario", scenario_file_});
+    argv.insert(argv.end(), {"--timeout", scenario_duration_text(rerun_timeout), "--wall-timeout", "3000000000", "--record",
+                             server_trace, "--outcome", server + "/outcome.json", "--"});
+    argv.insert(argv.end(), program_.begin(), program_.end());
+    setenv(kForkPlanEnv, plan_path.c_str(), 1);
+    run_process(argv, server + "/output.txt", 1e8);  // each rerun has its limit; the clean run passed
+    unsetenv(kForkPlanEnv);
+    std::string first_reason;
+    std::vector<std::tuple<std::size_t, std::optional<RunOutcome>, Ended>> ended_reruns;
+    for (std::size_t slot = 0; slot < mine.size(); ++slot) {
+      const std::string& dir = prepared[slot].dir;
+      std::ifstream ended_file(dir + "/" + fork_files::ended);
+      long long pid = 0;
+      int wstatus = 0;
+      if (!(ended_file >> pid >> wstatus)) {
+        if (first_reason.empty()) {
+          std::ifstream why(dir + "/" + fork_files::not_forked);
+          std::getline(why, first_reason);
+        }
+        continue;
+      }
+      ProgramExit pe;
+      pe.pid = static_cast<pid_t>(pid);
+      pe.wstatus = wstatus;
+      std::ifstream report_file(dir + "/" + fork_files::report, std::ios::binary);
+      pe.blocks = parse_run_reports(std::string((std::istreambuf_iterator<char>(report_file)), {}));
+      Ended ended;
+      ended.started = true;
+      ended.wstatus = wstatus;
+      ended.wall_killed = fs::exists(dir + "/" + fork_files::wall_killed);
+      // As a plain rerun stopped at the wall-clock limit: no outcome of its own.
+      const std::optional<RunOutcome> outcome =
+          ended.wall_killed ? std::nullopt : std::optional<RunOutcome>(judge_run(pe, rerun_timeout).outcome());
+      ended_reruns.emplace_back(slot, outcome, ended);
+      forked[slot] = true;
+    }
+    // Their recordings read in parallel, as the reruns from the beginning are.
+    std::atomic<std::size_t> at{0};
+    std::vector<std::thread> readers;
+    for (unsigned w = 0; w < jobs; ++w)
+      readers.emplace_back([&] {
+        for (std::size_t i; (i = at++) < ended_reruns.size();) {
+          const auto& [slot, outcome, ended] = ended_reruns[i];
+          judge(slot, outcome, ended);
+          ++done;
+        }
+      });
+    for (auto& t : readers) t.join();
+    const std::size_t from_snapshots = ended_reruns.size();
+    if (from_snapshots < mine.size() && first_reason.empty())
+      first_reason = "the program never took the snapshots' plan: a firmware program, or one the preload does not reach";
+    std::cerr << "l6470emu campaign: " << from_snapshots << " of " << mine.size() << " reruns forked from snapshots"
+              << (from_snapshots < mine.size() && !first_reason.empty() ? " (not the others: " + first_reason + ")" : "")
+              << "\n";
+  }
+  for (std::size_t slot = 0; slot < mine.size(); ++slot)
+    if (!forked[slot] && !g_stop.load()) todo.push_back(slot);
   std::vector<std::thread> workers;
   for (unsigned w = 0; w < jobs; ++w)
     workers.emplace_back([&] {
-      for (std::size_t slot; !g_stop.load() && (slot = next++) < mine.size();) one(slot);
+      for (std::size_t i; !g_stop.load() && (i = next++) < todo.size();) one(todo[i]);
     });
   for (auto& t : workers) t.join();
   if (tty) std::cerr << "\n";

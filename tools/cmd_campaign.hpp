@@ -25,7 +25,7 @@ class CampaignCommand {
   CLI::App* cmd_ = nullptr;
   CLI::App* merge_ = nullptr;
   std::string board_file_, chain_, scenario_file_, faults_ = "all", points_ = "phases", shard_, json_, junit_, fail_on_,
-      timeout_, reproducers_ = "failing", only_chips_, only_points_, coverage_, html_;
+      timeout_, reproducers_ = "failing", snapshots_ = "yes", only_chips_, only_points_, coverage_, html_;
   double wall_timeout_s_ = 60;
   unsigned jobs_ = 0;
   bool list_ = false;

@@ -188,6 +188,8 @@ void forget_virtual_timerfd(int fd) {
 }
 
 void timerfd_table_before_fork() { g_mutex.lock(); }
+void timerfd_table_after_snapshot() { g_owner_pid.store(getpid(), std::memory_order_release); }
+
 void timerfd_table_after_fork() {
   g_owner_pid.store(getpid(), std::memory_order_release);
   g_mutex.unlock();

@@ -13,6 +13,7 @@
 
 #include "linux/log.hpp"
 #include "linux/preload/coverage.hpp"
+#include "linux/preload/fork_server.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 
@@ -63,6 +64,7 @@ void start_run(DeviceBoard& board) {
       refuse(std::string("l6470emu: scenario ") + e.what());
     }
   }
+  start_fork_server(board);  // `l6470emu campaign`'s snapshots (its wait for the reruns runs after at_exit)
   std::atexit(at_exit);
 }
 
@@ -120,6 +122,14 @@ void end_run(RunEnd cause, std::string_view detail) {
 void run_after_fork_child() {
   g_reported.store(false);
   g_devices.store(false);
+  fork_server_after_fork_child();
+}
+
+bool run_devices_used() { return g_devices.load(std::memory_order_relaxed); }
+
+void run_continue_as_rerun(const std::string& report_path) {
+  g_report_path = new std::string(report_path);  // (the parent's stays: never freed)
+  g_reported.store(false);
 }
 
 void leave_run() {

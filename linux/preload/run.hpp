@@ -3,6 +3,8 @@
 // once per process. Inactive (every call a no-op) outside a run.
 #pragma once
 
+#include <string>
+
 #include <string_view>
 
 #include "core/tick.hpp"
@@ -37,6 +39,11 @@ void run_device_opened();
 void end_run(RunEnd cause, std::string_view detail);
 /// fork(): the child reports for itself (it has opened nothing yet).
 void run_after_fork_child();
+/// Whether this process exchanged SPI bytes with the board.
+bool run_devices_used();
+/// A campaign's snapshot child (linux/preload/fork_server.hpp): from now on this process is a
+/// rerun whose report goes to `report_path`.
+void run_continue_as_rerun(const std::string& report_path);
 /// The program has a board of its own that takes part in the run and reports for the process
 /// (a firmware program, firmware/run.hpp): the preload's board leaves the run (no report, no time
 /// limit of its own). Reached from the program through l6470emu_preload_leave_run().

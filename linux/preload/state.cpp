@@ -1,4 +1,5 @@
 // Preload state: configuration at load time, lazy backend, descriptor table, guard.
+#include "linux/preload/fork_server.hpp"
 #include "linux/preload/state.hpp"
 
 #include <pthread.h>
@@ -44,14 +45,19 @@ const std::vector<DeviceNode> kNoNodes;
 // until it execs (fork() handlers do not run for it), and must leave the table alone.
 std::atomic<pid_t> g_pid{0};
 
+// A snapshot's fork (fork_server.cpp) holds the scheduler's lock already, in a process of one
+// thread, and its child keeps the board as it is: the backend's handlers are not for it.
 void atfork_prepare() {
+  if (snapshot_forking()) return;
   if (Backend* b = g_backend.load()) b->before_fork();
 }
 void atfork_parent() {
+  if (snapshot_forking()) return;
   if (Backend* b = g_backend.load()) b->after_fork_parent();
 }
 void atfork_child() {
   g_pid.store(getpid(), std::memory_order_release);
+  if (snapshot_forking()) return;
   if (Backend* b = g_backend.load()) b->after_fork_child();
 }
 

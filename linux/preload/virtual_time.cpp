@@ -1,5 +1,6 @@
 // Virtual host time in the preload library: clock conversions, covered waits, the busy-wait
 // rule, the board's bus-time waiter, fork hooks.
+#include "linux/preload/fork_server.hpp"
 #include "linux/preload/virtual_time.hpp"
 #include "linux/preload/coverage.hpp"
 #include "linux/preload/run.hpp"
@@ -143,10 +144,11 @@ VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   h.now = [&board] { return board.time().now(); };
   h.advance_to = [&board](Tick t) {
     board.advance_to(t);
+    fork_server_reached(t);  // `campaign`'s snapshots: the reruns injected at t fork here
     run_time_reached(t);  // `run --timeout`: the run ends at its simulated time limit
   };
   h.next_edge = [&board] { return board.next_edge_tick(); };
-  h.next_world = [] { return run_next_tick(); };
+  h.next_world = [] { return std::min(run_next_tick(), fork_server_next_tick()); };
   h.fire_timer = [](int fd) { fire_virtual_timerfd(fd); };
   h.real_ns = [] { return real_clock_ns(CLOCK_MONOTONIC); };
   h.log = [](std::string_view line) { log_line(line); };
@@ -359,6 +361,11 @@ void VirtualHostTime::after_fork_child() {
   timerfd_table_after_fork();
   thread_table_after_fork();
   scheduler_.after_fork_child();
+}
+
+void VirtualHostTime::after_snapshot_fork_child() {
+  scheduler_.renew_wake_fd();
+  timerfd_table_after_snapshot();
 }
 
 void install_virtual_time(VirtualHostTime* vt) {

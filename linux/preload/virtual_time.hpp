@@ -89,6 +89,9 @@ class VirtualHostTime {
   void before_fork();
   void after_fork_parent();
   void after_fork_child();
+  /// A campaign's snapshot child (fork_server.cpp): the one thread goes on as it was, with a
+  /// wake-up descriptor of its own; its timer table is its own.
+  void after_snapshot_fork_child();
 
  private:
   class BusWaiter final : public BoardTime::Waiter {
@@ -172,6 +175,8 @@ bool read_virtual_timerfd(int fd, void* buf, std::size_t count, ssize_t* result)
 void forget_virtual_timerfd(int fd);
 void timerfd_table_before_fork();
 void timerfd_table_after_fork();
+/// intercept_timerfd.cpp: a snapshot's child owns the table (its lock was not taken for the fork).
+void timerfd_table_after_snapshot();
 /// intercept_poll.cpp: whether descriptor `fd` is an emulated gpio line with edge events.
 bool is_emulated_line(int fd);
 

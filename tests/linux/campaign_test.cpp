@@ -239,6 +239,80 @@ TEST_F(Campaign, BadInputIsOneLineAndStatusTwoAndNothingRuns) {
   }
 }
 
+TEST_F(Campaign, SnapshotsWriteTheSameJsonAsRerunsFromTheBeginningAndSayHowManyWereForked) {
+  // A Python driver (python3-spidev): "one" is single-threaded, "threads" has a second thread at
+  // every injection tick (no rerun can be forked), "fifo" blocks on a FIFO nobody opens when it
+  // sees a fault (the wall-clock limit ends it: hang).
+  std::ofstream(path("driver.py")) << R"(import os, sys, threading, time, spidev
+mode = sys.argv[1]
+if mode == "threads":
+    threading.Thread(target=threading.Event().wait, daemon=True).start()
+s = spidev.SpiDev(); s.open(0, 0); s.mode = 3
+x = lambda *bs: [s.xfer2([b])[0] for b in bs]
+def status():
+    r = x(0xD0, 0, 0)
+    return (r[1] << 8) | r[2]
+x(0x05, 0x00, 0x40); x(0x06, 0x00, 0x40); x(0x07, 0x00, 0x30)
+status()
+x(0x41, 0x00, 0x0F, 0xA0)
+while True:
+    st = status()
+    if not st & 0x1000 or not st & 0x0200:
+        if mode == "fifo":
+            fifo = "%s/fifo.%d" % (sys.argv[2], os.getpid())
+            os.mkfifo(fifo)
+            open(fifo).read()
+        sys.exit(1)
+    if st & 0x0002:
+        break
+    time.sleep(0.005)
+x(0x60, 0x00, 0x03, 0xE8)
+while not status() & 0x0002:
+    time.sleep(0.005)
+)";
+  struct Case {
+    std::vector<std::string> args, program;
+    std::size_t forked_of_all;  // 1: every rerun forked; 0: none
+  };
+  const std::string c = client("campaign_driver"), py = path("driver.py");
+  const std::vector<Case> cases{
+      {{"--faults", "ocd,uvlo,reset,lost_frame,miso_flip"}, {c, "careful"}, 1},
+      {{"--faults", "ocd"}, {c, "stuck"}, 1},
+      {{"--faults", "ocd"}, {c, "crash"}, 1},
+      {{"--faults", "ocd"}, {c, "deadlock"}, 1},
+      {{"--faults", "ocd,reset"}, {system_python(), py, "one"}, 1},
+      {{"--faults", "ocd"}, {system_python(), py, "threads"}, 0},
+      {{"--faults", "ocd", "--at", "during_motion", "--wall-timeout", "1"}, {system_python(), py, "fifo", dir_.string()}, 1},
+  };
+  for (const Case& k : cases) {
+    std::string json[2];
+    int status[2] = {0, 0};
+    for (const int snapshots : {1, 0}) {
+      fs::create_directories(path(snapshots ? "yes" : "no"));
+      std::vector<std::string> argv{l6470emu_program(), "campaign", "--chain", "chips=L6470 check=warn", "--snapshots",
+                                    snapshots ? "yes" : "no", "--json", path(snapshots ? "yes/c.json" : "no/c.json")};
+      argv.insert(argv.end(), k.args.begin(), k.args.end());
+      argv.push_back("--");
+      argv.insert(argv.end(), k.program.begin(), k.program.end());
+      const RunResult r = run_program(argv, {}, 120);
+      status[snapshots] = r.status;
+      json[snapshots] = read(path(snapshots ? "yes/c.json" : "no/c.json"));
+      for (std::size_t at; (at = json[snapshots].find(snapshots ? "/yes/" : "/no/")) != std::string::npos;)
+        json[snapshots].replace(at, snapshots ? 5 : 4, "/X/");
+      if (snapshots) {
+        const std::size_t total = Json::parse(read(path("yes/c.json")))["total"];
+        ASSERT_GT(total, 0u);
+        const std::string said = std::to_string(k.forked_of_all * total) + " of " + std::to_string(total) + " reruns forked from snapshots";
+        EXPECT_NE(r.err.find(said), std::string::npos) << k.program.back() << ": " << r.err;
+      }
+    }
+    EXPECT_EQ(status[1], status[0]) << k.program.back();
+    EXPECT_EQ(json[1], json[0]) << k.program.back();
+  }
+  // The verdicts a snapshot's child can come to, as the plain reruns came to them.
+  EXPECT_EQ(rerun(Json::parse(read(path("yes/c.json"))), "ocd", "during_motion")["verdict"], "hang");
+}
+
 TEST_F(Campaign, StoppedBySigtermItWritesTheReportsMarkedIncomplete) {
   // The reruns block where virtual time cannot see (a FIFO nobody opens); the clean run does not.
   const std::string script = path("driver.sh");
