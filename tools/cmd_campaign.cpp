@@ -589,7 +589,6 @@ int CampaignCommand::run_campaign() {
     const std::string dir = work + "/" + std::to_string(p.index);
     fs::create_directory(dir);
     Prepared out{name, yaml, dir, dir + "/" + name, dir + "/outcome.json", dir + "/run.trace", std::move(s)};
-    write_whole_file(out.scenario_path, yaml);
     // A snapshot's child adds what the user's scenario lacks: the fault and the oracle.
     Scenario added;
     added.steps.assign(out.scenario.steps.begin() + static_cast<std::ptrdiff_t>(user.steps.size()), out.scenario.steps.end());
@@ -667,6 +666,7 @@ int CampaignCommand::run_campaign() {
   // A rerun from the beginning: `run` of its scenario.
   auto one = [&](std::size_t slot) {
     const Prepared& prep = prepared[slot];
+    write_whole_file(prep.scenario_path, prep.yaml);
     std::vector<std::string> argv{exe, "run"};
     argv.insert(argv.end(), board_args.begin(), board_args.end());
     argv.insert(argv.end(), {"--scenario", prep.scenario_path, "--record", prep.trace, "--outcome", prep.outcome_path, "--"});

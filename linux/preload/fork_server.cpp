@@ -8,6 +8,7 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
@@ -36,6 +37,7 @@ namespace {
 
 struct Child {
   pid_t pid = 0;
+  int pidfd = -1;  // readable once it ended (-1: poll every millisecond instead)
   std::string dir;
   std::int64_t started_ns = 0;
 };
@@ -143,11 +145,21 @@ void reap(std::size_t keep) {
         kill(-c.pid, SIGKILL);  // whatever the rerun left behind in its group
         write_file(c.dir + "/" + fork_files::ended, std::to_string(c.pid) + " " + std::to_string(ws) + "\n");
       }
+      if (c.pidfd >= 0) real::close(c.pidfd);
       s.children.erase(s.children.begin() + static_cast<std::ptrdiff_t>(i));
     }
     if (s.children.size() <= keep) return;
-    const timespec pause{0, 1'000'000};
-    syscall(SYS_nanosleep, &pause, nullptr);
+    // Until one ends (its pidfd becomes readable) or the first wall-clock limit comes.
+    std::vector<pollfd> ended;
+    std::int64_t wait_ns = 100'000'000;
+    for (const Child& c : s.children) {
+      if (c.pidfd < 0) wait_ns = std::min<std::int64_t>(wait_ns, 1'000'000);
+      else ended.push_back(pollfd{c.pidfd, POLLIN, 0});
+      if (s.plan.wall_ns > 0)
+        wait_ns = std::min(wait_ns, std::max<std::int64_t>(0, c.started_ns + s.plan.wall_ns - monotonic_ns()) + 1'000'000);
+    }
+    const timespec ts{static_cast<time_t>(wait_ns / 1'000'000'000), static_cast<long>(wait_ns % 1'000'000'000)};
+    syscall(SYS_ppoll, ended.data(), ended.size(), &ts, nullptr, 0);
   }
 }
 
@@ -290,6 +302,8 @@ void fork_server_reached(Tick now) {
     if (pid == 0) {
       const ForkPlan plan = s.plan;
       DeviceBoard& board = *s.board;
+      for (const Child& c : s.children)  // (its siblings are not its to wait for)
+        if (c.pidfd >= 0) real::close(c.pidfd);
       g_server = nullptr;  // (the parent's; never freed)
       real::close(ready[0]);
       if (VirtualHostTime* vt = installed_virtual_time()) vt->after_snapshot_fork_child();
@@ -305,7 +319,7 @@ void fork_server_reached(Tick now) {
       write_file(job.dir + "/" + fork_files::not_forked, std::string("fork failed: ") + std::strerror(errno) + "\n");
       continue;
     }
-    s.children.push_back(Child{pid, job.dir, monotonic_ns()});
+    s.children.push_back(Child{pid, static_cast<int>(syscall(SYS_pidfd_open, pid, 0)), job.dir, monotonic_ns()});
   }
 }
 

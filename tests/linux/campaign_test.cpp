@@ -282,7 +282,7 @@ while not status() & 0x0002:
       {{"--faults", "ocd"}, {c, "deadlock"}, 1},
       {{"--faults", "ocd,reset"}, {system_python(), py, "one"}, 1},
       {{"--faults", "ocd"}, {system_python(), py, "threads"}, 0},
-      {{"--faults", "ocd", "--at", "during_motion", "--wall-timeout", "1"}, {system_python(), py, "fifo", dir_.string()}, 1},
+      {{"--faults", "ocd", "--at", "during_motion", "--wall-timeout", "2"}, {system_python(), py, "fifo", dir_.string()}, 1},
   };
   for (const Case& k : cases) {
     std::string json[2];
