@@ -13,6 +13,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "raw_client.hpp"
 #include "run_program.hpp"
@@ -116,6 +117,67 @@ TEST_P(DaemonSoak, SurvivorsStayExactAndTheRecordingReplaysClean) {
   EXPECT_EQ(replay.status, 0) << replay.out << replay.err;
   EXPECT_NE(replay.out.find(": matched"), std::string::npos) << replay.out;
   unlink(trace.c_str());
+}
+
+// The campaign's faults raised through ctl, again and again, with interface coverage collected,
+// while hostile clients come and go: the daemon serves on, reaps every client, writes a coverage
+// file that reads back with the faults it raised, and its recording (every fault in it) replays.
+TEST(DaemonSoakWithFaults, EveryCampaignFaultRaisedUnderHostileClientsLeavesADaemonServingACoverageFileAndARecording) {
+  const std::string why = missing_prerequisites();
+  if (!why.empty()) GTEST_SKIP() << why;
+  const std::string base = temp_socket_path("faultsoak");
+  const std::string trace = base + ".trace", coverage = base + ".coverage.json";
+  ServeDaemon d("bus=0 cs=0 chips=L6470", {"--record", trace, "--coverage", coverage, "--log", "off"});
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  std::vector<std::unique_ptr<Background>> readers, garbage;
+  for (int i = 0; i < 20; ++i)  // their answers are not exact here: the faults change them
+    readers.push_back(std::make_unique<Background>(
+        std::vector<std::string>{client("spidev_reader"), "/dev/spidev0.0", "400", "0x19", "0"}, d.env()));
+  for (int i = 0; i < 2; ++i)
+    garbage.push_back(std::make_unique<Background>(
+        std::vector<std::string>{system_python(), script("garbage_client.py"), d.socket(), std::to_string(i), "4"}));
+  const std::vector<std::vector<std::string>> faults{
+      {"fault", "ocd", "on", "--chip", "0"},           {"fault", "ocd", "off", "--chip", "0"},
+      {"fault", "thermal", "warning", "--chip", "0"},  {"fault", "thermal", "device-shutdown", "--chip", "0"},
+      {"fault", "thermal", "normal", "--chip", "0"},   {"fault", "uvlo", "on", "--chip", "0"},
+      {"fault", "uvlo", "off", "--chip", "0"},         {"fault", "stall-a", "on", "--chip", "0"},
+      {"fault", "stall-a", "off", "--chip", "0"},      {"fault", "stall-b", "on", "--chip", "0"},
+      {"fault", "stall-b", "off", "--chip", "0"},      {"fault", "reset", "--chip", "0"},
+      {"fault", "lost-frame", "--chip", "0"},          {"fault", "miso-flip", "5", "--chip", "0"},
+      {"sw", "closed", "--chip", "0"},                 {"sw", "open", "--chip", "0"},
+  };
+  for (int round = 0; round < 3; ++round) {
+    for (const auto& f : faults) {
+      const RunResult r = d.ctl(f);
+      EXPECT_EQ(r.status, 0) << f[1] << ": " << r.out << r.err;
+    }
+    if (round == 1)
+      for (int i = 0; i < 5; ++i) readers[static_cast<std::size_t>(i * 4)]->stop(SIGKILL);
+    EXPECT_EQ(dead_clients_with_unread_packets(d.socket(), 4), 4);
+  }
+  for (int i = 0; i < 20; ++i) {
+    if (i % 4 == 0) continue;
+    const RunResult r = readers[static_cast<std::size_t>(i)]->wait(120);
+    EXPECT_EQ(r.out.rfind("reads=400 ", 0), 0u) << "client " << i << ": " << r.out << r.err;
+  }
+  for (auto& g : garbage) EXPECT_EQ(g->wait(30).status, 0);
+  const std::string clients = wait_until_only_ctl(d);
+  EXPECT_EQ(clients.rfind("1 client\n", 0), 0u) << clients;
+  const RunResult status = d.ctl({"status", "--chip", "0"});
+  EXPECT_EQ(status.status, 0) << status.err;
+  const RunResult stopped = d.process().stop(SIGTERM, 30);
+  EXPECT_EQ(stopped.status, 0) << stopped.err;
+  unlink(d.socket().c_str());
+  const RunResult report = run_program({l6470emu_program(), "coverage", "report", "--format", "json", coverage}, {}, 60);
+  ASSERT_EQ(report.status, 0) << report.out << report.err;
+  const auto raised = nlohmann::json::parse(report.out)["variants"]["L6470"]["categories"]["flags raised"]["hit points"];
+  for (const char* flag : {"OCD", "TH_SD", "UVLO", "STEP_LOSS_A", "STEP_LOSS_B"})
+    EXPECT_NE(std::find(raised.begin(), raised.end(), flag), raised.end()) << flag << " was not raised: " << raised;
+  const RunResult replay = run_program({l6470emu_program(), "replay", trace}, {}, 120);
+  EXPECT_EQ(replay.status, 0) << replay.out << replay.err;
+  EXPECT_NE(replay.out.find(": matched"), std::string::npos) << replay.out;
+  unlink(trace.c_str());
+  unlink(coverage.c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(StoppedBySigtermAndBySigkill, DaemonSoak, ::testing::Values(SIGTERM, SIGKILL),
