@@ -327,6 +327,8 @@ void fork_server_after_fork_child() {
   if (!g_snapshot_forking.load()) g_server = nullptr;
 }
 
+void fork_server_leave() { g_server = nullptr; }
+
 bool snapshot_forking() { return g_snapshot_forking.load(); }
 
 }  // namespace l6470emu::preload

@@ -21,6 +21,9 @@ Tick fork_server_next_tick();
 void fork_server_reached(Tick now);
 /// A fork() of the program's own: the child is no server.
 void fork_server_after_fork_child();
+/// The program runs on a board of its own (a firmware program): no snapshot is taken here, and
+/// no rerun's directory is written.
+void fork_server_leave();
 /// Whether the fork in progress is a snapshot's (the fork handlers leave the scheduler's lock,
 /// which the snapshot holds, and the board's recordings alone).
 bool snapshot_forking();

@@ -135,6 +135,7 @@ void run_continue_as_rerun(const std::string& report_path) {
 void leave_run() {
   Guard guard;
   g_board = nullptr;  // no report at exit, no time limit: the program's own board has them
+  fork_server_leave();  // nor a campaign's snapshots (they are the preload board's)
 }
 
 }  // namespace l6470emu::preload
