@@ -79,6 +79,8 @@ L6470EMU_REAL(int, timespec_get, (struct timespec*, int))
 L6470EMU_REAL(int, nanosleep, (const struct timespec*, struct timespec*))
 L6470EMU_REAL(int, clock_nanosleep, (clockid_t, int, const struct timespec*, struct timespec*))
 L6470EMU_REAL(int, usleep, (useconds_t))
+L6470EMU_REAL(int, pause, ())
+L6470EMU_REAL(int, sigsuspend, (const sigset_t*))
 L6470EMU_REAL(unsigned, sleep, (unsigned))
 L6470EMU_REAL(int, select, (int, fd_set*, fd_set*, fd_set*, struct timeval*))
 L6470EMU_REAL(int, pselect, (int, fd_set*, fd_set*, fd_set*, const struct timespec*, const sigset_t*))
@@ -179,6 +181,8 @@ int clock_nanosleep(clockid_t clock, int flags, const struct timespec* req, stru
   return get_clock_nanosleep()(clock, flags, req, rem);
 }
 int usleep(useconds_t us) { return get_usleep()(us); }
+int pause() { return get_pause()(); }
+int sigsuspend(const sigset_t* mask) { return get_sigsuspend()(mask); }
 unsigned sleep(unsigned seconds) { return get_sleep()(seconds); }
 int select(int n, fd_set* r, fd_set* w, fd_set* e, struct timeval* timeout) { return get_select()(n, r, w, e, timeout); }
 int pselect(int n, fd_set* r, fd_set* w, fd_set* e, const struct timespec* timeout, const sigset_t* mask) {

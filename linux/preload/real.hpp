@@ -55,6 +55,8 @@ int timespec_get(struct timespec* ts, int base);
 int nanosleep(const struct timespec* req, struct timespec* rem);
 int clock_nanosleep(clockid_t clock, int flags, const struct timespec* req, struct timespec* rem);
 int usleep(useconds_t us);
+int pause();
+int sigsuspend(const sigset_t* mask);
 unsigned sleep(unsigned seconds);
 int select(int n, fd_set* r, fd_set* w, fd_set* e, struct timeval* timeout);
 int pselect(int n, fd_set* r, fd_set* w, fd_set* e, const struct timespec* timeout, const sigset_t* mask);

@@ -223,18 +223,34 @@ TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
 }
 
 TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClockGuard) {
-  // pause() waits for a signal: nothing in the board or the program can end it, and virtual time
-  // does not see it. The guard ends it, with the simulated time limit's status and its own words.
-  for (const std::vector<std::string>& time : {std::vector<std::string>{}, {"--time", "wall"}}) {
-    std::vector<std::string> args = time;
-    for (const char* a : {"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"}) args.push_back(a);
-    const RunResult r = run(args, python("import signal\nsignal.pause()\n"));
+  // In wall time pause() waits for a signal where nothing can see it: the guard ends it, with the
+  // simulated time limit's status and its own words. (A read on its own pipe the same way.)
+  for (const std::string& program : {std::string("import signal\nsignal.pause()\n"),
+                                     std::string("import os\nr, w = os.pipe()\nos.read(r, 1)\n")}) {
+    const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
+                            python(program));
     EXPECT_EQ(r.status, kRunTimedOut) << r.err;
     EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s of the host's time (--wall-timeout)"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.err.find("of virtual time"), std::string::npos) << r.err;  // when, in board time, nobody knows
   }
+}
+
+TEST_F(RunCommand, InVirtualTimeAPauseOrSigsuspendNoTimerCanEndIsADeadlockNamingTheCall) {
+  for (const auto& [program, call] : std::vector<std::pair<std::string, std::string>>{
+           {"import signal\nsignal.pause()\n", "pause()"},
+           {"import ctypes\nctypes.CDLL(None).sigsuspend(ctypes.create_string_buffer(128))\n", "sigsuspend()"}}) {
+    const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"}, python(program));
+    EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+    EXPECT_NE(r.err.find(call), std::string::npos) << r.err;
+  }
+  // A timer armed to send a signal is a wake-up: the handler runs and pause() returns.
+  const RunResult woke = run({"--chain", "chips=L6470", "--wall-timeout", "30"},
+                             python("import signal\nsignal.signal(signal.SIGALRM, lambda *a: None)\n"
+                                    "signal.setitimer(signal.ITIMER_REAL, 0.05)\nsignal.pause()\nprint('woke')\n"));
+  EXPECT_EQ(woke.status, kRunPassed) << woke.err;
+  EXPECT_EQ(woke.out, "woke\n") << woke.err;
 }
 
 TEST_F(RunCommand, TheWallClockGuardIsADurationAndLeavesAProgramThatEndsInTimeAlone) {
