@@ -1,5 +1,6 @@
 // Virtual host time in the preload library: clock conversions, covered waits, the busy-wait
 // rule, the board's bus-time waiter, fork hooks.
+#include "linux/preload/fd_holders.hpp"
 #include "linux/preload/fork_server.hpp"
 #include "linux/preload/virtual_time.hpp"
 #include "linux/preload/coverage.hpp"
@@ -92,7 +93,7 @@ bool epoll_members(int fd, std::vector<int>& members) {
 // Whether descriptor `fd` becomes ready only through this process: an emulated gpio line, a
 // virtual timerfd, or an epoll set of such descriptors.
 bool inside_fd(int fd, int depth = 0) {
-  if (is_emulated_line(fd) || is_virtual_timerfd(fd)) return true;
+  if (is_emulated_line(fd) || is_virtual_timerfd(fd) || pipe_held_by_this_process_alone(fd)) return true;
   std::vector<int> members;
   if (depth > 3 || !epoll_members(fd, members)) return false;
   for (const int m : members)
@@ -171,6 +172,7 @@ std::string VirtualHostTime::describe_fd(int fd) const {
     if (e->kind == HandleKind::line_request_v2) return n + " (a line request on " + node + ")";
     return n + " (" + node + ")";
   }
+  if (pipe_held_by_this_process_alone(fd)) return n + " (a pipe no other process holds)";
   bool armed = false;
   if (is_virtual_timerfd(fd, &armed)) return n + (armed ? " (a timerfd)" : " (a timerfd that is not armed)");
   std::vector<int> members;

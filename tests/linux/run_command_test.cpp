@@ -120,11 +120,11 @@ TEST_F(RunCommand, AReportThatCannotBeWrittenOrWouldOverwriteAnInputEndsTheRunBe
 }
 
 TEST_F(RunCommand, StoppedBySigtermItPassesTheSignalOnAndWritesTheJUnitReportWithTheProgramStopped) {
-  // signal.pause() blocks where virtual time cannot see: only a signal ends it.
+  // A read of its own pipe blocks where virtual time cannot see: only a signal ends it.
   const std::string marker = path("paused");
   Background b({l6470emu_program(), "run", "--chain", "chips=L6470", "--junit", path("r.xml"), "--", system_python(), "-c",
                 "import signal, spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n[s.xfer2([b]) for b in (0xD0, 0, 0)]\n"
-                "open('" + marker + "', 'w').close()\nsignal.pause()\n"});
+                "open('" + marker + "', 'w').close()\nimport os\nr, w = os.pipe()\nos.read(r, 1)\n"});
   for (int i = 0; i < 1000 && !fs::exists(marker); ++i) usleep(10'000);
   ASSERT_TRUE(fs::exists(marker)) << "the program never reached its pause";
   const RunResult r = b.stop(SIGTERM, 30);
@@ -237,10 +237,13 @@ TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClo
   }
 }
 
-TEST_F(RunCommand, InVirtualTimeAPauseOrSigsuspendNoTimerCanEndIsADeadlockNamingTheCall) {
+TEST_F(RunCommand, InVirtualTimeAPauseOrAPollOfItsOwnPipeNothingCanEndIsADeadlockNamingTheCall) {
   for (const auto& [program, call] : std::vector<std::pair<std::string, std::string>>{
            {"import signal\nsignal.pause()\n", "pause()"},
-           {"import ctypes\nctypes.CDLL(None).sigsuspend(ctypes.create_string_buffer(128))\n", "sigsuspend()"}}) {
+           {"import ctypes\nctypes.CDLL(None).sigsuspend(ctypes.create_string_buffer(128))\n", "sigsuspend()"},
+           // A poll on its own pipe: no other process holds it, and no thread is left to write it.
+           {"import os, select\nr, w = os.pipe()\np = select.poll()\np.register(r, select.POLLIN)\np.poll()\n",
+            "(a pipe no other process holds)"}}) {
     const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"}, python(program));
     EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
     EXPECT_NE(r.err.find(call), std::string::npos) << r.err;

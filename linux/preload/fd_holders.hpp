@@ -1,0 +1,13 @@
+// Whether another process could still make a descriptor readable: the deadlock rule asks it of
+// every descriptor a waiter polls that the board does not own (docs/linux.md, Deadlocks).
+#pragma once
+
+namespace l6470emu::preload {
+
+/// Whether `fd` is a pipe that no other process holds an end of, in a process with no child
+/// (whose end would be a SIGCHLD, and its handler may write the pipe). Read from /proc, which
+/// takes a scan of every process: for a deadlock check, never on a hot path. Then nothing outside
+/// this process can make it readable.
+bool pipe_held_by_this_process_alone(int fd);
+
+}  // namespace l6470emu::preload
