@@ -19,6 +19,16 @@ namespace l6470emu {
 inline constexpr const char* kRunReportEnv = "L6470EMU_RUN_REPORT";      ///< file the blocks are appended to
 inline constexpr const char* kRunScenarioEnv = "L6470EMU_SCENARIO";      ///< the scenario in exchange form (a file)
 inline constexpr const char* kRunTimeoutEnv = "L6470EMU_TIMEOUT_TICKS";  ///< simulated time limit, 250 ns ticks
+/// A file of kRunProgressBytes the program maps and keeps RunProgress in, for run's progress line.
+inline constexpr const char* kRunProgressEnv = "L6470EMU_RUN_PROGRESS";
+
+/// How far a program has come, as its front keeps it in the kRunProgressEnv file (two
+/// little-endian 64-bit words, each stored whole).
+struct RunProgress {
+  std::uint64_t tick = 0;      ///< the board's time
+  std::uint64_t messages = 0;  ///< SPI messages exchanged with the board
+};
+inline constexpr std::size_t kRunProgressBytes = 16;
 
 /// The exit status of a program whose run reached its simulated time limit (the report says so;
 /// like kDeadlockExitStatus, only a fallback when no report could be written).

@@ -29,6 +29,7 @@
 #include "linux/clock.hpp"
 #include "linux/device_board.hpp"
 #include "tools/run_judgement.hpp"
+#include "tools/run_progress.hpp"
 #include "tools/run_outcome.hpp"
 #include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
@@ -143,6 +144,7 @@ struct ProgramEnd {
   std::chrono::nanoseconds wall_guard_limit{};  // --wall-timeout: how long run waits, whatever the program does
   bool wall_guard = false;    // killed by that guard
   int stopped_by = 0;         // the signal run was stopped by and passed on to the program (0: none)
+  RunProgressLine* progress = nullptr;  // the line drawn while it waits (a terminal only)
   std::vector<RunReport> blocks;
 };
 
@@ -153,7 +155,8 @@ std::vector<std::string> program_environment(bool keep_ld_preload) {
     const std::string_view v(*e);
     bool drop = !keep_ld_preload && v.starts_with("LD_PRELOAD=");
     for (const char* name : {"L6470EMU_CONFIG=", "L6470EMU_SOCKET=", "L6470EMU_TRACE=", "L6470EMU_CHAIN=",
-                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS=", "L6470EMU_COVERAGE="})
+                             "L6470EMU_SCENARIO=", "L6470EMU_RUN_REPORT=", "L6470EMU_TIMEOUT_TICKS=", "L6470EMU_COVERAGE=",
+                             "L6470EMU_RUN_PROGRESS="})
       drop = drop || v.starts_with(name);
     if (!drop) env.emplace_back(v);
   }
@@ -213,6 +216,7 @@ void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardC
       kill(run.pid, SIGKILL);
       signalled = false;
     }
+    if (run.progress) run.progress->update();
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
 }
@@ -243,6 +247,9 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   env.push_back(std::string(kRunReportEnv) + "=" + report_path);
   if (!config.coverage.empty()) env.push_back(std::string(kCoverageEnv) + "=" + config.coverage);
   if (timeout && config.time.virtual_time) env.push_back(std::string(kRunTimeoutEnv) + "=" + std::to_string(*timeout));
+  const std::unique_ptr<RunProgressLine> progress = RunProgressLine::on_terminal();
+  if (progress) env.push_back(progress->environment_entry());
+  run.progress = progress.get();
   // SIGINT and SIGTERM interrupt the wait (no SA_RESTART) and are passed on to the program.
   struct sigaction stop {}, old_int {}, old_term {};
   stop.sa_handler = on_run_stop_signal;
@@ -252,6 +259,7 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   const bool started = spawn_program(program, std::move(env), nullptr, run.pid);
   if (started) {
     wait_for_program(run, timeout, config);
+    run.progress = nullptr;
     run.blocks = parse_run_reports(read_all(report_path));
   }
   sigaction(SIGINT, &old_int, nullptr);

@@ -6,6 +6,7 @@
 #include "linux/preload/backend.hpp"
 #include "linux/preload/check_exit.hpp"
 #include "linux/preload/coverage.hpp"
+#include "linux/preload/progress.hpp"
 #include "linux/preload/run.hpp"
 #include "linux/preload/virtual_time.hpp"
 
@@ -17,6 +18,7 @@ class LocalBackend final : public Backend {
   explicit LocalBackend(const BoardConfig& config) : log_(config.log), board_(config, log_), trace_(config.trace) {
     start_run(board_);  // `l6470emu run`: the scenario, the time limit, the report at exit
     start_coverage(board_);  // L6470EMU_COVERAGE: merged into its file at exit
+    start_progress();        // `run`'s progress line
     if (config.time.virtual_time) {
       // Made when the program starts (its clock is the board's from then on): the trace starts
       // with the first open of a device, so that a child that never opens one (a shell, a
@@ -42,17 +44,23 @@ class LocalBackend final : public Backend {
                    std::span<std::uint8_t> rx) override {
     run_device_opened();
     std::string report;
-    return checked(board_.spi_message(handle, xfers, tx, rx, &report), report);
+    const long r = checked(board_.spi_message(handle, xfers, tx, rx, &report), report);
+    if (progress_kept()) progress_message(board_.time().now());
+    return r;
   }
   long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) override {
     run_device_opened();
     std::string report;
-    return checked(board_.spi_read(handle, rx, &report), report);
+    const long r = checked(board_.spi_read(handle, rx, &report), report);
+    if (progress_kept()) progress_message(board_.time().now());
+    return r;
   }
   long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) override {
     run_device_opened();
     std::string report;
-    return checked(board_.spi_write(handle, tx, &report), report);
+    const long r = checked(board_.spi_write(handle, tx, &report), report);
+    if (progress_kept()) progress_message(board_.time().now());
+    return r;
   }
   // The scheduler's lock before the board's: the scheduler moves the board while holding it.
   void before_fork() override {

@@ -2,6 +2,7 @@
 // rule, the board's bus-time waiter, fork hooks.
 #include "linux/preload/fd_holders.hpp"
 #include "linux/preload/fork_server.hpp"
+#include "linux/preload/progress.hpp"
 #include "linux/preload/virtual_time.hpp"
 #include "linux/preload/coverage.hpp"
 #include "linux/preload/run.hpp"
@@ -145,6 +146,7 @@ VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   h.now = [&board] { return board.time().now(); };
   h.advance_to = [&board](Tick t) {
     board.advance_to(t);
+    progress_time(t);
     fork_server_reached(t);  // `campaign`'s snapshots: the reruns injected at t fork here
     run_time_reached(t);  // `run --timeout`: the run ends at its simulated time limit
   };
