@@ -89,7 +89,7 @@ steps:
     expect: {sanitizer: clean}
 )");
   ASSERT_EQ(original.steps.size(), 28u);
-  EXPECT_EQ(original.steps[14].action->text, "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash");
+  EXPECT_EQ(original.steps[15].action->text, "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash");
   const std::string written = scenario_yaml(original, "made by a test\nsecond line");
   EXPECT_EQ(written.rfind("# made by a test\n# second line\n", 0), 0u) << written;
   expect_same_steps(original, read(written));
