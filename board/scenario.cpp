@@ -46,7 +46,7 @@ ScenarioChip chip_of(const json& j) { return ScenarioChip{unhex(j.at("chain")), 
 }  // namespace
 
 std::string_view to_string(ScenarioAction::Kind k) {
-  constexpr std::string_view n[] = {"sw", "stby_rst", "fault", "load", "block", "supply"};
+  constexpr std::string_view n[] = {"sw", "stby_rst", "fault", "load", "block", "supply", "serial"};
   return n[static_cast<unsigned>(k)];
 }
 std::string_view to_string(ScenarioTrigger::Kind k) {
@@ -54,7 +54,7 @@ std::string_view to_string(ScenarioTrigger::Kind k) {
   return n[static_cast<unsigned>(k)];
 }
 std::string_view to_string(ScenarioExpectation::Kind k) {
-  constexpr std::string_view n[] = {"register", "true_position", "status", "busy_pulse", "command", "frames"};
+  constexpr std::string_view n[] = {"register", "true_position", "status", "busy_pulse", "command", "frames", "sanitizer"};
   return n[static_cast<unsigned>(k)];
 }
 
@@ -77,7 +77,7 @@ std::string serialize_scenario(const Scenario& s) {
       j["do"] = {{"kind", static_cast<unsigned>(a.kind)}, {"chip", chip_json(a.chip)}, {"level", a.level},
                  {"fault", static_cast<unsigned>(a.fault)}, {"value", a.value},
                  {"load", {a.load.inertia_g_mm2, a.load.friction_uNm, a.load.force_uNm}},
-                 {"position", a.position}, {"supply_mV", a.supply_mV}};
+                 {"position", a.position}, {"supply_mV", a.supply_mV}, {"text", hex(a.text)}};
     }
     if (st.expect) {
       const ScenarioExpectation& e = *st.expect;
@@ -116,7 +116,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
       if (js.contains("do")) {
         const json& a = js.at("do");
         ScenarioAction act;
-        act.kind = enum_at<ScenarioAction::Kind>(a, "kind", 6);
+        act.kind = enum_at<ScenarioAction::Kind>(a, "kind", 7);
         act.chip = chip_of(a.at("chip"));
         act.level = a.at("level").get<bool>();
         act.fault = enum_at<TraceFault>(a, "fault", kTraceFaultCount);
@@ -126,6 +126,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
         act.load.force_uNm = a.at("load").at(2).get<std::int32_t>();
         act.position = a.at("position").get<std::int64_t>();
         act.supply_mV = a.at("supply_mV").get<std::uint32_t>();
+        if (a.contains("text")) act.text = unhex(a.at("text"));
         st.action = act;
       }
       if (js.contains("expect")) {

@@ -44,7 +44,7 @@ struct ScenarioTrigger {
   friend bool operator==(const ScenarioTrigger&, const ScenarioTrigger&) = default;
 };
 
-/// Something the world does to one chip.
+/// Something the world does to one chip, or (serial) types into the program's Serial.
 struct ScenarioAction {
   enum class Kind : std::uint8_t {
     sw,        ///< the switch on SW closes (level low) or opens (high): `level`
@@ -53,6 +53,7 @@ struct ScenarioAction {
     load,      ///< the axis's load becomes `load`
     block,     ///< a hard stop at `position` (1/128 step) on the side the rotor is moving to
     supply,    ///< the motor supply becomes `supply_mV`; UVLO follows the L6470's thresholds
+    serial,    ///< `text` arrives at the program's Serial input (a firmware sketch's); no chip
   };
   Kind kind = Kind::sw;
   ScenarioChip chip;
@@ -62,6 +63,7 @@ struct ScenarioAction {
   LoadSpec load;
   std::int64_t position = 0;
   std::uint32_t supply_mV = 12'000;
+  std::string text;  ///< serial: the bytes, as they are
   friend bool operator==(const ScenarioAction&, const ScenarioAction&) = default;
 };
 
@@ -142,7 +144,7 @@ std::string serialize_scenario(const Scenario& s);
 /// Reads serialize_scenario's form back; nullopt and `error` (one line) when it is not that.
 std::optional<Scenario> deserialize_scenario(std::string_view text, std::string& error);
 
-/// Names: "sw", "stby_rst", "fault", "load", "block", "supply"; triggers and expectations alike.
+/// Names: "sw", "stby_rst", "fault", "load", "block", "supply", "serial"; triggers and expectations alike.
 std::string_view to_string(ScenarioAction::Kind k);
 std::string_view to_string(ScenarioTrigger::Kind k);
 std::string_view to_string(ScenarioExpectation::Kind k);

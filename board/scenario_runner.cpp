@@ -50,6 +50,24 @@ bool is_command_name(std::string_view name) {
   return false;
 }
 
+// Text as a scenario log shows it: in double quotes, control bytes and quotes escaped.
+std::string shown_serial_text(std::string_view text) {
+  std::string out = "\"";
+  for (const char ch : text.substr(0, 200)) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (ch == '\n') out += "\\n";
+    else if (ch == '\r') out += "\\r";
+    else if (ch == '"' || ch == '\\') out += std::string("\\") + ch;
+    else if (c < 0x20 || c == 0x7f) {
+      static const char* digits = "0123456789abcdef";
+      out += std::string("\\x") + digits[c >> 4] + digits[c & 15];
+    } else {
+      out += ch;
+    }
+  }
+  return out + (text.size() > 200 ? "\"..." : "\"");
+}
+
 std::string with_tolerance(std::int64_t v, std::int64_t tol) {
   return tol ? std::to_string(v) + " ± " + std::to_string(tol) : std::to_string(v);
 }
@@ -71,6 +89,7 @@ std::string describe(const ScenarioAction& a) {
              std::to_string(a.load.friction_uNm) + " µN·m, force " + std::to_string(a.load.force_uNm) + " µN·m";
     case ScenarioAction::Kind::block: return "hard stop at " + std::to_string(a.position) + " (1/128 step)";
     case ScenarioAction::Kind::supply: return "supply " + std::to_string(a.supply_mV) + " mV";
+    case ScenarioAction::Kind::serial: return "typed " + shown_serial_text(a.text);
   }
   return "";
 }
@@ -84,8 +103,9 @@ bool is_position(ScenarioTrigger::Kind k) {
 
 }  // namespace
 
-ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario)
-    : board_(board), scenario_(std::move(scenario)), state_(scenario_.steps.size()) {
+ScenarioRunner::ScenarioRunner(Board& board, Scenario scenario, SerialInput serial_input)
+    : board_(board), scenario_(std::move(scenario)), serial_input_(std::move(serial_input)),
+      state_(scenario_.steps.size()) {
   pulses_.resize(board_.chain_count());
   commands_.resize(board_.chain_count());
   uvlo_by_supply_.resize(board_.chain_count());
@@ -126,7 +146,10 @@ void ScenarioRunner::check_step_against_board(std::size_t i, std::vector<std::pa
     bad(quoted_text(st.when.command) + " is not a command (datasheet names: GoUntil, Move, GetStatus, ...)");
   if (st.when.kind == ScenarioTrigger::Kind::busy_fall || st.when.kind == ScenarioTrigger::Kind::busy_rise)
     busy_watch.emplace_back(s.trigger_chip.chain, s.trigger_chip.chip);
-  if (st.action) {
+  if (st.action && st.action->kind == ScenarioAction::Kind::serial) {
+    s.target_chip.label = "Serial";  // the program's, not a chip's
+    if (st.when.kind == ScenarioTrigger::Kind::end) bad("an action cannot happen at the end");
+  } else if (st.action) {
     const ScenarioAction& a = *st.action;
     s.target_chip = resolve(a.chip, w);
     const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
@@ -374,7 +397,11 @@ void ScenarioRunner::fire(std::size_t i, Tick tick) {
   StepState& s = state_[i];
   s.done = true;
   const ScenarioStep& st = scenario_.steps[i];
-  if (st.action) {
+  if (st.action && st.action->kind == ScenarioAction::Kind::serial && !serial_input_) {
+    ++judged_;  // counted with the expectations: it is what fails the run
+    fail(st.where, "serial input", tick, s.target_chip, "a program whose Serial reads it (a firmware sketch)",
+         "a program with no Serial (under the preload): " + shown_serial_text(st.action->text) + " went nowhere");
+  } else if (st.action) {
     log_.push_back(seconds_text(tick) + ": " + st.where + ": " + s.target_chip.label + ": " + describe(*st.action));
     apply(*st.action, s.target_chip, st.where);
   }
@@ -413,6 +440,9 @@ void ScenarioRunner::apply(const ScenarioAction& a, const Resolved& r, const std
         board_.set_axis_stops(r.chain, r.chip, true, a.position, spec.has_upper_stop, spec.upper_stop);
       return;
     }
+    case ScenarioAction::Kind::serial:
+      serial_input_(a.text);
+      return;
     case ScenarioAction::Kind::supply: {
       board_.set_axis_supply(r.chain, r.chip, a.supply_mV);  // recorded; no effect without an axis
       auto uvlo = uvlo_by_supply_[r.chain][r.chip];

@@ -4,7 +4,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "board/board.hpp"
@@ -22,9 +24,16 @@ namespace l6470emu {
 /// a position is reached) and applies the step there, so that the world acts at its own time
 /// whatever the host waits for. Steps fired by a command are applied by after_transfer(), at
 /// the end of the SPI use that carried the command.
+///
+/// Serial steps (`serial: "text"`) go to `serial_input`, the program's Serial as its front
+/// gives it (a firmware sketch's); without one (a program under the preload) such a step fails
+/// when it fires, named, as a program with no Serial to read it.
 class ScenarioRunner {
  public:
-  ScenarioRunner(Board& board, Scenario scenario);
+  /// Where a serial step's bytes go: the program's Serial input.
+  using SerialInput = std::function<void(std::string_view bytes)>;
+
+  ScenarioRunner(Board& board, Scenario scenario, SerialInput serial_input = {});
   ~ScenarioRunner();
   ScenarioRunner(const ScenarioRunner&) = delete;
   ScenarioRunner& operator=(const ScenarioRunner&) = delete;
@@ -103,6 +112,7 @@ class ScenarioRunner {
 
   Board& board_;
   Scenario scenario_;
+  SerialInput serial_input_;
   std::vector<StepState> state_;
   std::vector<ScenarioFailure> failures_;
   std::vector<std::string> log_;

@@ -3,11 +3,15 @@
 #
 #   l6470emu_add_sketch(NAME SOURCES sketch.ino [more.ino] [lib.cpp ...]
 #                       [BOARD "chips=3xL6470 cs_pin=D10 flag_pin=D2" | BOARD_FILE board.conf]
+#                       [ARDUINO_BOARD uno | nucleo_f401re]
 #                       [INCLUDE_DIRECTORIES dir ...] [LINK_LIBRARIES lib ...])
 #     An Arduino sketch and its libraries: .ino files become one C++ file as the Arduino IDE
 #     makes it (#include <Arduino.h>, prototypes; the first .ino is the main one, the others
 #     follow by name), compiled as GNU C++17 with -fpermissive (as the Arduino IDE compiles);
-#     linked with l6470emu::arduino, whose main() runs setup() then loop().
+#     linked with l6470emu::arduino, whose main() runs setup() then loop(). ARDUINO_BOARD is the
+#     board whose pin numbers the sketch uses: an Uno by default (D10 is 10); nucleo_f401re
+#     numbers them as a NUCLEO-F401RE's Arduino header (D10, 10 and the description's D10 are
+#     PB6). The sketch gets the compile definition L6470EMU_ARDUINO_BOARD_<BOARD>.
 #   l6470emu_add_hal_program(NAME SOURCES main.c ... [BOARD ... | BOARD_FILE ...] ...)
 #     An STM32Cube HAL program with its own main(), linked with l6470emu::stm32hal
 #     (stm32f4xx_hal.h and the other families' headers).
@@ -20,10 +24,20 @@
 include_guard(GLOBAL)
 
 function(_l6470emu_firmware_program name front_library)
-  cmake_parse_arguments(PARSE_ARGV 2 arg "" "BOARD;BOARD_FILE" "SOURCES;INCLUDE_DIRECTORIES;LINK_LIBRARIES")
+  cmake_parse_arguments(PARSE_ARGV 2 arg "" "BOARD;BOARD_FILE;ARDUINO_BOARD" "SOURCES;INCLUDE_DIRECTORIES;LINK_LIBRARIES")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "l6470emu: ${name}: unknown arguments ${arg_UNPARSED_ARGUMENTS} "
-                        "(SOURCES, BOARD, BOARD_FILE, INCLUDE_DIRECTORIES, LINK_LIBRARIES)")
+                        "(SOURCES, BOARD, BOARD_FILE, ARDUINO_BOARD, INCLUDE_DIRECTORIES, LINK_LIBRARIES)")
+  endif()
+  if(DEFINED arg_ARDUINO_BOARD)
+    if(NOT front_library STREQUAL "l6470emu::arduino")
+      message(FATAL_ERROR "l6470emu: ${name}: ARDUINO_BOARD is for sketches (l6470emu_add_sketch); "
+                          "a HAL or C API program names STM32 port pins itself")
+    endif()
+    string(TOLOWER "${arg_ARDUINO_BOARD}" arduino_board)
+    if(NOT arduino_board MATCHES "^(uno|nucleo_f401re)$")
+      message(FATAL_ERROR "l6470emu: ${name}: ARDUINO_BOARD \"${arg_ARDUINO_BOARD}\" is none of uno, nucleo_f401re")
+    endif()
   endif()
   if(NOT arg_SOURCES)
     message(FATAL_ERROR "l6470emu: ${name}: no SOURCES")
@@ -83,6 +97,10 @@ extern \"C\" const char* ${function}(void) { return \"${text}\"; }
   target_link_libraries(${name} PRIVATE ${front_library} ${arg_LINK_LIBRARIES})
   list(REMOVE_DUPLICATES include_dirs)
   target_include_directories(${name} PRIVATE ${include_dirs} ${arg_INCLUDE_DIRECTORIES})
+  if(DEFINED arduino_board)
+    string(TOUPPER "${arduino_board}" upper)
+    target_compile_definitions(${name} PRIVATE L6470EMU_ARDUINO_BOARD_${upper})
+  endif()
 endfunction()
 
 function(l6470emu_add_sketch name)

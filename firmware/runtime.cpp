@@ -81,8 +81,9 @@ void apply_default_pins(BoardConfig& config, FirmwareFront front) {
 
 }  // namespace
 
-FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log)
-    : front_(front), config_(config), timing_(config.firmware), log_(std::move(log)), limit_ticks_(timing_.limit_ticks) {
+FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log,
+                                 ArduinoBoard arduino_board)
+    : front_(front), arduino_board_(arduino_board), config_(config), timing_(config.firmware), log_(std::move(log)), limit_ticks_(timing_.limit_ticks) {
   if (!config_.socket.empty())
     throw std::invalid_argument("socket= forwards to an l6470emu serve daemon; a firmware run has its board in itself");
   if (!config_.time.virtual_time && config_.time.scale != 1.0)
@@ -91,6 +92,7 @@ FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front,
   config_.time.virtual_time = true;
   config_.time.idle_ns = 0;
   apply_default_pins(config_, front_);
+  if (front_ == FirmwareFront::arduino) map_arduino_header(config_, arduino_board_);
   clock_ = std::make_unique<FixedHostClock>();
   board_ = std::make_unique<Board>(config_, log_, *clock_);
   board_->set_edge_sink([this](const PinEdge& e) { edges_.push_back(e); });
@@ -617,9 +619,23 @@ void FirmwareRuntime::stop_at_limit() {
 
 void FirmwareRuntime::bind_scenario(const Scenario& scenario) {
   scenario_.reset();
-  scenario_ = std::make_unique<ScenarioRunner>(*board_, scenario);
+  scenario_ = std::make_unique<ScenarioRunner>(*board_, scenario, [this](std::string_view bytes) { serial_arrive(bytes); });
   scenario_->advance_to(now_);  // steps at tick 0 act before the program's first call
   world_acted();
+}
+
+int FirmwareRuntime::serial_peek() const {
+  return serial_available() ? static_cast<unsigned char>(serial_in_[serial_at_]) : -1;
+}
+
+int FirmwareRuntime::serial_read() {
+  const int c = serial_peek();
+  if (c < 0) return c;
+  if (++serial_at_ == serial_in_.size()) {
+    serial_in_.clear();  // all read: the queue starts again
+    serial_at_ = 0;
+  }
+  return c;
 }
 
 bool FirmwareRuntime::finish_scenario(ScenarioOutcome& out) {
@@ -654,6 +670,9 @@ extern "C" {
 /// Set by l6470emu_add_sketch / l6470emu_add_hal_program BOARD (a description) or BOARD_FILE.
 const char* l6470emu_fw_default_board(void) __attribute__((weak));
 const char* l6470emu_fw_default_board_file(void) __attribute__((weak));
+/// Defined (weak, in every file that includes it) by Arduino.h when the sketch is built for a
+/// board other than an Uno (l6470emu_add_sketch's ARDUINO_BOARD): "nucleo_f401re".
+const char* l6470emu_fw_arduino_board(void) __attribute__((weak));
 }
 
 namespace {
@@ -769,9 +788,18 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
     }
     config.check.allowed = *rules;
   }
+  ArduinoBoard arduino_board = ArduinoBoard::uno;
+  if (const char* name = l6470emu_fw_arduino_board ? l6470emu_fw_arduino_board() : nullptr; name && *name) {
+    const auto b = parse_arduino_board(name);
+    if (!b) {
+      error = "l6470emu: firmware: the sketch's Arduino board " + quoted_text(name) + " is none of uno, nucleo_f401re";
+      return nullptr;
+    }
+    arduino_board = *b;
+  }
   std::unique_ptr<FirmwareRuntime> runtime;
   try {
-    runtime = std::make_unique<FirmwareRuntime>(config, front, make_log(config.log));
+    runtime = std::make_unique<FirmwareRuntime>(config, front, make_log(config.log), arduino_board);
   } catch (const std::exception& e) {
     error = std::string("l6470emu: firmware: ") + e.what();
     return nullptr;

@@ -19,6 +19,7 @@
 #include "board/pin_map.hpp"
 #include "board/run_report.hpp"
 #include "board/scenario.hpp"
+#include "firmware/arduino_board.hpp"
 
 namespace l6470emu {
 
@@ -51,14 +52,21 @@ class FirmwareRuntime {
   }
 
   /// The board of `config` in virtual time, with `front`'s default pin map when the description
-  /// names no pin. Diagnostics go to `log`. Throws std::invalid_argument (one line) when the
-  /// description cannot run as firmware (a socket=, wall-time scale=, two controllers of one name).
-  FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log);
+  /// names no pin, and (Arduino front) the description's Arduino pin numbers wired as
+  /// `arduino_board` has them (map_arduino_header). Diagnostics go to `log`. Throws
+  /// std::invalid_argument (one line) when the description cannot run as firmware (a socket=,
+  /// wall-time scale=, two controllers of one name).
+  FirmwareRuntime(const BoardConfig& config, FirmwareFront front, LineSink log,
+                  ArduinoBoard arduino_board = ArduinoBoard::uno);
   ~FirmwareRuntime();
   FirmwareRuntime(const FirmwareRuntime&) = delete;
   FirmwareRuntime& operator=(const FirmwareRuntime&) = delete;
 
   FirmwareFront front() const { return front_; }
+  /// The Arduino board whose pin numbering the program uses (an Uno unless it says otherwise).
+  ArduinoBoard arduino_board() const { return arduino_board_; }
+  /// The key of Arduino pin number `pin` on that board (arduino_pin_key).
+  int arduino_pin(int pin) const { return arduino_pin_key(arduino_board_, pin); }
   const FirmwareTiming& timing() const { return timing_; }
   Board& board() { return *board_; }
   /// The description the run uses, with the default pin map filled in when it named no pin.
@@ -136,6 +144,18 @@ class FirmwareRuntime {
   /// them and every other broken rule as check= says (check=error ends the run: check_rules).
   void transfer(int controller, const BusSettings& settings, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx);
 
+  // ---- Serial input -------------------------------------------------------------------------
+
+  /// Bytes arriving at the program's Serial (a bound scenario's serial: step at its tick, the
+  /// program's standard input as the front reads it), queued in arrival order until read.
+  void serial_arrive(std::string_view bytes) { serial_in_.append(bytes); }
+  /// How many bytes have arrived and are not read yet.
+  std::size_t serial_available() const { return serial_in_.size() - serial_at_; }
+  /// The next byte without taking it, or -1 when none is there.
+  int serial_peek() const;
+  /// Takes the next byte, or -1 when none is there.
+  int serial_read();
+
   // ---- the run ------------------------------------------------------------------------------
 
   /// A diagnostic line ("l6470emu: " is added by the sink).
@@ -151,7 +171,7 @@ class FirmwareRuntime {
 
   /// Binds `scenario` to the board (board/scenario_runner.hpp): from then on time moves through
   /// it (its steps act at their own ticks; a delay wakes for them) and it sees every SPI use and
-  /// pin change. Throws std::invalid_argument (one line naming the step) when it does not fit.
+  /// pin change; its serial: steps arrive at serial_arrive(). Throws std::invalid_argument (one line naming the step) when it does not fit.
   void bind_scenario(const Scenario& scenario);
   /// Ends the bound scenario at the time now (its `end` expectations judged) into `out`; false
   /// when none is bound. Idempotent.
@@ -209,6 +229,7 @@ class FirmwareRuntime {
   void world_acted();
 
   FirmwareFront front_;
+  ArduinoBoard arduino_board_;
   BoardConfig config_;
   FirmwareTiming timing_;
   LineSink log_;
@@ -235,7 +256,15 @@ class FirmwareRuntime {
   Tick limit_ticks_ = 0;   // the earlier of limit= and the run's limit
   std::function<void(RunEnd, std::string_view)> end_hook_;
   bool clocked_ = false;
+  std::string serial_in_;      // Serial input arrived: read up to serial_at_
+  std::size_t serial_at_ = 0;
 };
+
+/// millis() at `tick`: milliseconds since the start in 32 bits, wrapping at 2^32 (after 49.7
+/// days) as a board's counter does.
+inline std::uint32_t board_millis(Tick tick) { return static_cast<std::uint32_t>(tick / (1000 * kTicksPerMicrosecond)); }
+/// micros() at `tick`: microseconds in 32 bits, wrapping at 2^32 (after 71.6 minutes).
+inline std::uint32_t board_micros(Tick tick) { return static_cast<std::uint32_t>(tick / kTicksPerMicrosecond); }
 
 /// The program's runtime, made at its first use: from L6470EMU_CHAIN (a description), else
 /// L6470EMU_CONFIG (a file), else the description the program was built with

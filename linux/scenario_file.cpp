@@ -231,7 +231,7 @@ class Reader {
 
   ScenarioAction action(const YAML::Node& m, const ScenarioChip& dflt) {
     if (!m.IsMap()) fail(m, "do", "expects a map such as {sw: close}");
-    const std::vector<std::string> kinds{"sw", "stby_rst", "fault", "thermal", "adcin", "load", "block", "supply_mV"};
+    const std::vector<std::string> kinds{"sw", "stby_rst", "fault", "thermal", "adcin", "load", "block", "supply_mV", "serial"};
     std::vector<std::string> keys = kinds;
     keys.insert(keys.end(), {"clear", "bit", "chip", "chain"});
     check_keys(m, "do:", keys);
@@ -239,7 +239,16 @@ class Reader {
     a.chip = chip_of(m, dflt);
     int n = 0;
     for (const auto& k : kinds) n += m[k] ? 1 : 0;
-    if (n != 1) fail(m, "do", "names exactly one action: sw, stby_rst, fault, thermal, adcin, load, block or supply_mV");
+    if (n != 1) fail(m, "do", "names exactly one action: sw, stby_rst, fault, thermal, adcin, load, block, supply_mV or serial");
+    if (const YAML::Node v = m["serial"]) {
+      // Text typed into the program's Serial: no chip takes it.
+      for (const char* k : {"chip", "chain"})
+        if (m[k]) fail(m[k], k, "not with serial: (the text goes to the program's Serial, not to a chip)");
+      a.kind = ScenarioAction::Kind::serial;
+      a.text = scalar(v, "serial");
+      if (a.text.empty()) fail(v, "serial", "types nothing: give the text, e.g. \"G 100\\n\"");
+      return a;
+    }
     if (m["clear"] && !m["fault"]) fail(m["clear"], "clear", "only with fault:");
     if (m["bit"] && !m["fault"]) fail(m["bit"], "bit", "only with fault: miso_flip");
     if (const YAML::Node v = m["sw"]) {

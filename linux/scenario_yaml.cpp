@@ -49,6 +49,7 @@ std::string_view fault_word(TraceFault f) {
 }
 
 std::string action_text(const ScenarioAction& a) {
+  if (a.kind == ScenarioAction::Kind::serial) return "{serial: " + quoted(a.text) + "}";  // no chip
   std::ostringstream o;
   o << "{";
   switch (a.kind) {
@@ -72,6 +73,7 @@ std::string action_text(const ScenarioAction& a) {
       break;
     case ScenarioAction::Kind::block: o << "block: " << a.position; break;
     case ScenarioAction::Kind::supply: o << "supply_mV: " << a.supply_mV; break;
+    case ScenarioAction::Kind::serial: break;  // written above
   }
   o << ", " << chip_keys(a.chip) << "}";
   return o.str();

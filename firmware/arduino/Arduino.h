@@ -94,24 +94,29 @@ typedef int PinStatus;
 typedef int PinMode;
 typedef int BitOrder;
 
-/* Pin numbers: D0..D127 are 0..127 (an Uno's), A0..A7 are 14..21, and the STM32 port pins
- * PA0..PH15 are 128..255 (STM32duino sketches name pins so). */
-static const uint8_t SS = 10;
-static const uint8_t MOSI = 11;
-static const uint8_t MISO = 12;
-static const uint8_t SCK = 13;
-static const uint8_t A0 = 14;
-static const uint8_t A1 = 15;
-static const uint8_t A2 = 16;
-static const uint8_t A3 = 17;
-static const uint8_t A4 = 18;
-static const uint8_t A5 = 19;
-static const uint8_t A6 = 20;
-static const uint8_t A7 = 21;
-#define LED_BUILTIN 13
-#define NUM_DIGITAL_PINS 256
+/* Pin numbers: the imitated board's (pins_arduino.h: an Uno's by default, D0..D19 and A0..A7 =
+ * 14..21; a NUCLEO-F401RE's on request, D0..D15 its header's port pins) and the STM32 port pins
+ * PA0..PH15 = 128..255 (STM32duino sketches name pins so). */
+#include "pins_arduino.h"
+#include "binary.h"
 
-#include "stm32_pin_names.h"
+/* The Cortex-M intrinsics STM32duino sketches and libraries call (CMSIS's): the barriers and
+ * wait-for-interrupt do nothing here; __disable_irq/__enable_irq are noInterrupts/interrupts. */
+#ifndef __NOP
+#define __NOP() ((void)0)
+#endif
+#ifndef __DSB
+#define __DSB() ((void)0)
+#endif
+#ifndef __ISB
+#define __ISB() ((void)0)
+#endif
+#ifndef __DMB
+#define __DMB() ((void)0)
+#endif
+#ifndef __WFI
+#define __WFI() ((void)0)
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -142,6 +147,8 @@ void attachInterruptArg(uint8_t interruptNum, void (*userFunc)(void*), void* arg
 void detachInterrupt(uint8_t interruptNum);
 void interrupts(void);
 void noInterrupts(void);
+void __disable_irq(void);
+void __enable_irq(void);
 
 void yield(void);
 

@@ -1,7 +1,9 @@
 /* Serial on the desktop: what the sketch writes goes to standard output (the CR of each CR LF
- * pair dropped, so println ends lines with a newline), nothing is ever there to read, and each
- * write call costs one HAL call of virtual time (no baud rate is modelled). Serial1 and Serial2
- * write to standard output too. */
+ * pair dropped, so println ends lines with a newline), and each call costs one HAL call of
+ * virtual time (no baud rate is modelled). Serial reads the program's standard input (all of it
+ * there from the start: it is read to its end at the first read) and the text of a scenario's
+ * serial: steps from their tick on; available() is what has arrived. Serial1 and Serial2 write to
+ * standard output too and read nothing. */
 #ifndef L6470EMU_HARDWARE_SERIAL_H
 #define L6470EMU_HARDWARE_SERIAL_H
 

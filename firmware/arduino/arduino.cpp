@@ -51,19 +51,19 @@ void pinMode(uint8_t pin, uint8_t mode) {
     case OUTPUT_OPEN_DRAIN: m = l6470emu::McuPinMode::output_open_drain; break;
     default: break;
   }
-  r.set_pin_mode(pin, m);
+  r.set_pin_mode(r.arduino_pin(pin), m);
 }
 
 void digitalWrite(uint8_t pin, uint8_t val) {
   FirmwareRuntime& r = runtime();
   r.call();
-  r.write_pin(pin, val != LOW);
+  r.write_pin(r.arduino_pin(pin), val != LOW);
 }
 
 int digitalRead(uint8_t pin) {
   FirmwareRuntime& r = runtime();
   r.call();
-  return r.read_pin(pin) ? HIGH : LOW;
+  return r.read_pin(r.arduino_pin(pin)) ? HIGH : LOW;
 }
 
 int analogRead(uint8_t) {
@@ -78,20 +78,21 @@ void analogWriteResolution(int) { runtime().call(); }
 void analogWrite(uint8_t pin, int val) {
   FirmwareRuntime& r = runtime();
   r.call();
-  r.set_pin_mode(pin, l6470emu::McuPinMode::output);
-  r.write_pin(pin, val >= 128);
+  const int key = r.arduino_pin(pin);
+  r.set_pin_mode(key, l6470emu::McuPinMode::output);
+  r.write_pin(key, val >= 128);
 }
 
 unsigned long millis(void) {
   FirmwareRuntime& r = runtime();
   r.call();
-  return static_cast<unsigned long>(r.now() / (1000 * l6470emu::kTicksPerMicrosecond));
+  return l6470emu::board_millis(r.now());
 }
 
 unsigned long micros(void) {
   FirmwareRuntime& r = runtime();
   r.call();
-  return static_cast<unsigned long>(r.now() / l6470emu::kTicksPerMicrosecond);
+  return l6470emu::board_micros(r.now());
 }
 
 void delay(unsigned long ms) {
@@ -106,9 +107,10 @@ void delayMicroseconds(unsigned int us) {
   r.sleep_until(r.now() + l6470emu::ticks_from_us(us));
 }
 
-unsigned long pulseIn(uint8_t pin, uint8_t state, unsigned long timeout) {
+unsigned long pulseIn(uint8_t pin_number, uint8_t state, unsigned long timeout) {
   FirmwareRuntime& r = runtime();
   r.call();
+  const int pin = r.arduino_pin(pin_number);
   const Tick end = r.now() + l6470emu::ticks_from_us(timeout);
   const bool level = state != LOW;
   // A pulse already under way is not counted: wait for it to end, then for one to start.
@@ -144,7 +146,7 @@ static void attach(uint8_t number, void (*isr)(void), void (*isr_arg)(void*), vo
   FirmwareRuntime& r = runtime();
   r.call();
   auto& a = l6470emu::arduino::g_attached[number];
-  const int pin = number;  // digitalPinToInterrupt(p) == p
+  const int pin = r.arduino_pin(number);  // digitalPinToInterrupt(p) == p
   a.isr = isr;
   a.isr_arg = isr_arg;
   a.arg = arg;
@@ -182,8 +184,8 @@ void detachInterrupt(uint8_t interruptNum) {
   auto& a = l6470emu::arduino::g_attached[interruptNum];
   if (!a.attached) return;
   a.attached = false;
-  r.watch_pin(interruptNum, 0, nullptr);
-  r.watch_level(interruptNum, false, nullptr);
+  r.watch_pin(r.arduino_pin(interruptNum), 0, nullptr);
+  r.watch_level(r.arduino_pin(interruptNum), false, nullptr);
   r.clear_irq(a.irq);
   r.set_irq_enabled(a.irq, false);
 }
@@ -199,6 +201,9 @@ void noInterrupts(void) {
   r.call();
   r.disable_interrupts();
 }
+
+void __disable_irq(void) { noInterrupts(); }
+void __enable_irq(void) { interrupts(); }
 
 void yield(void) { runtime().call(); }
 

@@ -3,6 +3,8 @@
 // The model first: Arduino.h's macros (HIGH, DEC, ...) must not reach its headers.
 #include "firmware/arduino/arduino_internal.hpp"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -149,7 +151,7 @@ int Stream::timedRead() {
     const int c = read();
     if (c >= 0) return c;
     delay(1);
-  } while (millis() - start < timeout_ms_);
+  } while (static_cast<uint32_t>(millis() - start) < timeout_ms_);  // across the wrap too
   return -1;
 }
 
@@ -159,7 +161,7 @@ int Stream::timedPeek() {
     const int c = peek();
     if (c >= 0) return c;
     delay(1);
-  } while (millis() - start < timeout_ms_);
+  } while (static_cast<uint32_t>(millis() - start) < timeout_ms_);  // across the wrap too
   return -1;
 }
 
@@ -239,17 +241,26 @@ void HardwareSerial::begin(unsigned long, uint32_t, int8_t, int8_t, bool, unsign
   l6470emu::arduino::runtime().call();
 }
 void HardwareSerial::end() { l6470emu::arduino::runtime().call(); }
+// Serial reads what has arrived by now (the program's standard input, a scenario's serial:
+// steps at their ticks); Serial1 and Serial2 read nothing.
+static l6470emu::FirmwareRuntime* input_of(HardwareSerial* port) {
+  l6470emu::FirmwareRuntime& r = l6470emu::arduino::runtime();
+  r.call();
+  if (port != &Serial) return nullptr;
+  l6470emu::arduino::take_stdin(r);
+  return &r;
+}
 int HardwareSerial::available() {
-  l6470emu::arduino::runtime().call();
-  return 0;
+  l6470emu::FirmwareRuntime* r = input_of(this);
+  return r ? static_cast<int>(std::min<std::size_t>(r->serial_available(), INT_MAX)) : 0;
 }
 int HardwareSerial::peek() {
-  l6470emu::arduino::runtime().call();
-  return -1;
+  l6470emu::FirmwareRuntime* r = input_of(this);
+  return r ? r->serial_peek() : -1;
 }
 int HardwareSerial::read() {
-  l6470emu::arduino::runtime().call();
-  return -1;
+  l6470emu::FirmwareRuntime* r = input_of(this);
+  return r ? r->serial_read() : -1;
 }
 int HardwareSerial::availableForWrite() { return 64; }
 void HardwareSerial::flush() {

@@ -250,7 +250,7 @@ __weak HAL_StatusTypeDef HAL_InitTick(uint32_t) { return HAL_OK; }
 
 __weak uint32_t HAL_GetTick(void) {
   FirmwareRuntime& r = call();
-  return static_cast<uint32_t>(r.now() / l6470emu::ticks_from_ms(1));
+  return l6470emu::board_millis(r.now());  // wraps at 2^32 ms as the SysTick counter does
 }
 
 uint32_t HAL_GetTickPrio(void) { return 0; }

@@ -104,6 +104,47 @@ TEST(ScenarioRunner, TheOutcomeSaysWhenTheHostLastLookedAtEachChipsBusyAndFlagPi
   EXPECT_EQ(v.board.last_output_read(0, 1, Pin::BUSY), kNever);
 }
 
+TEST(ScenarioRunner, SerialTextReachesTheProgramsSerialAtItsTick) {
+  VirtualBoard v("chips=L6470 time=virtual");
+  ScenarioAction typed;
+  typed.kind = ScenarioAction::Kind::serial;
+  typed.text = "MOVE 12800\n";
+  Scenario s;
+  s.steps.push_back(at_time(ticks_from_ms(500), typed));
+  std::string arrived;
+  ScenarioRunner runner(v.board, s, [&](std::string_view bytes) { arrived += bytes; });
+  EXPECT_EQ(runner.next_tick(), ticks_from_ms(500));
+  runner.advance_to(ticks_from_ms(499));
+  EXPECT_EQ(arrived, "");
+  runner.advance_to(ticks_from_ms(1000));
+  EXPECT_EQ(arrived, "MOVE 12800\n");
+  ASSERT_EQ(runner.log().size(), 1u);
+  EXPECT_EQ(runner.log()[0], "0.500000 s: s.yaml:1: Serial: typed \"MOVE 12800\\n\"");
+  runner.finish();
+  EXPECT_TRUE(runner.failures().empty());
+}
+
+TEST(ScenarioRunner, SerialTextForAProgramWithNoSerialFailsNamedWhenItFires) {
+  VirtualBoard v("chips=L6470 time=virtual");
+  ScenarioAction typed;
+  typed.kind = ScenarioAction::Kind::serial;
+  typed.text = "G\n";
+  Scenario s;
+  s.steps.push_back(at_time(ticks_from_ms(10), typed));
+  ScenarioRunner runner(v.board, s);  // the preload's: no Serial
+  runner.advance_to(ticks_from_ms(20));
+  runner.finish();
+  ASSERT_EQ(runner.failures().size(), 1u);
+  const ScenarioFailure& f = runner.failures()[0];
+  EXPECT_EQ(f.where, "s.yaml:1");
+  EXPECT_EQ(f.what, "serial input");
+  EXPECT_EQ(f.chip, "Serial");
+  EXPECT_EQ(f.tick, ticks_from_ms(10));
+  EXPECT_EQ(f.expected, "a program whose Serial reads it (a firmware sketch)");
+  EXPECT_EQ(f.seen, "a program with no Serial (under the preload): \"G\\n\" went nowhere");
+  EXPECT_EQ(runner.judged(), 1u);
+}
+
 TEST(ScenarioRunner, ATimedSwitchClosureReachesTheChipAtItsTickWhateverTheHostWaitsFor) {
   VirtualBoard v("chips=L6470; time=virtual");
   ScenarioAction close;
@@ -472,6 +513,10 @@ TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
   s.steps.push_back(expect_at(cmd, st));
   s.steps.push_back(at_time(9, one_shot(TraceFault::LOST_FRAME, 1)));
   s.steps.push_back(at_time(10, one_shot(TraceFault::MISO_FLIP, 0, 5)));
+  ScenarioAction typed;
+  typed.kind = ScenarioAction::Kind::serial;
+  typed.text = "G 100\r\n\xff";  // bytes, as they are
+  s.steps.push_back(at_time(11, typed));
   std::string error;
   const auto back = deserialize_scenario(serialize_scenario(s), error);
   ASSERT_TRUE(back) << error;

@@ -22,8 +22,9 @@ BoardConfig config_of(const std::string& text) {
 }
 
 struct Rig {
-  explicit Rig(const std::string& description, FirmwareFront front = FirmwareFront::arduino)
-      : rt(config_of(description), front, [this](std::string_view l) { log.emplace_back(l); }) {}
+  explicit Rig(const std::string& description, FirmwareFront front = FirmwareFront::arduino,
+               ArduinoBoard board = ArduinoBoard::uno)
+      : rt(config_of(description), front, [this](std::string_view l) { log.emplace_back(l); }, board) {}
   std::vector<std::string> log;
   FirmwareRuntime rt;
 
@@ -229,6 +230,84 @@ TEST(FirmwarePinMap, ADescriptionWithoutPinsGetsTheFrontsDefaultsOnItsFirstChain
   Rig given("chips=L6470 busy_pin=4; bus=1 chips=L6470");
   EXPECT_FALSE(given.rt.config().chains[0].pins.cs) << "a description with any pin gets no defaults";
   EXPECT_EQ(given.log.size(), 2u) << "each chain without cs_pin= is said to be unreachable";
+}
+
+TEST(FirmwarePinMap, OnANucleoTheHeadersPinNumbersAreItsPortPinsInTheSketchAndTheDescription) {
+  Rig nucleo("chips=2xL6470 cs_pin=D10 busy_pin=D3,PB5 flag_pin=2 stby_rst_pin=D6 sw_pin=D20", FirmwareFront::arduino,
+             ArduinoBoard::nucleo_f401re);
+  const ChainPins& n = nucleo.rt.config().chains[0].pins;
+  EXPECT_EQ(n.cs, parse_mcu_pin("PB6"));
+  EXPECT_EQ(chip_mcu_pin(n, Pin::BUSY, 0), parse_mcu_pin("PB3"));
+  EXPECT_EQ(chip_mcu_pin(n, Pin::BUSY, 1), parse_mcu_pin("PB5"));
+  EXPECT_EQ(chip_mcu_pin(n, Pin::FLAG, 0), parse_mcu_pin("PA10"));
+  EXPECT_EQ(chip_mcu_pin(n, Pin::STBY_RST, 1), parse_mcu_pin("PB10"));
+  EXPECT_EQ(chip_mcu_pin(n, Pin::SW, 0), parse_mcu_pin("D20")) << "past the header a number stays itself";
+  EXPECT_EQ(nucleo.rt.arduino_pin(10), nucleo.pin("PB6"));
+  EXPECT_EQ(nucleo.rt.arduino_pin(0), nucleo.pin("PA3"));
+  EXPECT_EQ(nucleo.rt.arduino_pin(15), nucleo.pin("PB8"));
+  EXPECT_EQ(nucleo.rt.arduino_pin(16), 16);
+  EXPECT_EQ(nucleo.rt.arduino_pin(nucleo.pin("PC13")), nucleo.pin("PC13"));
+  Rig defaults("chips=L6470", FirmwareFront::arduino, ArduinoBoard::nucleo_f401re);
+  EXPECT_EQ(defaults.rt.config().chains[0].pins.cs, parse_mcu_pin("PB6")) << "the default D10 is the header's";
+  Rig uno("chips=L6470 cs_pin=D10");
+  EXPECT_EQ(uno.rt.config().chains[0].pins.cs, parse_mcu_pin("D10"));
+  EXPECT_EQ(uno.rt.arduino_pin(10), 10);
+  Rig hal("chips=L6470 cs_pin=PA4", FirmwareFront::stm32_hal, ArduinoBoard::nucleo_f401re);
+  EXPECT_EQ(hal.rt.config().chains[0].pins.cs, parse_mcu_pin("PA4"));
+  EXPECT_EQ(parse_arduino_board("NUCLEO_F401RE"), ArduinoBoard::nucleo_f401re);
+  EXPECT_EQ(parse_arduino_board("uno"), ArduinoBoard::uno);
+  EXPECT_FALSE(parse_arduino_board("nucleo_f411re"));
+}
+
+TEST(FirmwareTime, MillisAndMicrosWrapAt2To32AsABoardsCountersDo) {
+  EXPECT_EQ(board_micros(ticks_from_us(4'294'967'295)), 4'294'967'295u);
+  EXPECT_EQ(board_micros(ticks_from_us(4'294'967'296)), 0u) << "71.58 minutes";
+  EXPECT_EQ(board_micros(ticks_from_us(4'294'967'296) + ticks_from_us(704)), 704u);
+  EXPECT_EQ(board_millis(ticks_from_ms(4'294'967'295)), 4'294'967'295u);
+  EXPECT_EQ(board_millis(ticks_from_ms(4'294'967'296)), 0u) << "49.7 days";
+  EXPECT_EQ(board_millis(ticks_from_ms(4'294'967'296) + 3999), 0u) << "a millisecond is whole before it counts";
+  EXPECT_EQ(board_millis(ticks_from_ms(4'294'967'296) + 4000), 1u);
+  // A sketch's `now - start` in uint32_t holds across the wrap.
+  const std::uint32_t start = board_millis(ticks_from_ms(4'294'967'290));
+  EXPECT_EQ(static_cast<std::uint32_t>(board_millis(ticks_from_ms(4'294'967'300)) - start), 10u);
+}
+
+TEST(FirmwareSerial, InputIsReadInArrivalOrderAndAvailableCountsWhatIsLeft) {
+  Rig r("chips=L6470");
+  EXPECT_EQ(r.rt.serial_available(), 0u);
+  EXPECT_EQ(r.rt.serial_read(), -1);
+  EXPECT_EQ(r.rt.serial_peek(), -1);
+  r.rt.serial_arrive("ab");
+  r.rt.serial_arrive(std::string_view("\xff\0", 2));
+  EXPECT_EQ(r.rt.serial_available(), 4u);
+  EXPECT_EQ(r.rt.serial_peek(), 'a');
+  EXPECT_EQ(r.rt.serial_read(), 'a');
+  EXPECT_EQ(r.rt.serial_read(), 'b');
+  EXPECT_EQ(r.rt.serial_read(), 0xff) << "bytes, not chars";
+  r.rt.serial_arrive("c");
+  EXPECT_EQ(r.rt.serial_read(), 0);
+  EXPECT_EQ(r.rt.serial_read(), 'c');
+  EXPECT_EQ(r.rt.serial_available(), 0u);
+  EXPECT_EQ(r.rt.serial_read(), -1);
+}
+
+TEST(FirmwareSerial, AScenariosSerialStepArrivesAtItsTickDuringASleep) {
+  Rig r("chips=L6470");
+  Scenario s;
+  ScenarioStep st;
+  st.where = "s.yaml:3";
+  st.when.tick = ticks_from_ms(250);
+  ScenarioAction typed;
+  typed.kind = ScenarioAction::Kind::serial;
+  typed.text = "G\n";
+  st.action = typed;
+  s.steps.push_back(st);
+  r.rt.bind_scenario(s);
+  r.rt.sleep_until(ticks_from_ms(249));
+  EXPECT_EQ(r.rt.serial_available(), 0u);
+  r.rt.sleep_until(ticks_from_ms(250));
+  EXPECT_EQ(r.rt.serial_available(), 2u);
+  EXPECT_EQ(r.rt.serial_read(), 'G');
 }
 
 TEST(FirmwareSpi, ControllersAreNamedBySpiOrAfterTheirBusAndOneBusAnswersToAnyName) {

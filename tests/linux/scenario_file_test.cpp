@@ -91,7 +91,7 @@ TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
             "l6470emu: scenario s.yaml:3: key 'sw': 'shut' is not one of close, open");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {falt: ocd}\n"),
             "l6470emu: scenario s.yaml:3: key 'falt': unknown (did you mean fault?) in do:; known: sw, stby_rst, fault, "
-            "thermal, adcin, load, block, supply_mV, clear, bit, chip, chain");
+            "thermal, adcin, load, block, supply_mV, serial, clear, bit, chip, chain");
   EXPECT_EQ(error_of("steps:\n  - at: 1.0000001s\n    do: {sw: close}\n"),
             "l6470emu: scenario s.yaml:2: key 'at': expects a duration (250ns, 1us, 10ms, 2.5s, 1min: whole ticks of "
             "250 ns), got '1.0000001s'");
@@ -145,7 +145,7 @@ TEST(ScenarioFile, AMisspelledOneShotFaultIsNamedWithTheNearMiss) {
             "reset, miso_flip, lost_frame (did you mean lost_frame?)");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bti: 3}\n"),
             "l6470emu: scenario s.yaml:3: key 'bti': unknown (did you mean bit?) in do:; known: sw, stby_rst, fault, "
-            "thermal, adcin, load, block, supply_mV, clear, bit, chip, chain");
+            "thermal, adcin, load, block, supply_mV, serial, clear, bit, chip, chain");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bit: 8}\n"),
             "l6470emu: scenario s.yaml:3: key 'bit': 8 is out of range (0..7)");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: reset, clear: true}\n"),
@@ -154,6 +154,37 @@ TEST(ScenarioFile, AMisspelledOneShotFaultIsNamedWithTheNearMiss) {
             "l6470emu: scenario s.yaml:3: key 'bit': only with fault: miso_flip");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: lost_frame, bit: 2}\n"),
             "l6470emu: scenario s.yaml:3: key 'bit': only with fault: miso_flip");
+}
+
+TEST(ScenarioFile, SerialTextReadsAsItIsWrittenAndNamesNoChip) {
+  const ScenarioParse p = parse_scenario_yaml(R"(steps:
+  - at: 500ms
+    do: {serial: "MOVE 12800\n"}
+  - on: {command: Move}
+    do: {serial: 'plain: text'}
+)",
+                                              "f.yaml");
+  ASSERT_TRUE(p.scenario) << p.error;
+  ASSERT_EQ(p.scenario->steps.size(), 2u);
+  const ScenarioAction& a = *p.scenario->steps[0].action;
+  EXPECT_EQ(a.kind, ScenarioAction::Kind::serial);
+  EXPECT_EQ(a.text, "MOVE 12800\n");
+  EXPECT_EQ(p.scenario->steps[0].when.tick, ticks_from_ms(500));
+  EXPECT_EQ(p.scenario->steps[1].action->text, "plain: text");
+}
+
+TEST(ScenarioFile, SerialTextThatIsEmptyOrAimedAtAChipIsNamed) {
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: \"\"}\n"),
+            "l6470emu: scenario s.yaml:3: key 'serial': types nothing: give the text, e.g. \"G 100\\n\"");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: x, chip: 1}\n"),
+            "l6470emu: scenario s.yaml:3: key 'chip': not with serial: (the text goes to the program's Serial, not to a chip)");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: [1, 2]}\n"),
+            "l6470emu: scenario s.yaml:3: key 'serial': expects a single value");
+  EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: x, sw: close}\n"),
+            "l6470emu: scenario s.yaml:3: key 'do': names exactly one action: sw, stby_rst, fault, thermal, adcin, load, "
+            "block, supply_mV or serial");
+  EXPECT_EQ(error_of("steps:\n  - at: end\n    do: {serial: x}\n"),
+            "l6470emu: scenario s.yaml:3: key 'do': nothing can be done at the end; use expect:");
 }
 
 TEST(ScenarioFile, DurationsAreWholeTicksOfTheChip) {

@@ -60,6 +60,10 @@ steps:
     do: {fault: miso_flip, bit: 2}
   - at: 3s
     do: {fault: lost_frame}
+  - at: 4s
+    do: {serial: "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash"}
+  - on: {command: Move}
+    do: {serial: x}
   - at: end
     chip: 1
     expect: {register: ABS_POS, value: -5, tolerance: 3}
@@ -84,7 +88,8 @@ steps:
   - at: end
     expect: {sanitizer: clean}
 )");
-  ASSERT_EQ(original.steps.size(), 26u);
+  ASSERT_EQ(original.steps.size(), 28u);
+  EXPECT_EQ(original.steps[15].action->text, "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash");
   const std::string written = scenario_yaml(original, "made by a test\nsecond line");
   EXPECT_EQ(written.rfind("# made by a test\n# second line\n", 0), 0u) << written;
   expect_same_steps(original, read(written));
