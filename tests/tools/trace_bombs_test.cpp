@@ -139,7 +139,8 @@ TEST(TraceBombs, AConversionThatWouldPassTheOutputLimitIsRefusedFromTheTracesCou
                                                 "limit (raise it with --max-output 4G"}}) {
     std::vector<std::string> args = {"convert", in, "-o", dir.file(c.out)};
     args.insert(args.end(), c.args.begin(), c.args.end());
-    const Measured m = run_measured(args);
+    // Limited all the same, so that a program that did not refuse could not fill the disk.
+    const Measured m = run_measured(args, 512u << 20, 64u << 20);
     EXPECT_EQ(m.status, 2) << c.out << "\n" << m.out;
     EXPECT_EQ(m.out, "l6470emu convert: " + dir.file(c.out) + ": " + c.why + "; 0 = no limit)\n");
     EXPECT_NE(access(dir.file(c.out).c_str(), F_OK), 0) << c.out << " was written";
