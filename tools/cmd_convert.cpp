@@ -142,7 +142,7 @@ class StdoutBuf final : public ErrorKeepingBuf {
 /// Where the output goes, for messages: "standard output" or the path as given.
 std::string output_name(const std::string& output) { return output == "-" ? "standard output" : output; }
 
-/// The default --max-output, and what it means: see docs/trace-format.md ("Converting").
+/// What --max-output takes (its default, 1G, and why: docs/trace-format.md, "Exporters").
 constexpr std::string_view kMaxOutputWords = "a size: bytes, or a number with K, M, G or T (500M, 10G); 0 = no limit";
 
 /// --max-output's value in bytes (0 = no limit); throws std::invalid_argument for anything else.
