@@ -3,6 +3,8 @@
 #include "daisychain/emulated_vcd.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +21,7 @@ struct ChipWires {
 
 }  // namespace
 
-void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, const EmulatedVcdOptions& options) {
+void export_emulated_vcd(const TracePasses& passes, Chain& chain, std::ostream& out, const EmulatedVcdOptions& options) {
   VcdWriter w(out, options.timescale_ns);
   SpiVcdWaveform spi(w);
   const std::size_t n = chain.size();
@@ -63,17 +65,14 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
 
   std::vector<std::uint8_t> rx;
   std::uint64_t end_ns = 0;
-  for (std::size_t i = 0; i < trace.size(); ++i) {
-    const TraceEvent e = trace[i];
+  std::unique_ptr<TraceReader> events = passes();
+  NextFrameTicks next(passes());
+  TraceEvent e;
+  while (events->next(e)) {
     run_until(e.tick);
     if (e.kind == TraceEventKind::frame) {
-      std::uint64_t limit = 0;
-      for (std::size_t j = i + 1; j < trace.size(); ++j)
-        if (trace[j].kind == TraceEventKind::frame) {
-          limit = ns_from_ticks(trace[j].tick);
-          break;
-        }
-      end_ns = std::max(end_ns, spi.draw(e, limit));
+      const std::optional<Tick> limit = next.after_frame();
+      end_ns = std::max(end_ns, spi.draw(e, limit ? ns_from_ticks(*limit) : 0));
       rx.resize(e.mosi.size());
       tracker.begin_frame(e, rx);
       tracker.end_frame();
@@ -81,7 +80,7 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
       continue;
     }
     if (e.chip >= n)
-      throw TraceError(trace.header.name, e.line, trace_chip_outside_chain(e.chip, n));
+      throw TraceError(events->header().name, e.line, trace_chip_outside_chain(e.chip, n));
     tracker.apply(e);
     const std::uint64_t ns = ns_from_ticks(e.tick);
     if (e.kind == TraceEventKind::pin) {
@@ -96,6 +95,10 @@ void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, co
   const Tick stop = std::max(chain.now(), static_cast<Tick>(end_ns / 250)) + kTicksPerSecond;
   while (chain.next_event_tick() != kNever && chain.now() < stop) run_until(std::min(stop, chain.now() + step * 64));
   w.finish(std::max(end_ns, ns_from_ticks(chain.now())) + 1000);
+}
+
+void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, const EmulatedVcdOptions& options) {
+  export_emulated_vcd([&trace] { return trace.reader(); }, chain, out, options);
 }
 
 }  // namespace l6470emu

@@ -8,6 +8,7 @@
 
 #include "core/tick.hpp"
 #include "daisychain/chain.hpp"
+#include "spi/export_vcd.hpp"
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -18,8 +19,13 @@ struct EmulatedVcdOptions {
   Tick sample_ticks = ticks_from_us(10);    ///< while a chip moves, look at it this often
 };
 
-/// Writes `trace`, replayed through `chain` (fresh), as VCD to `out`. Throws TraceError
-/// for events naming chips outside the chain.
+/// Writes a trace, replayed through `chain` (fresh), as VCD to `out`. Throws TraceError
+/// for events naming chips outside the chain. Streams: it reads two passes side by side (the
+/// events, the next frame's time) and writes as it goes, so its memory does not grow with the
+/// trace (its output does, with the time the chips move: options.sample_ticks).
+void export_emulated_vcd(const TracePasses& passes, Chain& chain, std::ostream& out,
+                         const EmulatedVcdOptions& options = {});
+/// The same for a trace in memory.
 void export_emulated_vcd(const Trace& trace, Chain& chain, std::ostream& out, const EmulatedVcdOptions& options = {});
 
 }  // namespace l6470emu

@@ -1,6 +1,7 @@
 // umockdev .ioctl export: the format umockdev-spi.vala reads ("TW hex", " R hex", '#' comments).
 #include "spi/export_umockdev.hpp"
 
+#include <ios>
 #include <ostream>
 #include <string>
 
@@ -50,6 +51,7 @@ UmockdevExportStats export_umockdev_ioctl(TraceReader& in, std::ostream& out, st
       }
     }
     out << line;
+    if (!out) throw std::ios_base::failure("umockdev output: write failed");
   }
   return stats;
 }

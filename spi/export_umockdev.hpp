@@ -19,7 +19,8 @@ struct UmockdevExportStats {
 };
 
 /// Writes `in` as a umockdev .ioctl file for `device`: one "TW" transfer (with its " R"
-/// answer) per CS frame, everything else as '#' comments.
+/// answer) per CS frame, everything else as '#' comments. Streams (one event in memory at a
+/// time) and stops at the first write error: std::ios_base::failure once `out` has gone bad.
 UmockdevExportStats export_umockdev_ioctl(TraceReader& in, std::ostream& out,
                                           std::string_view device = "/dev/spidev0.0");
 

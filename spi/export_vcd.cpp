@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <map>
+#include <memory>
+#include <optional>
+#include <ios>
 #include <ostream>
 #include <stdexcept>
 
@@ -76,8 +79,7 @@ void VcdWriter::begin() {
   for (const Signal& s : signals_) put_value(s);
   buf_ += "$end\n";
   time_written_ = true;
-  out_ << buf_;
-  buf_.clear();
+  spill();
 }
 
 void VcdWriter::at(std::uint64_t time_ns) {
@@ -85,10 +87,7 @@ void VcdWriter::at(std::uint64_t time_ns) {
   std::uint64_t units = time_ns / timescale_;
   if (units < last_units_) units = last_units_;  // never backwards
   if (units != last_units_ || !time_written_) {
-    if (!buf_.empty()) {
-      out_ << buf_;
-      buf_.clear();
-    }
+    if (!buf_.empty()) spill();
     buf_ = '#';
     buf_ += std::to_string(units);
     buf_ += '\n';
@@ -104,6 +103,7 @@ void VcdWriter::change(std::uint64_t time_ns, int signal, std::int64_t value) {
   s.value = value;
   s.is_unknown = false;
   put_value(s);
+  if (buf_.size() >= kMaxBufferedBytes) spill();
 }
 
 void VcdWriter::unknown(std::uint64_t time_ns, int signal) {
@@ -112,6 +112,17 @@ void VcdWriter::unknown(std::uint64_t time_ns, int signal) {
   at(time_ns);
   s.is_unknown = true;
   put_value(s);
+  if (buf_.size() >= kMaxBufferedBytes) spill();
+}
+
+void VcdWriter::spill() {
+  out_ << buf_;
+  buf_.clear();
+  check_output();
+}
+
+void VcdWriter::check_output() const {
+  if (!out_) throw std::ios_base::failure("VCD output: write failed");
 }
 
 void VcdWriter::finish(std::uint64_t time_ns) {
@@ -173,32 +184,44 @@ TracePin vcd_pin(TracePin pin) { return pin == TracePin::SW_AXIS ? TracePin::SW 
 
 }  // namespace
 
-void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options) {
+NextFrameTicks::NextFrameTicks(std::unique_ptr<TraceReader> pass) : pass_(std::move(pass)) {
+  TraceEvent e;
+  while (pass_->next(e))
+    if (e.kind == TraceEventKind::frame) return;
+  done_ = true;
+}
+
+std::optional<Tick> NextFrameTicks::after_frame() {
+  TraceEvent e;
+  while (!done_ && pass_->next(e))
+    if (e.kind == TraceEventKind::frame) return e.tick;
+  done_ = true;
+  return std::nullopt;
+}
+
+void export_vcd(const TracePasses& passes, std::ostream& out, const VcdOptions& options) {
   VcdWriter w(out, options.timescale_ns);
   SpiVcdWaveform spi(w);
   // One wire per (chip, pin) that occurs, with the level of its first event as the initial one.
   std::map<std::pair<std::uint16_t, TracePin>, int> pins;
-  for (std::size_t i = 0; i < trace.size(); ++i) {
-    const TraceEvent e = trace[i];
-    if (e.kind != TraceEventKind::pin) continue;
-    const auto key = std::make_pair(e.chip, vcd_pin(e.pin));
-    if (!pins.count(key)) pins[key] = -1;
+  {
+    std::unique_ptr<TraceReader> first = passes();
+    TraceEvent e;
+    while (first->next(e))
+      if (e.kind == TraceEventKind::pin) pins.emplace(std::make_pair(e.chip, vcd_pin(e.pin)), -1);
   }
   for (auto& [key, id] : pins) {
     // Inputs idle high except STCK; outputs default to released.
     id = w.wire("chip" + std::to_string(key.first), to_string(key.second), key.second != TracePin::STCK);
   }
+  std::unique_ptr<TraceReader> events = passes();
+  NextFrameTicks next(passes());
   std::uint64_t end = 0;
-  for (std::size_t i = 0; i < trace.size(); ++i) {
-    const TraceEvent e = trace[i];
+  TraceEvent e;
+  while (events->next(e)) {
     if (e.kind == TraceEventKind::frame) {
-      std::uint64_t limit = 0;
-      for (std::size_t j = i + 1; j < trace.size(); ++j)
-        if (trace[j].kind == TraceEventKind::frame) {
-          limit = ns_from_ticks(trace[j].tick);
-          break;
-        }
-      end = std::max(end, spi.draw(e, limit));
+      const std::optional<Tick> limit = next.after_frame();
+      end = std::max(end, spi.draw(e, limit ? ns_from_ticks(*limit) : 0));
     } else if (e.kind == TraceEventKind::pin) {
       const std::uint64_t t = ns_from_ticks(e.tick);
       w.change(t, pins[{e.chip, vcd_pin(e.pin)}], e.value);
@@ -206,6 +229,10 @@ void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options
     }
   }
   w.finish(end + 1000);
+}
+
+void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options) {
+  export_vcd([&trace] { return trace.reader(); }, out, options);
 }
 
 }  // namespace l6470emu

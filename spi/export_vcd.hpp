@@ -4,7 +4,10 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -13,7 +16,8 @@
 
 namespace l6470emu {
 
-/// Writes a VCD file: declare every signal first, then changes in time order.
+/// Writes a VCD file: declare every signal first, then changes in time order. Once its stream
+/// has gone bad (a write error) the next write throws std::ios_base::failure.
 class VcdWriter {
  public:
   /// `timescale_ns` is the VCD time unit: 1, 10 or 100 ns (10 ns = sigrok reads it at 100 MHz).
@@ -49,6 +53,13 @@ class VcdWriter {
   void begin();
   void at(std::uint64_t time_ns);
   void put_value(const Signal& s);
+  /// Writes out the changes buffered at the current time (bounded: many signals changing at
+  /// one time, or times clamped to the last one, never pile up in memory).
+  void spill();
+  /// Throws std::ios_base::failure once the stream has gone bad (a full disk, a closed pipe):
+  /// an export stops at its first write error instead of drawing the rest into nothing.
+  void check_output() const;
+  static constexpr std::size_t kMaxBufferedBytes = std::size_t{1} << 16;
 
   std::ostream& out_;
   unsigned timescale_;
@@ -76,13 +87,36 @@ class SpiVcdWaveform {
   int cs_, sck_, mosi_, miso_;
 };
 
+/// A new pass over a trace's events, from the first (a file read again from its start, a
+/// Trace in memory): the exports read a trace more than once instead of holding it whole.
+using TracePasses = std::function<std::unique_ptr<TraceReader>()>;
+
+/// The CS falling edge of the frame after each frame, from a pass of its own that runs one
+/// frame ahead of the export's: what SpiVcdWaveform::draw takes as its limit, with no more
+/// of the trace in memory than that pass's current event.
+class NextFrameTicks {
+ public:
+  /// Reads `pass` up to its first frame.
+  explicit NextFrameTicks(std::unique_ptr<TraceReader> pass);
+  /// Called once per frame, in order: the tick of the frame after it; nothing after the last.
+  std::optional<Tick> after_frame();
+
+ private:
+  std::unique_ptr<TraceReader> pass_;
+  bool done_ = false;
+};
+
 /// VCD export options.
 struct VcdOptions {
   unsigned timescale_ns = 10;
 };
 
-/// Exports `trace`: the SPI wires, and for every chip that has pin events in the trace
-/// a wire per pin (SW, STCK, STBY, BUSY, FLAG). Times are the trace's ticks.
+/// Exports a trace: the SPI wires, and for every chip that has pin events in the trace
+/// a wire per pin (SW, STCK, STBY, BUSY, FLAG). Times are the trace's ticks. Streams: it
+/// reads three passes side by side (the pins, the events, the next frame's time) and writes as
+/// it reads, so its memory does not grow with the trace.
+void export_vcd(const TracePasses& passes, std::ostream& out, const VcdOptions& options = {});
+/// The same for a trace in memory.
 void export_vcd(const Trace& trace, std::ostream& out, const VcdOptions& options = {});
 
 /// Nanoseconds of a tick count.

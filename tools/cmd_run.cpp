@@ -38,6 +38,7 @@
 #include "tools/cmd_report.hpp"
 #include "tools/run_recordings.hpp"
 #include "tools/kernel_nodes.hpp"
+#include "tools/left_processes.hpp"
 #include "tools/output_check.hpp"
 #include "tools/xml_text.hpp"
 
@@ -172,19 +173,37 @@ bool spawn_program(const std::vector<std::string>& program, std::vector<std::str
   envp.push_back(nullptr);
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  // Whatever the program leaves running when it ends, setsid() grandchildren included, comes to
+  // this process to be ended (wait_for_program): a process group would not reach those.
+  adopt_orphans_from_now();
   const int error = posix_spawnp(&pid, argv[0], nullptr, attr, argv.data(), envp.data());
   if (error == 0) return true;
   std::cerr << "l6470emu run: cannot start " << program[0] << ": " << std::strerror(error) << "\n";
   return false;
 }
 
+void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config);
+
 // Waits for the program. In wall time a limit in simulated seconds is limit / scale seconds of
 // real time, after which run kills it. In any time, the wall-clock guard (--wall-timeout) ends a
 // program that waits where virtual time cannot see it (pause(), a read on its own pipe, a lock no
 // thread releases) or simply runs too long. A SIGINT or SIGTERM to run is passed on to the
 // program, which gets 5 s to end before SIGKILL; run then writes its reports with the program
-// marked as stopped.
+// marked as stopped. Once the program has ended, whatever it left running (its children and
+// their descendants, setsid() ones too: spawn_program made run their reaper) gets 2 s to end by
+// itself, then SIGTERM, then SIGKILL, and run says so in one line: the run is over only when
+// nothing of the program holds its output or the board any more. Chosen over watching the
+// output pipe, which a program writing to a file does not hold, and over a process group, which
+// setsid() leaves.
 void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config) {
+  wait_for_program_itself(run, timeout, config);
+  constexpr std::chrono::seconds kLeftGrace{2};
+  const LeftProcesses left = end_left_processes(kLeftGrace);
+  if (!left.running.empty()) std::cerr << "l6470emu run: " << left.line(kLeftGrace) << "\n";
+}
+
+// wait_for_program up to the end of the program itself.
+void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   std::optional<Clock::time_point> limit_at;

@@ -139,6 +139,9 @@ void add_trace_commands(CLI::App& app) {
   c->add_flag("--no-emulation", convert->no_emulation, "VCD: only the trace's own signals, no emulated BUSY/FLAG/ABS_POS");
   c->add_flag("--expand", convert->expand,
               "native: one line per frame (by default frames repeated at a constant period become 'repeat' lines)");
+  c->add_option("--max-output", convert->max_output,
+                "the most bytes the output may take, before compression (default 1G; K, M, G, T are powers of 1024; "
+                "0 = no limit): a conversion that would write more is refused before it starts");
   c->callback([convert] {
     // A reader that goes away (`convert -o - | head`) is a write error with a message and
     // exit status 2, not a silent death by SIGPIPE.

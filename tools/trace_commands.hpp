@@ -79,6 +79,9 @@ struct ConvertArgs {
   double sample_us = 10;        ///< VCD: how often moving chips are looked at
   bool no_emulation = false;    ///< VCD: only what the trace holds (no BUSY/FLAG/ABS_POS from the emulator)
   bool expand = false;          ///< native: one line per frame, no `repeat` lines
+  /// The most bytes the output may take (uncompressed), as --max-output takes it ("1G", "500M",
+  /// "0" = no limit): a conversion that would write more is refused before it starts.
+  std::string max_output = "1G";
 };
 /// `l6470emu convert`: 0, or 2 on bad input.
 int run_convert(const ConvertArgs& args, std::ostream& out, std::ostream& err);

@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -305,6 +306,47 @@ TEST_F(RunCommand, TheSameRunGivesTheSameHtmlPageByteForByte) {
   }
   EXPECT_FALSE(pages[0].empty());
   EXPECT_TRUE(pages[0] == pages[1]) << "two runs of one program give two different pages";
+}
+
+TEST_F(RunCommand, EndsWhatTheProgramLeftRunningSetsidGrandchildrenTooAndSaysSoInOneLine) {
+  // Three grandchildren in sessions of their own (setsid: out of the program's process group),
+  // holding run's standard output: one ends by itself within the grace period, one is ended by
+  // SIGTERM, one ignores SIGTERM and is ended by SIGKILL. Outside the preload, so that their
+  // sleeps take the host's time.
+  const std::string ends = path("ends.pid"), termed = path("termed.pid"), killed = path("killed.pid");
+  const std::string program = file(
+      "leaves.sh", "setsid /bin/sh -c 'echo $$ > " + ends + "; exec env -u LD_PRELOAD sleep 0.3' &\n"
+                   "setsid /bin/sh -c 'echo $$ > " + termed + "; exec env -u LD_PRELOAD sleep 60' &\n"
+                   "setsid /bin/sh -c 'trap \"\" TERM; echo $$ > " + killed + "; exec env -u LD_PRELOAD sleep 60' &\n"
+                   "while [ ! -s " + ends + " ] || [ ! -s " + termed + " ] || [ ! -s " + killed + " ]; do :; done\n");
+  // Through a pipe, as a CI job reads it: the reader sees its end when run returns, not 60 s later.
+  const std::string line = l6470emu_program() + " run --chain chips=L6470 -- /bin/sh " + program + " | cat";
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult r = run_program({"/bin/sh", "-c", line}, {}, 40);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::vector<pid_t> pids;
+  for (const std::string& f : {ends, termed, killed}) {
+    std::ifstream in(f);
+    pid_t pid = 0;
+    in >> pid;
+    pids.push_back(pid);
+  }
+  for (const pid_t pid : pids) {
+    EXPECT_GT(pid, 0);
+    if (pid > 0 && kill(pid, 0) == 0) {
+      ADD_FAILURE() << "process " << pid << " is still running";
+      kill(pid, SIGKILL);
+    }
+  }
+  EXPECT_LT(seconds, 20.0);
+  EXPECT_NE(r.status, 128 + SIGKILL) << r.err;
+  const std::string said = "l6470emu run: the program left 2 processes running (";
+  const std::size_t at = r.err.find(said);
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const std::string rest = r.err.substr(at, r.err.find('\n', at) - at);
+  EXPECT_NE(rest.find(std::to_string(pids[1]) + " sleep"), std::string::npos) << rest;
+  EXPECT_NE(rest.find(std::to_string(pids[2]) + " sleep"), std::string::npos) << rest;
+  EXPECT_NE(rest.find(") 2 s after it ended: ended them with SIGTERM, then SIGKILL"), std::string::npos) << rest;
 }
 
 TEST_F(RunCommand, TheProgramsOwnStatusEvenEightySixIsNotADeadlock) {

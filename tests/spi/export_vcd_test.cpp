@@ -49,6 +49,66 @@ TEST(VcdWriter, DeclaresWiresAndNumbersThenWritesChangesInTimeOrder) {
             "#10\n0!\nr7 \"\n#20\nx!\n#30\n");
 }
 
+/// A stream buffer that keeps nothing and remembers the longest piece it was handed at once.
+class LargestWrite : public std::streambuf {
+ public:
+  std::streamsize largest = 0, total = 0;
+
+ protected:
+  std::streamsize xsputn(const char*, std::streamsize n) override {
+    largest = std::max(largest, n);
+    total += n;
+    return n;
+  }
+  int_type overflow(int_type c) override {
+    largest = std::max<std::streamsize>(largest, 1);
+    ++total;
+    return traits_type::not_eof(c);
+  }
+};
+
+TEST(VcdWriter, HoldsAtMost64KiBOfChangesHoweverManyFallAtOneTime) {
+  LargestWrite sink;
+  std::ostream out(&sink);
+  VcdWriter w(out, 10);
+  const int a = w.wire("top", "A", false);
+  // A million changes at one time (times that go back are written at the last one).
+  w.change(1000, a, 1);
+  for (int i = 0; i < 1'000'000; ++i) w.change(500, a, i % 2 == 0 ? 0 : 1);
+  w.finish(2000);
+  EXPECT_GT(sink.total, 3'000'000);
+  EXPECT_LE(sink.largest, 65536 + 64);
+}
+
+TEST(VcdWriter, StopsAtTheFirstFailedWrite) {
+  std::ostringstream out;
+  VcdWriter w(out, 10);
+  const int a = w.wire("top", "A", false);
+  w.change(10, a, 1);
+  out.setstate(std::ios::badbit);
+  EXPECT_THROW(
+      {
+        for (int i = 0; i < 1'000'000; ++i) w.change(20 + 10 * static_cast<std::uint64_t>(i), a, i % 2);
+      },
+      std::ios_base::failure);
+}
+
+TEST(VcdExport, ReadsATraceAsPassesSideBySideAndWritesWhatItWroteFromMemory) {
+  // The streamed export (three passes of a reader) writes the same bytes as from a Trace.
+  const Trace t = session();
+  std::ostringstream from_memory, streamed;
+  export_vcd(t, from_memory);
+  int passes = 0;
+  export_vcd(
+      [&] {
+        ++passes;
+        return t.reader();
+      },
+      streamed);
+  EXPECT_EQ(streamed.str(), from_memory.str());
+  EXPECT_EQ(passes, 3);
+}
+
 TEST(SpiVcdWaveform, DrawsAFrameInMode3WithEightClocksPerByte) {
   std::ostringstream out;
   VcdWriter w(out, 1);

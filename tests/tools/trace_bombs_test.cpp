@@ -9,6 +9,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -32,7 +34,10 @@ struct Measured {
   long max_rss_kb = 0;   ///< ru_maxrss of the process
 };
 
-Measured run_measured(const std::vector<std::string>& args, rlim_t address_space = RLIM_INFINITY) {
+/// Runs l6470emu with `args`, its address space and the size of the files it writes limited
+/// (past `file_size`, a write fails with EFBIG instead of killing it with SIGXFSZ).
+Measured run_measured(const std::vector<std::string>& args, rlim_t address_space = RLIM_INFINITY,
+                      rlim_t file_size = RLIM_INFINITY) {
   TempDir dir;
   const std::string out_path = dir.file("out.txt");
   std::vector<std::string> argv = {L6470EMU_BINARY};
@@ -45,6 +50,11 @@ Measured run_measured(const std::vector<std::string>& args, rlim_t address_space
     if (address_space != RLIM_INFINITY) {
       const rlimit limit{address_space, address_space};
       setrlimit(RLIMIT_AS, &limit);
+    }
+    if (file_size != RLIM_INFINITY) {
+      const rlimit limit{file_size, file_size};
+      setrlimit(RLIMIT_FSIZE, &limit);
+      signal(SIGXFSZ, SIG_IGN);
     }
     const int fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
     dup2(fd, 1);
@@ -102,6 +112,69 @@ TEST(TraceBombs, ANativeRepeatLineAskingForATrillionFramesIsRefusedAtOnceByRepla
                      "Python; 0 = no limit)\n"
             : why;
     EXPECT_NE(m.out.find("l6470emu " + args[0] + ": " + expected), std::string::npos) << m.out;
+    EXPECT_LT(m.max_rss_kb, kBoundedKb);
+  }
+}
+
+// The finding (issue 35, 7): 6 KB of gzip, one 1 MiB frame on 256 chips repeated 1000 times;
+// `convert` to VCD held 2.1 GB (the whole trace in memory) and would have written ~240 GB.
+const std::string kMebibyteFrames = "mebibyte_frame_repeated.trace.gz";
+/// The address space a conversion of it is given (a sanitizer build's program cannot run under a limit).
+#if defined(L6470EMU_TEST_ASAN)
+constexpr rlim_t kConvertAddressSpace = RLIM_INFINITY;
+#else
+constexpr rlim_t kConvertAddressSpace = 512u << 20;
+#endif
+
+TEST(TraceBombs, AConversionThatWouldPassTheOutputLimitIsRefusedFromTheTracesCountsBeforeItWritesAByte) {
+  TempDir dir;
+  const std::string in = fixture_path(kMebibyteFrames);
+  ASSERT_LT(test::read_text(in).size(), 8000u);
+  const std::string mib = "1001 frames (1001.0 MiB of MOSI) would take ";
+  const std::string limit = "more than 1.0 GiB, the output limit (raise it with --max-output ";
+  struct Case {
+    std::vector<std::string> args;
+    std::string out, why;
+  };
+  for (const Case& c : std::vector<Case>{
+           {{"--no-emulation"}, "out.vcd", "VCD of " + mib + "at least 239.8 GiB, " + limit + "240G"},
+           {{}, "out.vcd", "VCD of " + mib + "at least 239.8 GiB, " + limit + "240G"},
+           {{"--expand"}, "out.trace", "expanded native text of " + mib + "5.9 GiB, " + limit + "6G"},
+           {{}, "out.ioctl.gz", "umockdev .ioctl of " + mib + "3.9 GiB, " + limit + "4G"},
+           {{"--max-output", "3G"}, "out.ioctl", "umockdev .ioctl of " + mib + "3.9 GiB, more than 3.0 GiB, the output "
+                                                "limit (raise it with --max-output 4G"}}) {
+    std::vector<std::string> args = {"convert", in, "-o", dir.file(c.out)};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    // Limited all the same, so that a program that did not refuse could not fill the disk.
+    const Measured m = run_measured(args, kConvertAddressSpace, 64u << 20);
+    EXPECT_EQ(m.status, 2) << c.out << "\n" << m.out;
+    EXPECT_EQ(m.out, "l6470emu convert: " + dir.file(c.out) + ": " + c.why + "; 0 = no limit)\n");
+    EXPECT_NE(access(dir.file(c.out).c_str(), F_OK), 0) << c.out << " was written";
+    EXPECT_LT(m.max_rss_kb, kBoundedKb);
+  }
+  // Compact native text is what the trace is: 12 MB, written.
+  const Measured m = run_measured({"convert", in, "-o", dir.file("out.trace")});
+  EXPECT_EQ(m.status, 0) << m.out;
+  EXPECT_LT(m.max_rss_kb, kBoundedKb);
+}
+
+TEST(TraceBombs, ConvertingTheMebibyteFramesWithNoOutputLimitStreamsInBoundedMemoryUpToAFailedWrite) {
+#if defined(L6470EMU_TEST_ASAN)
+  GTEST_SKIP() << "a sanitizer build's program cannot run under an address-space limit";
+#endif
+  // Allowed to write, each conversion fills the 32 MiB the files may take and fails there with
+  // one line; its memory stays that of one frame, never the trace's gigabytes (the address
+  // space it is given is a quarter of the trace).
+  TempDir dir;
+  const std::string in = fixture_path(kMebibyteFrames);
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--no-emulation"}, {}}) {
+    std::vector<std::string> args = {"convert", in, "-o", dir.file("out.vcd"), "--max-output", "0"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const Measured m = run_measured(args, 256u << 20, 32u << 20);
+    EXPECT_EQ(m.status, 2) << m.out;
+    EXPECT_NE(m.out.find("l6470emu convert: " + dir.file("out.vcd") + ": write failed: File too large\n"),
+              std::string::npos)
+        << m.out;
     EXPECT_LT(m.max_rss_kb, kBoundedKb);
   }
 }

@@ -245,6 +245,72 @@ TEST(ConvertCommand, NamesWhereItWasWritingWhenAWriteFails) {
   EXPECT_EQ(r.out, "l6470emu convert: standard output: write failed: No space left on device\n");
 }
 
+TEST(ConvertCommand, StopsAVcdAtItsFirstFailedWrite) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "no /dev/full";
+  const std::string in = fixture_path("polling_host.trace");
+  RunResult r = l6470emu("convert --to vcd " + in + " -o /dev/full");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: /dev/full: write failed: No space left on device\n");
+  r = run_command("{ " + std::string(L6470EMU_BINARY) + " convert --to vcd --no-emulation " + in + " -o - >/dev/full; }");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "l6470emu convert: standard output: write failed: No space left on device\n");
+}
+
+TEST(ConvertCommand, StopsAnEmulatedVcdAtTheOutputLimitWhenTheMotorsSamplesPassIt) {
+  // The wires of polling_host.trace take at least 1.5 MiB of VCD; the emulated chain's samples
+  // of its move (not told by the trace's counts) make it 2.3 MiB.
+  test::TempDir dir;
+  const std::string out = dir.file("p.vcd");
+  const RunResult r = l6470emu("convert " + fixture_path("polling_host.trace") + " -o " + out + " --max-output 2M");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out, "l6470emu convert: " + out +
+                       ": stopped at 2.0 MiB, the output limit: what was written is incomplete (raise it with "
+                       "--max-output SIZE; 0 = no limit)\n");
+  EXPECT_EQ(test::read_text(out).size(), 2u << 20);
+  EXPECT_EQ(l6470emu("convert " + fixture_path("polling_host.trace") + " -o " + out + " --max-output 3M").status, 0);
+  EXPECT_EQ(l6470emu("convert " + fixture_path("polling_host.trace") + " -o " + out + " --max-output 0").status, 0);
+}
+
+TEST(ConvertCommand, TakesMaxOutputInBytesOrBinaryUnitsAndRefusesAnythingElseInOneLine) {
+  test::TempDir dir;
+  const std::string in = fixture_path("single_chip.trace");
+  for (const char* ok : {"100000", "1G", "500M", "0.5g", "64KiB", "2TB", "0"})
+    EXPECT_EQ(l6470emu("convert " + in + " -o " + dir.file("o.ioctl") + " --max-output " + ok).status, 0) << ok;
+  for (const char* bad : {"x", "-1", "10Q", "1.5.2", "99999999999999999999"}) {
+    const RunResult r = l6470emu("convert " + in + " -o " + dir.file("o.ioctl") + " --max-output " + bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_EQ(r.out, "l6470emu convert: --max-output: '" + std::string(bad) +
+                         "' is not a size: bytes, or a number with K, M, G or T (500M, 10G); 0 = no limit\n")
+        << bad;
+  }
+  const RunResult r = l6470emu("convert " + in + " -o " + dir.file("o.ioctl") + " --max-output 100");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.out.find("more than 100 bytes, the output limit (raise it with --max-output 1M; 0 = no limit)\n"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(ConvertCommand, NeverWritesOverItsInput) {
+  test::TempDir dir;
+  const std::string original = test::fixture("polling_host.trace");
+  const std::string in = dir.write("p.trace", original);
+  ASSERT_EQ(::link(in.c_str(), dir.file("same.trace").c_str()), 0);
+  for (const std::string& out : {in, dir.file("same.trace")})
+    for (const char* opts : {"", " --expand", " --to vcd", " --to ioctl"}) {
+      const RunResult r = l6470emu("convert " + in + " -o " + out + opts);
+      EXPECT_EQ(r.status, 2) << out << opts;
+      EXPECT_EQ(r.out, "l6470emu convert: cannot write " + out + ": it is one of the inputs (" + in +
+                           "): an output never overwrites an input\n")
+          << opts;
+      EXPECT_EQ(test::read_text(in), original) << out << opts;
+    }
+  // Nor the board description it was given.
+  const std::string board = dir.write("b.board", "chips=2*L6470\n");
+  const RunResult r = l6470emu("convert " + in + " --board " + board + " -o " + board);
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(test::read_text(board), "chips=2*L6470\n");
+}
+
 TEST(ConvertCommand, SaysSoInOneLineWhenItsReaderGoesAway) {
   test::TempDir dir;
   // The reader takes 10 bytes of a 100 kB output and closes the pipe.
