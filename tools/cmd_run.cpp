@@ -197,6 +197,7 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
 // setsid() leaves.
 void wait_for_program(ProgramEnd& run, std::optional<Tick> timeout, const BoardConfig& config) {
   wait_for_program_itself(run, timeout, config);
+  if (run.progress) run.progress->finish();
   constexpr std::chrono::seconds kLeftGrace{2};
   const LeftProcesses left = end_left_processes(kLeftGrace);
   if (!left.running.empty()) std::cerr << "l6470emu run: " << left.line(kLeftGrace) << "\n";

@@ -41,7 +41,7 @@ std::unique_ptr<RunProgressLine> RunProgressLine::on_terminal() {
 RunProgressLine::RunProgressLine(std::string path, void* page) : path_(std::move(path)), page_(page) {}
 
 RunProgressLine::~RunProgressLine() {
-  if (drawn_) std::cerr << "\r\033[K" << std::flush;
+  finish();
   munmap(page_, kRunProgressBytes);
   unlink(path_.c_str());
 }
@@ -53,7 +53,14 @@ RunProgress RunProgressLine::read() const {
   return RunProgress{w[0].load(std::memory_order_relaxed), w[1].load(std::memory_order_relaxed)};
 }
 
+void RunProgressLine::finish() {
+  if (drawn_) std::cerr << "\r\033[K" << std::flush;
+  drawn_ = false;
+  finished_ = true;
+}
+
 void RunProgressLine::update() {
+  if (finished_) return;
   using namespace std::chrono;
   const auto now = steady_clock::now();
   if (now - start_ < seconds(2) || now - last_ < milliseconds(500)) return;

@@ -32,6 +32,8 @@ class RunProgressLine {
   RunProgress read() const;
   /// Draws the line once 2 s of wall time have passed, then at most every 500 ms.
   void update();
+  /// Takes the line off the screen for good (the program ended: run's own lines follow).
+  void finish();
 
  private:
   RunProgressLine(std::string path, void* page);
@@ -40,6 +42,7 @@ class RunProgressLine {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_{};
   bool drawn_ = false;
+  bool finished_ = false;
 };
 
 }  // namespace l6470emu
