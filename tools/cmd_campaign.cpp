@@ -42,6 +42,7 @@
 #include "spi/trace.hpp"
 #include "tools/campaign_plan.hpp"
 #include "tools/cli_errors.hpp"
+#include "tools/left_processes.hpp"
 #include "tools/output_check.hpp"
 #include "tools/campaign_report.hpp"
 #include "tools/cmd_report.hpp"
@@ -447,6 +448,10 @@ int CampaignCommand::run_campaign() {
   clean_argv.insert(clean_argv.end(), {"--record", clean_trace, "--outcome", clean_outcome, "--"});
   clean_argv.insert(clean_argv.end(), program_.begin(), program_.end());
   Watchdog watchdog;
+  // A run ended whole at the wall-clock limit or by a stop (SIGKILL to its group) cannot end what
+  // its program left in sessions of their own (setsid): those come to the campaign, which ends
+  // them once the reruns are over.
+  adopt_orphans_from_now();
   std::cerr << "l6470emu campaign: the clean run\n";
   const Ended clean_end = run_process(clean_argv, "", wall_timeout_s_);
   if (g_stop.load()) return 128 + g_stop.load();
@@ -757,7 +762,8 @@ int CampaignCommand::run_campaign() {
     for (auto& t : readers) t.join();
     const std::size_t from_snapshots = ended_reruns.size();
     if (from_snapshots < mine.size() && first_reason.empty())
-      first_reason = "the program never took the snapshots' plan: a firmware program, or one the preload does not reach";
+      first_reason = "the program's first process took no snapshot: a firmware program, a shell around the driver that "
+                     "ends by _exit(), or a program the preload does not reach";
     std::cerr << "l6470emu campaign: " << from_snapshots << " of " << mine.size() << " reruns forked from snapshots"
               << (from_snapshots < mine.size() && !first_reason.empty() ? " (not the others: " + first_reason + ")" : "")
               << "\n";
@@ -770,6 +776,13 @@ int CampaignCommand::run_campaign() {
       for (std::size_t i; !g_stop.load() && (i = next++) < todo.size();) one(todo[i]);
     });
   for (auto& t : workers) t.join();
+  if (const LeftProcesses left = end_left_processes(std::chrono::milliseconds(0)); !left.running.empty()) {
+    std::string names;
+    for (const std::string& r : left.running) names += (names.empty() ? "" : ", ") + r;
+    std::cerr << "l6470emu campaign: ended with " << (left.killed ? "SIGTERM, then SIGKILL, " : "SIGTERM ")
+              << left.running.size() << " process" << (left.running.size() == 1 ? "" : "es")
+              << " that reruns ended at a limit left running (" << names << ")\n";
+  }
   if (tty) std::cerr << "\n";
 
   // 5. The report.

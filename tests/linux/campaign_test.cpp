@@ -313,6 +313,32 @@ while not status() & 0x0002:
   EXPECT_EQ(rerun(Json::parse(read(path("yes/c.json"))), "ocd", "during_motion")["verdict"], "hang");
 }
 
+TEST_F(Campaign, WhatARerunEndedAtItsWallClockLimitLeftRunningInASessionOfItsOwnIsEndedToo) {
+  // The rerun starts a shell in a session of its own (setsid: no signal to the rerun's process
+  // group reaches it), then blocks where virtual time cannot see; the wall-clock limit ends it.
+  const std::string script = path("driver.sh");
+  // (A shell that waits on a FIFO: a sleep would end at once, in virtual time.)
+  std::ofstream(script) << "\"$1\" careless || exit $?\n"
+                           "if grep -q fault \"$L6470EMU_SCENARIO\"; then\n"
+                           "  mkfifo \"$2/held.$$\"\n"
+                           "  setsid sh -c 'echo $$ > \"$1\"; read x < \"$2\"' sh \"$2/left.$$\" \"$2/held.$$\" &\n"
+                           "  mkfifo \"$2/fifo.$$\"; read x < \"$2/fifo.$$\"\nfi\n";
+  const RunResult r = run_program({l6470emu_program(), "campaign", "--chain", "chips=L6470 check=warn", "--faults", "ocd", "--at",
+                                   "during_motion", "--wall-timeout", "2", "--json", path("c.json"), "--", "/bin/sh",
+                                   script, client("campaign_driver"), dir_.string()},
+                                  {}, 120);
+  EXPECT_EQ(r.status, 1) << r.err;  // the rerun: hang
+  EXPECT_NE(r.err.find("that reruns ended at a limit left running"), std::string::npos) << r.err;
+  int left = 0;
+  for (const auto& e : fs::directory_iterator(dir_))
+    if (e.path().filename().string().rfind("left.", 0) == 0) {
+      ++left;
+      const pid_t pid = std::stoi(read(e.path().string()));
+      EXPECT_NE(kill(pid, 0), 0) << "the setsid shell " << pid << " still runs";
+    }
+  EXPECT_EQ(left, 1);
+}
+
 TEST_F(Campaign, StoppedBySigtermItWritesTheReportsMarkedIncomplete) {
   // The reruns block where virtual time cannot see (a FIFO nobody opens); the clean run does not.
   const std::string script = path("driver.sh");
