@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# What recording costs (issue 25): the same virtual-time run unrecorded, recorded into a plain
-# trace and into a .trace.gz, side by side in alternating runs, for a C client (one-byte NOP
+# What recording costs (issues 25 and 34): the same virtual-time run unrecorded, recorded into a
+# plain trace and into a .trace.gz, side by side in alternating runs, for a C client (one-byte NOP
 # messages: bench/preload_roundtrips.c; its trace is a few repeat lines) and a polling Python
 # client (python3-spidev: a Move, then 100 000 polls of GetStatus and GetParam(ABS_POS), one
-# xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames). Prints each run's
+# xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames)
+# under the preload, and a firmware program (bench/recording_poll: an Arduino sketch polling two
+# daisy-chained L6470s with GetStatus for 57 s of virtual time, a few repeat lines of 999 999
+# repetitions; L6470EMU_TRACE as for any firmware program). Prints each run's
 # CPU time (user + system, to the microsecond, best of RUNS), the time per frame and the ratio recorded/unrecorded
 # (goal: at most 1.25), then the .gz recording's size against `gzip -6` of the plain one
 # (goal: at most 1.2x). With valgrind installed it then counts the instructions per frame of
@@ -18,8 +21,9 @@ runs=${2:-3}
 build=$(cd "$build" && pwd)
 client=$build/bench/l6470emu_preload_roundtrips
 preload=$build/libl6470emu-preload.so
+firmware=$build/bench/l6470emu_recording_poll
 python=/usr/bin/python3
-for f in "$client" "$preload"; do
+for f in "$client" "$preload" "$firmware"; do
   [ -e "$f" ] || { echo "recording_bench: $f is missing; build the l6470emu_benchmarks target" >&2; exit 1; }
 done
 work=$(mktemp -d)
@@ -44,6 +48,7 @@ cpu_seconds() {
   local trace=$1; shift
   rm -f "$trace"
   local env=(L6470EMU_CHAIN="$chain" LD_PRELOAD="$preload")
+  [ "$1" = "$firmware" ] && env=()  # a firmware program: its own board, no preload
   [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
   "$python" - "${env[@]}" -- "$@" <<'PY'
 import os, sys
@@ -102,6 +107,14 @@ if "$python" -c 'import spidev' 2>/dev/null; then
 else
   echo "Python client: skipped ($python has no spidev module; Debian: python3-spidev)"
 fi
+# The firmware program's frames, from its trace: a frame line is one, a repeat line its group
+# times its count (an open line: "repeat K frames every Pus times N"; closed: "repeat K frames N times").
+fw_frames=$(L6470EMU_TRACE="$work/count.trace" "$firmware" >/dev/null && awk '
+  $2 == "frame" { n += 1 }
+  $2 == "repeat" && $5 == "every" { n += $3 * $NF }
+  $2 == "repeat" && $5 != "every" { n += $3 * $5 }
+  END { print n }' "$work/count.trace")
+bench "Firmware (Arduino GetStatus)" "${fw_frames:-0}" "$firmware"
 
 # instructions NAME FRAMES BASE_ARG FULL_ARG COMMAND... (the frame count argument last): the
 # instructions per frame, unrecorded and recorded, each run once with BASE_ARG and once with
