@@ -287,6 +287,8 @@ class Board {
   SpiDevice& spi_of(ChainState& c);
   void apply_input(ChainState& c, std::size_t chip, Pin pin, bool level);
   void record_outputs(ChainState& c);
+  /// A recording whose file failed: said once in the log, and the chain goes on without it.
+  void drop_failed_recording(ChainState& c);
   bool change_axis(std::size_t chain, std::size_t chip, bool needs_axis,
                    const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
                    const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);

@@ -46,7 +46,7 @@ class MappedOutput final : public TraceOutput {
   void append(std::string_view text) override {
     if (fd_ < 0) throw std::runtime_error(path_ + ": write after close");
     if (text.empty()) return;
-    reserve(size_ + text.size() + 1);
+    if (size_ + text.size() + 1 > capacity_) reserve(size_ + text.size() + 1);
     char* at = map_ + size_;
     // The rest of the text and the zero byte after it first, the first byte last: a reader (or a
     // kill) sees the whole text or none of it.
