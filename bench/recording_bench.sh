@@ -107,13 +107,16 @@ if "$python" -c 'import spidev' 2>/dev/null; then
 else
   echo "Python client: skipped ($python has no spidev module; Debian: python3-spidev)"
 fi
-# The firmware program's frames, from its trace: a frame line is one, a repeat line its group
+# count_frames TRACE: the frames of a plain trace: a frame line is one, a repeat line its group
 # times its count (an open line: "repeat K frames every Pus times N"; closed: "repeat K frames N times").
-fw_frames=$(L6470EMU_TRACE="$work/count.trace" "$firmware" >/dev/null && awk '
-  $2 == "frame" { n += 1 }
-  $2 == "repeat" && $5 == "every" { n += $3 * $NF }
-  $2 == "repeat" && $5 != "every" { n += $3 * $5 }
-  END { print n }' "$work/count.trace")
+count_frames() {
+  awk '
+    $2 == "frame" { n += 1 }
+    $2 == "repeat" && $5 == "every" { n += $3 * $NF }
+    $2 == "repeat" && $5 != "every" { n += $3 * $5 }
+    END { print n }' "$1"
+}
+fw_frames=$(L6470EMU_TRACE="$work/count.trace" "$firmware" >/dev/null && count_frames "$work/count.trace")
 bench "Firmware (Arduino GetStatus)" "${fw_frames:-0}" "$firmware"
 
 # instructions NAME FRAMES BASE_ARG FULL_ARG COMMAND... (the frame count argument last): the
@@ -150,3 +153,25 @@ instructions "C client (NOP messages)" 100000 0 100000 "$client" /dev/spidev0.0
 if "$python" -c 'import spidev' 2>/dev/null; then
   instructions "Python client (GetStatus)" 35000 0 5000 "$python" "$work/poll.py"
 fi
+# The firmware program stopped at 1 s and at 3 s of virtual time (limit=), its own board otherwise.
+fw_count() {
+  local trace=$1 limit=$2
+  rm -f "$trace"
+  local env=(L6470EMU_CHAIN="chips=2xL6470 cs_pin=D10 limit=$limit")
+  [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
+  env "${env[@]}" valgrind --tool=cachegrind --cache-sim=no --branch-sim=no --cachegrind-out-file=/dev/null \
+    "$firmware" 2>&1 >/dev/null | awk '/I *refs:/ { gsub(",", "", $NF); print $NF }' | tail -1
+}
+fw_n0=$(fw_count "" 1s)
+fw_n1=$(fw_count "" 3s)
+fw_p0=$(fw_count "$work/f1.trace" 1s)
+fw_f0=$(count_frames "$work/f1.trace")
+fw_p1=$(fw_count "$work/f3.trace" 3s)
+fw_f1=$(count_frames "$work/f3.trace")
+fw_g0=$(fw_count "$work/f1.trace.gz" 1s)
+fw_g1=$(fw_count "$work/f3.trace.gz" 3s)
+awk -v name="Firmware (Arduino GetStatus)" -v f="$((fw_f1 - fw_f0))" -v n0="$fw_n0" -v n1="$fw_n1" -v p0="$fw_p0" \
+    -v p1="$fw_p1" -v g0="$fw_g0" -v g1="$fw_g1" 'BEGIN {
+  n = (n1 - n0) / f; p = (p1 - p0) / f; g = (g1 - g0) / f
+  printf "%-28s %9d frames  unrecorded %7.0f instructions/frame, plain %7.0f: ratio %.2f, .gz %7.0f: ratio %.2f\n", name, f, n, p, p / n, g, g / n
+}'
