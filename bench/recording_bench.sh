@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
-# What recording costs (issue 25): the same virtual-time run unrecorded, recorded into a plain
-# trace and into a .trace.gz, side by side in alternating runs, for a C client (one-byte NOP
+# What recording costs (issues 25 and 34): the same virtual-time run unrecorded, recorded into a
+# plain trace and into a .trace.gz, side by side in alternating runs, for a C client (one-byte NOP
 # messages: bench/preload_roundtrips.c; its trace is a few repeat lines) and a polling Python
 # client (python3-spidev: a Move, then 100 000 polls of GetStatus and GetParam(ABS_POS), one
-# xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames). Prints each run's
+# xfer2 call per byte as most drivers do; the position changes, so the trace is mostly frames)
+# under the preload, and a firmware program (bench/recording_poll: an Arduino sketch polling two
+# daisy-chained L6470s with GetStatus for 57 s of virtual time, a few repeat lines of 999 999
+# repetitions; L6470EMU_TRACE as for any firmware program). Prints each run's
 # CPU time (user + system, to the microsecond, best of RUNS), the time per frame and the ratio recorded/unrecorded
 # (goal: at most 1.25), then the .gz recording's size against `gzip -6` of the plain one
 # (goal: at most 1.2x). With valgrind installed it then counts the instructions per frame of
@@ -18,8 +21,9 @@ runs=${2:-3}
 build=$(cd "$build" && pwd)
 client=$build/bench/l6470emu_preload_roundtrips
 preload=$build/libl6470emu-preload.so
+firmware=$build/bench/l6470emu_recording_poll
 python=/usr/bin/python3
-for f in "$client" "$preload"; do
+for f in "$client" "$preload" "$firmware"; do
   [ -e "$f" ] || { echo "recording_bench: $f is missing; build the l6470emu_benchmarks target" >&2; exit 1; }
 done
 work=$(mktemp -d)
@@ -44,6 +48,7 @@ cpu_seconds() {
   local trace=$1; shift
   rm -f "$trace"
   local env=(L6470EMU_CHAIN="$chain" LD_PRELOAD="$preload")
+  [ "$1" = "$firmware" ] && env=()  # a firmware program: its own board, no preload
   [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
   "$python" - "${env[@]}" -- "$@" <<'PY'
 import os, sys
@@ -102,6 +107,17 @@ if "$python" -c 'import spidev' 2>/dev/null; then
 else
   echo "Python client: skipped ($python has no spidev module; Debian: python3-spidev)"
 fi
+# count_frames TRACE: the frames of a plain trace: a frame line is one, a repeat line its group
+# times its count (an open line: "repeat K frames every Pus times N"; closed: "repeat K frames N times").
+count_frames() {
+  awk '
+    $2 == "frame" { n += 1 }
+    $2 == "repeat" && $5 == "every" { n += $3 * $NF }
+    $2 == "repeat" && $5 != "every" { n += $3 * $5 }
+    END { print n }' "$1"
+}
+fw_frames=$(L6470EMU_TRACE="$work/count.trace" "$firmware" >/dev/null && count_frames "$work/count.trace")
+bench "Firmware (Arduino GetStatus)" "${fw_frames:-0}" "$firmware"
 
 # instructions NAME FRAMES BASE_ARG FULL_ARG COMMAND... (the frame count argument last): the
 # instructions per frame, unrecorded and recorded, each run once with BASE_ARG and once with
@@ -137,3 +153,25 @@ instructions "C client (NOP messages)" 100000 0 100000 "$client" /dev/spidev0.0
 if "$python" -c 'import spidev' 2>/dev/null; then
   instructions "Python client (GetStatus)" 35000 0 5000 "$python" "$work/poll.py"
 fi
+# The firmware program stopped at 1 s and at 3 s of virtual time (limit=), its own board otherwise.
+fw_count() {
+  local trace=$1 limit=$2
+  rm -f "$trace"
+  local env=(L6470EMU_CHAIN="chips=2xL6470 cs_pin=D10 limit=$limit")
+  [ -n "$trace" ] && env+=(L6470EMU_TRACE="$trace")
+  env "${env[@]}" valgrind --tool=cachegrind --cache-sim=no --branch-sim=no --cachegrind-out-file=/dev/null \
+    "$firmware" 2>&1 >/dev/null | awk '/I *refs:/ { gsub(",", "", $NF); print $NF }' | tail -1
+}
+fw_n0=$(fw_count "" 1s)
+fw_n1=$(fw_count "" 3s)
+fw_p0=$(fw_count "$work/f1.trace" 1s)
+fw_f0=$(count_frames "$work/f1.trace")
+fw_p1=$(fw_count "$work/f3.trace" 3s)
+fw_f1=$(count_frames "$work/f3.trace")
+fw_g0=$(fw_count "$work/f1.trace.gz" 1s)
+fw_g1=$(fw_count "$work/f3.trace.gz" 3s)
+awk -v name="Firmware (Arduino GetStatus)" -v f="$((fw_f1 - fw_f0))" -v n0="$fw_n0" -v n1="$fw_n1" -v p0="$fw_p0" \
+    -v p1="$fw_p1" -v g0="$fw_g0" -v g1="$fw_g1" 'BEGIN {
+  n = (n1 - n0) / f; p = (p1 - p0) / f; g = (g1 - g0) / f
+  printf "%-28s %9d frames  unrecorded %7.0f instructions/frame, plain %7.0f: ratio %.2f, .gz %7.0f: ratio %.2f\n", name, f, n, p, p / n, g, g / n
+}'

@@ -250,8 +250,10 @@ class Board {
   /// flag is inject_fault's business), recorded. False for a bad index or a chip without an axis.
   bool set_axis_supply(std::size_t chain, std::size_t chip, std::uint32_t supply_mV);
   /// Opens the output of a recording at `path` (throws std::runtime_error with one line when it
-  /// cannot). A front brings its own (linux/: a memory-mapped file); the default writes through
-  /// stdio and zlib (spi/trace_output.hpp).
+  /// cannot). The default is open_recording_output without a clock (spi/recording_output.hpp: a
+  /// plain file through a shared mapping, no system call per event; a gzip file flushed by size),
+  /// what a firmware program in virtual time records through; a front may bring its own
+  /// (linux/: the same, after its path checks, with gzip flushes by host time too).
   using TraceOutputOpener = std::function<std::unique_ptr<TraceOutput>(const std::string& path)>;
   /// Sets how recordings open their files (an empty function: the default). For recordings
   /// started after the call.
@@ -285,6 +287,8 @@ class Board {
   SpiDevice& spi_of(ChainState& c);
   void apply_input(ChainState& c, std::size_t chip, Pin pin, bool level);
   void record_outputs(ChainState& c);
+  /// A recording whose file failed: said once in the log, and the chain goes on without it.
+  void drop_failed_recording(ChainState& c);
   bool change_axis(std::size_t chain, std::size_t chip, bool needs_axis,
                    const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
                    const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);

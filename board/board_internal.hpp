@@ -47,4 +47,12 @@ struct Board::ChainState {
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 
+// Inline: it runs after every step of a chain's time and every transfer, recorded or not.
+inline void Board::record_outputs(ChainState& c) {
+  if (!c.recorder) return;
+  c.recorder->observe_outputs();  // free when nothing changed since the last look
+  if (!c.recorder->error().empty()) [[unlikely]]
+    drop_failed_recording(c);
+}
+
 }  // namespace l6470emu

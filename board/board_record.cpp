@@ -26,14 +26,10 @@ void Board::apply_input(ChainState& c, std::size_t chip, Pin pin, bool level) {
   if (pin == Pin::STBY_RST) ch.set_stby_rst_pin(level);
 }
 
-void Board::record_outputs(ChainState& c) {
-  if (!c.recorder) return;
-  c.recorder->observe_outputs();  // free when nothing changed since the last look
-  if (!c.recorder->error().empty()) {
-    // The file failed (disk full, removed device): say so once and go on without it.
-    log_(c.name + ": trace recording stopped: " + c.recorder->error());
-    c.recorder.reset();
-  }
+void Board::drop_failed_recording(ChainState& c) {
+  // The file failed (disk full, removed device): say so once and go on without it.
+  log_(c.name + ": trace recording stopped: " + c.recorder->error());
+  c.recorder.reset();
 }
 
 bool Board::inject_fault(std::size_t chain, std::size_t chip, TraceFault fault, std::uint8_t value) {
@@ -201,10 +197,7 @@ void Board::flush_recordings() {
   for (auto& c : chains_)
     if (c->recorder) {
       c->recorder->flush_if_due();
-      if (!c->recorder->error().empty()) {
-        log_(c->name + ": trace recording stopped: " + c->recorder->error());
-        c->recorder.reset();
-      }
+      if (!c->recorder->error().empty()) drop_failed_recording(*c);
     }
 }
 

@@ -3,6 +3,7 @@
 
 #include <exception>
 
+#include "spi/recording_output.hpp"
 #include "spi/trace_file.hpp"
 #include "spi/trace_native.hpp"
 
@@ -44,7 +45,7 @@ std::unique_ptr<ChainTraceRecorder> ChainTraceRecorder::open(
     Chain& chain, const std::string& path, const std::string& board,
     const std::function<std::unique_ptr<TraceOutput>(const std::string&)>& open_output, std::string& error) noexcept {
   try {
-    auto sink = std::make_unique<Sink>(open_output ? open_output(path) : open_trace_file_output(path));
+    auto sink = std::make_unique<Sink>(open_output ? open_output(path) : open_recording_output(path));
     std::unique_ptr<ChainTraceRecorder> r(new ChainTraceRecorder(chain, std::move(sink), path, board));
     if (!r->error().empty()) {
       error = r->error();

@@ -1,6 +1,7 @@
 // Recording one chain of the board into a native trace (docs/trace-format.md): a
-// RecordingChain over the chain and a NativeTraceWriter on an output the front chose (a
-// memory-mapped file, stdio), event by event, so a killed process leaves a complete file.
+// RecordingChain over the chain and a NativeTraceWriter on a recording output (a memory-mapped
+// file, a gzip file: spi/recording_output.hpp), event by event, so a killed process leaves a
+// complete file.
 // Never throws after it is open: a write error stops the recording and is reported once.
 // Knows nothing of spidev, gpio or file descriptors; the Board drives it.
 #pragma once
@@ -20,9 +21,10 @@ namespace l6470emu {
 /// A native trace being recorded from one chain. Single-threaded: its owner (the Board) serialises every call.
 class ChainTraceRecorder {
  public:
-  /// Opens the output of `path` with `open_output` (the default stdio/zlib one when empty) and
-  /// writes the header: the chain, its board description `board` (`board` lines), and the
-  /// BUSY/FLAG levels. Returns nullptr and sets `error` (one line) when that fails.
+  /// Opens the output of `path` with `open_output` (open_recording_output without a clock when
+  /// empty: mapped when plain, gzip flushed by size) and writes the header: the chain, its board
+  /// description `board` (`board` lines), and the BUSY/FLAG levels. Returns nullptr and sets
+  /// `error` (one line) when that fails.
   static std::unique_ptr<ChainTraceRecorder> open(
       Chain& chain, const std::string& path, const std::string& board,
       const std::function<std::unique_ptr<TraceOutput>(const std::string&)>& open_output, std::string& error) noexcept;

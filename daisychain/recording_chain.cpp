@@ -67,6 +67,18 @@ void RecordingChain::advance_to(Tick tick) {
     chain_.advance_to(tick);
     return;
   }
+  if (observed_at_ != kNever && tick <= quiet_until_) {
+    // The usual case, on every call of a polling host: the last look's levels hold up to
+    // `tick` (what observe_outputs() and the loop below would find at once), in a function
+    // small enough to save no registers.
+    chain_.advance_to(tick);
+    observed_at_ = tick;
+    return;
+  }
+  advance_observing(tick);
+}
+
+[[gnu::noinline]] void RecordingChain::advance_observing(Tick tick) {
   observe_outputs();  // what is recorded is the levels now
   // Step from change to change so that each is recorded at the tick it happens. A look ahead
   // that finds nothing up to quiet_until_ holds until something is done to the chain.
@@ -142,24 +154,31 @@ std::uint8_t RecordingChain::exchange(std::uint8_t mosi) {
   return miso;
 }
 
-void RecordingChain::keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx) {
-  // Into buffers that only ever grow (most frames are a few bytes: a plain loop).
+inline void RecordingChain::keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx) {
+  // Into buffers that only ever grow. Most frames are a few bytes, clocked a byte at a time: a
+  // plain loop here, inlined where the bytes come in; the rest out of line.
+  const std::size_t at = frame_bytes_, n = tx.size();
+  if (n > 16 || at + n > tx_.size()) [[unlikely]] {
+    keep_long(tx, rx);
+    return;
+  }
+  std::uint8_t* t = tx_.data() + at;
+  std::uint8_t* r = rx_.data() + at;
+  for (std::size_t i = 0; i < n; ++i) {
+    t[i] = tx[i];
+    r[i] = rx[i];
+  }
+  frame_bytes_ = at + n;
+}
+
+[[gnu::noinline]] void RecordingChain::keep_long(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx) {
   const std::size_t at = frame_bytes_, n = tx.size();
   if (at + n > tx_.size()) {
     tx_.resize(std::max<std::size_t>(2 * (at + n), 64));
     rx_.resize(tx_.size());
   }
-  std::uint8_t* t = tx_.data() + at;
-  std::uint8_t* r = rx_.data() + at;
-  if (n <= 16) {
-    for (std::size_t i = 0; i < n; ++i) {
-      t[i] = tx[i];
-      r[i] = rx[i];
-    }
-  } else {
-    std::memcpy(t, tx.data(), n);
-    std::memcpy(r, rx.data(), n);
-  }
+  std::memcpy(tx_.data() + at, tx.data(), n);
+  std::memcpy(rx_.data() + at, rx.data(), n);
   frame_bytes_ = at + n;
 }
 
@@ -174,12 +193,15 @@ void RecordingChain::exchange(std::span<const std::uint8_t> tx, std::span<std::u
 
 void RecordingChain::exchange_wire(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                                    const WireSettings& wire) {
-  if (!chain_.selected()) touched();
-  chain_.exchange_wire(tx, rx, wire);
-  if (chain_.selected()) {
-    if (!wire_noted_) note_wire(trace_wire_of(wire, frame_timed_));
-    keep(tx, rx);
+  // (Clocking bytes never moves CS: selected before is selected after.)
+  if (!chain_.selected()) [[unlikely]] {
+    touched();
+    chain_.exchange_wire(tx, rx, wire);
+    return;
   }
+  chain_.exchange_wire(tx, rx, wire);
+  if (!wire_noted_) note_wire(trace_wire_of(wire, frame_timed_));
+  keep(tx, rx);
 }
 
 void RecordingChain::deselect() {

@@ -111,6 +111,8 @@ class RecordingChain final : public SpiDevice {
   void finish_frame();
   void look_at_outputs();
   void keep(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
+  void keep_long(std::span<const std::uint8_t> tx, std::span<const std::uint8_t> rx);
+  void advance_observing(Tick tick);
   void backdoor(std::size_t chip, TraceEventKind kind, std::uint8_t what, std::uint8_t value);
   Tick first_output_change(std::size_t chip, Tick to, bool& unsure) const;
   void stimulus(const TraceEvent& e);
@@ -130,7 +132,7 @@ class RecordingChain final : public SpiDevice {
   void note_wire(const TraceWire& wire) {
     if (wire_noted_) return;
     wire_noted_ = true;
-    if (!(wire_ == wire)) wire_ = wire;
+    wire_ = wire;  // (a store costs less than comparing first)
   }
   std::uint64_t decoded_at_select_ = 0;  // chain_.decoded_bytes() when CS fell
   std::vector<TraceEvent> deferred_;  // backdoor events while CS is low

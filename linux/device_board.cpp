@@ -12,7 +12,7 @@
 
 #include "board/scenario_runner.hpp"
 #include "board/trace_recorder.hpp"
-#include "linux/recording_output.hpp"
+#include "linux/recording_path.hpp"
 #include "linux/device_board_internal.hpp"
 
 namespace l6470emu {
@@ -23,7 +23,7 @@ DeviceBoard::DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostCloc
   // Recordings: plain files through a shared mapping (no system call per event), gzip flushed
   // by size and host time (the coarse clock: it is read on every event, to 200 ms).
   board_.set_trace_output_opener([&host](const std::string& path) {
-    return open_recording_output(path, [&host] { return host.coarse_monotonic_ns(); });
+    return open_host_recording_output(path, [&host] { return host.coarse_monotonic_ns(); });
   });
   unsigned spi_minor = 0;
   for (const ChainConfig& cc : config.chains) {

@@ -9,7 +9,7 @@
 #include <new>
 
 #include "linux/device_board_internal.hpp"
-#include "linux/recording_output.hpp"
+#include "spi/recording_output.hpp"
 
 namespace l6470emu {
 

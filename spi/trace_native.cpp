@@ -674,11 +674,18 @@ bool NativeTraceWriter::Held::same_bytes(const Held& o) const {
   return true;
 }
 
-bool NativeTraceWriter::Held::same_bytes(const TraceEvent& e) const {
+[[gnu::always_inline]] inline bool NativeTraceWriter::Held::same_bytes(const TraceEvent& e) const {
   // As same_bytes(Held) with `e` held (without copying it). Sizes first, then the few bytes.
   const std::size_t n = mosi.size();
   if (duration != e.duration || n != e.mosi.size() || miso.size() != e.miso.size() || known.size() != e.miso_known.size())
     return false;
+  if (known.empty() && miso.size() == n) {
+    // The usual frame, every MISO byte known: both directions in one loop.
+    const std::uint8_t *m = mosi.data(), *em = e.mosi.data(), *s = miso.data(), *es = e.miso.data();
+    for (std::size_t i = 0; i < n; ++i)
+      if (m[i] != em[i] || s[i] != es[i]) return false;
+    return true;
+  }
   if (!same_small(mosi.data(), e.mosi.data(), n)) return false;
   if (known.empty()) return same_small(miso.data(), e.miso.data(), miso.size());
   if (!same_small(known.data(), e.miso_known.data(), known.size())) return false;
@@ -825,7 +832,7 @@ char* write_frame_body(char* p, const TraceEvent& e) {
 
 }  // namespace
 
-void NativeTraceWriter::write_line(const TraceEvent& e) {
+[[gnu::noinline]] void NativeTraceWriter::write_line(const TraceEvent& e) {
   constexpr std::size_t kShortFrame = 32;
   if (e.kind == TraceEventKind::frame && e.mosi.size() <= kShortFrame && e.miso.size() <= kShortFrame) {
     // The line of a short frame, the most common one, straight from the stack.
@@ -919,9 +926,9 @@ std::uint64_t step_open_count_word(std::uint64_t word) {
 
 }  // namespace
 
-/// A frame with compaction: either the next one of the run under way, or a line of its own
-/// (after which it may start a run).
-void NativeTraceWriter::frame(const TraceEvent& e) {
+/// A frame with compaction: either the next one of the run under way (the usual case in a poll
+/// loop, inlined into write()), or a line of its own (after which it may start a run).
+[[gnu::always_inline]] inline void NativeTraceWriter::frame(const TraceEvent& e) {
   if (in_run_) {
     const Held& model = run_[partial_];
     // A repeat line stands for at most kMaxRepeatCount repetitions (an open one for
@@ -929,21 +936,7 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     const std::uint64_t max_count = open_runs() ? kMaxOpenRepeatCount : kMaxRepeatCount;
     if (e.tick == model.tick + run_period_ && model.same_bytes(e) && line_count_ < max_count) {
       if (++partial_ < run_group_) {
-        if (open_runs()) {
-          // A killed process leaves it; taken into the count below. Only its time is new.
-          const std::string& body = run_bodies_[partial_ - 1];
-          char buf[kMaxTimeChars + 128];
-          if (body.size() <= sizeof buf - kMaxTimeChars) {  // a short frame's line, from the stack
-            char* p = write_seconds(buf, e.tick);
-            std::memcpy(p, body.data(), body.size());
-            out_->append(std::string_view(buf, static_cast<std::size_t>(p - buf) + body.size()));
-          } else {
-            line_.clear();
-            append_seconds(line_, e.tick);
-            line_ += body;
-            put(line_);
-          }
-        }
+        if (open_runs()) write_partial_line(e);
         return;
       }
       // A whole repetition more: the group moves on by one period.
@@ -964,6 +957,28 @@ void NativeTraceWriter::frame(const TraceEvent& e) {
     }
     end_run();
   }
+  frame_line(e);
+}
+
+/// A frame of the repetition under way, in an open run: a killed process leaves it; the
+/// repetition's count takes it in when the repetition is whole. Only its time is new.
+[[gnu::noinline]] void NativeTraceWriter::write_partial_line(const TraceEvent& e) {
+  const std::string& body = run_bodies_[partial_ - 1];
+  char buf[kMaxTimeChars + 128];
+  if (body.size() <= sizeof buf - kMaxTimeChars) {  // a short frame's line, from the stack
+    char* p = write_seconds(buf, e.tick);
+    std::memcpy(p, body.data(), body.size());
+    out_->append(std::string_view(buf, static_cast<std::size_t>(p - buf) + body.size()));
+  } else {
+    line_.clear();
+    append_seconds(line_, e.tick);
+    line_ += body;
+    put(line_);
+  }
+}
+
+/// A frame outside a run: its own line, after which it may start one.
+[[gnu::noinline]] void NativeTraceWriter::frame_line(const TraceEvent& e) {
   write_line(e);
   if (recent_.size() == 3 * kMaxRepeatGroup) {
     recent_[recent_first_].assign(e);  // the newest takes the oldest one's place (and buffers)

@@ -187,6 +187,8 @@ class NativeTraceWriter final : public TraceSink {
   void put(const std::string& text);
   void write_line(const TraceEvent& e);
   void frame(const TraceEvent& e);
+  void write_partial_line(const TraceEvent& e);
+  void frame_line(const TraceEvent& e);
   void look_for_run();
   void end_run();
   /// The run's repeat line for the repetitions since the last one; `progress_only` when the run

@@ -2,6 +2,9 @@
 // rounded to nearest, negative pre-trigger times, and the fixed-width printing of ticks.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "spi/trace.hpp"
 
 namespace l6470emu {
@@ -61,6 +64,26 @@ TEST(FormatSeconds, PrintsTicksExactlyWithEightDecimals) {
   EXPECT_EQ(format_seconds(1), "0.00000025");
   EXPECT_EQ(format_seconds(4'938'271), "1.23456775");
   EXPECT_EQ(format_microseconds(7), "1.75");
+}
+
+TEST(FormatSeconds, GivesEveryTimeAsItsWholeSecondsAndEightDecimals) {
+  // The exact text, the long way, against write_seconds' short cuts (below 10 000 s) and its
+  // general path: around every carry of the whole seconds and of the decimals, and far out.
+  auto expected = [](Tick t) {
+    std::string decimals = std::to_string(t % kTicksPerSecond * 25);
+    return std::to_string(t / kTicksPerSecond) + "." + std::string(8 - decimals.size(), '0') + decimals;
+  };
+  std::vector<Tick> ticks;
+  for (Tick s : {0ull, 1ull, 9ull, 10ull, 99ull, 100ull, 999ull, 1000ull, 9999ull, 10000ull, 123456ull, 1000000000000ull})
+    for (Tick d : {0ull, 1ull, 3ull, 4ull, 39ull, 40ull, 399ull, 400ull, 3999ull, 4000ull, 39999ull, 40000ull, 399999ull,
+                   400000ull, 3999999ull})
+      ticks.push_back(s * kTicksPerSecond + d);
+  for (Tick t = 0; t < 40'000'000'000ull; t = t * 3 + 7) ticks.push_back(t);
+  for (const Tick t : ticks) {
+    char buf[kMaxTimeChars];
+    EXPECT_EQ(std::string(buf, write_seconds(buf, t)), expected(t)) << t;
+    EXPECT_EQ(format_seconds(t), expected(t)) << t;
+  }
 }
 
 TEST(HexBytes, MarksUnknownBytes) {

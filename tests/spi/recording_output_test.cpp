@@ -1,4 +1,4 @@
-// The recording's memory-mapped plain file (linux/recording_output.hpp) under the trace writer:
+// The recording's memory-mapped plain file (spi/recording_output.hpp) under the trace writer:
 // an open run's count, replaced in place one 8-byte word at a time, is right after every
 // repetition through every carry of its six digits, and a run longer than the field goes on in a
 // new one.
@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "linux/recording_output.hpp"
+#include "spi/recording_output.hpp"
 #include "spi/trace_native.hpp"
 #include "support/trace_test_support.hpp"
 

@@ -2,7 +2,7 @@
 // after it, and the zero byte that ends the text, are in place before), a `repeat` count when
 // the aligned 8-byte word holding it is stored. Readers stop at a line that starts with a zero
 // byte (spi/trace_native.cpp), so the file reads as a whole trace at every instant.
-#include "linux/recording_output.hpp"
+#include "spi/recording_output.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -46,7 +46,7 @@ class MappedOutput final : public TraceOutput {
   void append(std::string_view text) override {
     if (fd_ < 0) throw std::runtime_error(path_ + ": write after close");
     if (text.empty()) return;
-    reserve(size_ + text.size() + 1);
+    if (size_ + text.size() + 1 > capacity_) reserve(size_ + text.size() + 1);
     char* at = map_ + size_;
     // The rest of the text and the zero byte after it first, the first byte last: a reader (or a
     // kill) sees the whole text or none of it.
@@ -169,21 +169,6 @@ std::unique_ptr<TraceOutput> open_mapped_trace_output(const std::string& path) {
 }
 
 std::unique_ptr<TraceOutput> open_recording_output(const std::string& path, std::function<std::int64_t()> clock) {
-  // Only a regular file, never through a symbolic link, and nothing that could block: a FIFO
-  // opened for writing waits for a reader (a daemon holding its board's lock would wait with it),
-  // and a root daemon must not follow another user's link to overwrite what it names.
-  {
-    int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
-    if (fd < 0 && errno == ENOENT) fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) {
-      if (errno == ELOOP) throw std::runtime_error(path + ": a symbolic link: name the file itself");
-      throw std::runtime_error(path + ": cannot create: " + std::strerror(errno));
-    }
-    struct stat st {};
-    const bool regular = fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
-    ::close(fd);
-    if (!regular) throw std::runtime_error(path + ": not a regular file (a device, a FIFO or a directory): a trace goes to a file");
-  }
   if (gzip_file_name(path)) {
     TraceFlushPolicy policy;
     policy.gzip_bytes = kRecordingGzipFlushBytes;

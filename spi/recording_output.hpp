@@ -1,7 +1,8 @@
-// Where the Linux front's recordings go: a plain trace file written through a MAP_SHARED
-// mapping (appending a line and updating a `repeat` count are memory writes, not system calls,
-// and the pages belong to the file, so a killed process leaves every event written), and gzip
-// files flushed by size and host time. It does not format traces (spi/trace_native.hpp does).
+// Where a board's recordings go, from every front: a plain trace file written through a
+// MAP_SHARED mapping (appending a line and updating a `repeat` count are memory writes, not system
+// calls, and the pages belong to the file, so a killed process leaves every event written), and
+// gzip files flushed by size and, when the front has one, host time. It neither formats traces
+// (spi/trace_native.hpp does) nor judges which paths a front may write (linux/recording_path.hpp).
 #pragma once
 
 #include <functional>
@@ -29,9 +30,13 @@ inline constexpr std::int64_t kRecordingGzipFlushNs = 200'000'000;
 /// be created or mapped.
 std::unique_ptr<TraceOutput> open_mapped_trace_output(const std::string& path);
 
-/// The output of a recording at `path`: mapped (open_mapped_trace_output) for a plain file,
-/// zlib flushed every kRecordingGzipFlushBytes or kRecordingGzipFlushNs of `clock` (host
-/// monotonic ns) for a name ending in ".gz", stdio for what cannot be mapped.
-std::unique_ptr<TraceOutput> open_recording_output(const std::string& path, std::function<std::int64_t()> clock);
+/// The output of a recording at `path` (what Board::start_recording opens unless its front says
+/// otherwise): mapped (open_mapped_trace_output) for a plain file; for a name ending in ".gz",
+/// zlib flushed every kRecordingGzipFlushBytes of text or, when `clock` (host monotonic ns) is
+/// given, kRecordingGzipFlushNs after the last flush; stdio for what cannot be mapped (a FIFO,
+/// /dev/stdout). Without a clock (a firmware program in virtual time) the flush points, and so the
+/// text, depend on the events alone. Throws std::runtime_error (one line) when `path` cannot be
+/// created.
+std::unique_ptr<TraceOutput> open_recording_output(const std::string& path, std::function<std::int64_t()> clock = {});
 
 }  // namespace l6470emu
