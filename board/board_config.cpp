@@ -376,6 +376,7 @@ struct Parser {
       const auto level = parse_check_level(value, why);
       if (!level) return fail("check " + why);
       cfg.check.level = *level;
+      cfg.check_given = true;
     } else if (k == "check.allow") {
       std::string why;
       const auto rules = parse_rule_list(value, why);

@@ -66,6 +66,7 @@ struct BoardConfig {
   std::string coverage;
   NumberFrom numbering = NumberFrom::miso;  ///< how diagnostics and `ctl` number the chips (numbering=)
   CheckConfig check;                        ///< the driver sanitizer: check= and check.allow=
+  bool check_given = false;                 ///< the description said check= (a front's own default yields to it)
   FirmwareTiming firmware;                  ///< call_time=, loop_time=, limit=, apb_clock= (firmware runs)
 };
 

@@ -3,7 +3,7 @@
 #
 #   l6470emu_add_sketch(NAME SOURCES sketch.ino [more.ino] [lib.cpp ...]
 #                       [BOARD "chips=3xL6470 cs_pin=D10 flag_pin=D2" | BOARD_FILE board.conf]
-#                       [ARDUINO_BOARD uno | nucleo_f401re]
+#                       [ARDUINO_BOARD uno | nucleo_f401re] [CHECK error | warn | off]
 #                       [INCLUDE_DIRECTORIES dir ...] [LINK_LIBRARIES lib ...])
 #     An Arduino sketch and its libraries: .ino files become one C++ file as the Arduino IDE
 #     makes it (#include <Arduino.h>, prototypes; the first .ino is the main one, the others
@@ -19,15 +19,24 @@
 #     A program on the plain C API (<l6470emu/firmware/firmware.h>), linked with l6470emu::firmware.
 #
 # BOARD / BOARD_FILE is the board the program runs on unless L6470EMU_CHAIN or L6470EMU_CONFIG
-# says otherwise at run time; without either, one L6470 with the front's default pins. The
-# project must enable C++ (and C for C sources).
+# says otherwise at run time; without either, one L6470 with the front's default pins. CHECK is
+# the driver sanitizer's level unless the description's check= or L6470EMU_CHECK says: error by
+# default, so a program run as a test (add_test) fails on the first broken rule with status 86;
+# warn reports each broken rule and runs on. The project must enable C++ (and C for C sources).
 include_guard(GLOBAL)
 
 function(_l6470emu_firmware_program name front_library)
-  cmake_parse_arguments(PARSE_ARGV 2 arg "" "BOARD;BOARD_FILE;ARDUINO_BOARD" "SOURCES;INCLUDE_DIRECTORIES;LINK_LIBRARIES")
+  cmake_parse_arguments(PARSE_ARGV 2 arg "" "BOARD;BOARD_FILE;ARDUINO_BOARD;CHECK" "SOURCES;INCLUDE_DIRECTORIES;LINK_LIBRARIES")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "l6470emu: ${name}: unknown arguments ${arg_UNPARSED_ARGUMENTS} "
-                        "(SOURCES, BOARD, BOARD_FILE, ARDUINO_BOARD, INCLUDE_DIRECTORIES, LINK_LIBRARIES)")
+                        "(SOURCES, BOARD, BOARD_FILE, ARDUINO_BOARD, CHECK, INCLUDE_DIRECTORIES, LINK_LIBRARIES)")
+  endif()
+  set(check error)
+  if(DEFINED arg_CHECK)
+    string(TOLOWER "${arg_CHECK}" check)
+    if(NOT check MATCHES "^(off|warn|error)$")
+      message(FATAL_ERROR "l6470emu: ${name}: CHECK \"${arg_CHECK}\" is none of off, warn, error")
+    endif()
   endif()
   if(DEFINED arg_ARDUINO_BOARD)
     if(NOT front_library STREQUAL "l6470emu::arduino")
@@ -92,6 +101,14 @@ extern \"C\" const char* ${function}(void) { return \"${text}\"; }
 ")
     list(APPEND sources "${board_source}")
   endif()
+
+  # The driver sanitizer's level unless the description (check=) or L6470EMU_CHECK says.
+  set(check_source "${CMAKE_CURRENT_BINARY_DIR}/${name}_check.cpp")
+  file(CONFIGURE OUTPUT "${check_source}" CONTENT
+"// The driver sanitizer's level of ${name} unless its description or L6470EMU_CHECK says (generated).
+extern \"C\" const char* l6470emu_fw_default_check(void) { return \"${check}\"; }
+")
+  list(APPEND sources "${check_source}")
 
   add_executable(${name} ${sources})
   target_link_libraries(${name} PRIVATE ${front_library} ${arg_LINK_LIBRARIES})

@@ -670,6 +670,9 @@ extern "C" {
 /// Set by l6470emu_add_sketch / l6470emu_add_hal_program BOARD (a description) or BOARD_FILE.
 const char* l6470emu_fw_default_board(void) __attribute__((weak));
 const char* l6470emu_fw_default_board_file(void) __attribute__((weak));
+/// Defined by a program built with the CMake functions (CHECK, default error): the sanitizer's
+/// level when neither the description nor L6470EMU_CHECK says.
+const char* l6470emu_fw_default_check(void) __attribute__((weak));
 /// Defined (weak, in every file that includes it) by Arduino.h when the sketch is built for a
 /// board other than an Uno (l6470emu_add_sketch's ARDUINO_BOARD): "nucleo_f401re".
 const char* l6470emu_fw_arduino_board(void) __attribute__((weak));
@@ -769,7 +772,19 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
     }
     config.coverage = coverage;
   }
-  // The driver sanitizer, as the preload reads it.
+  // The driver sanitizer, as the preload reads it; below the description's check= and the
+  // environment, the level the program was built with.
+  // (Under `l6470emu run` the run's board decides, as it does the board itself.)
+  if (const char* built = l6470emu_fw_default_check ? l6470emu_fw_default_check() : nullptr;
+      built && *built && !config.check_given && !run_board) {
+    std::string why;
+    const auto level = parse_check_level(built, why);
+    if (!level) {
+      error = "l6470emu: the program's CHECK " + why;
+      return nullptr;
+    }
+    config.check.level = *level;
+  }
   if (const char* check = std::getenv("L6470EMU_CHECK"); check && *check) {
     std::string why;
     const auto level = parse_check_level(check, why);
