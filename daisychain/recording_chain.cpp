@@ -325,6 +325,10 @@ void RecordingChain::set_stck_pin(std::size_t chip, bool level) {
   chain_.chip(chip).set_stck_pin(level);
   backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STCK), level);
 }
+void RecordingChain::set_dir_pin(std::size_t chip, bool level) {
+  chain_.chip(chip).set_dir_pin(level);
+  backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::DIR), level);
+}
 void RecordingChain::set_stby_rst_pin(std::size_t chip, bool level) {
   chain_.chip(chip).set_stby_rst_pin(level);
   backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STBY), level);
