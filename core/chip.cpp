@@ -89,10 +89,17 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   }
   const Opcode& op = variant_->opcodes[byte];
   switch (op.command) {
-    case Command::Unknown:
-      wrong_command(byte, classify_opcode(byte).command == Command::Unknown ? "no such command"
-                                                                            : "no register at this address");
+    case Command::Unknown: {
+      const Command raw = classify_opcode(byte).command;
+      if (raw == Command::SetParam || raw == Command::GetParam)
+        wrong_command(byte, "no register at this address");
+      else if (raw == Command::Unknown)
+        wrong_command(byte, "no such command");
+      else  // a command of the parts with a motion engine, sent to one without (the L6474)
+        wrong_command(byte, ("no such command on an " + std::string(variant_->name) + " (" +
+                             std::string(to_string(raw)) + " on the others)").c_str());
       break;
+    }
     case Command::Reserved:
       wrong_command(byte, "reserved opcode");
       break;

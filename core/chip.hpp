@@ -120,8 +120,11 @@ class alignas(64) Chip {
 
   // ---- pins (the physical world; host programs only see SPI and these) ------
 
-  /// BUSY\SYNC output level: false = pulled low (busy, or the SYNC clock low).
+  /// BUSY\SYNC output level: false = pulled low (busy, or the SYNC clock low). Always high on
+  /// a part without the pin (the L6474).
   bool busy_sync_pin() const;
+  /// Whether BUSY\SYNC outputs the SYNC clock (STEP_MODE.SYNC_EN on a part with the pin).
+  bool sync_clock_on() const;
   /// FLAG output level: false = pulled low (an enabled alarm is active).
   bool flag_pin() const;
   /// SW input level; false = switch closed (pin pulled to ground). Edges act at now(). A part
@@ -337,8 +340,6 @@ class alignas(64) Chip {
   /// BUSY\SYNC and FLAG from the state as it stands (the pins' levels once synced).
   bool busy_level() const;
   bool flag_level() const;
-  /// Whether BUSY\SYNC outputs the SYNC clock (STEP_MODE.SYNC_EN on a part with the pin).
-  bool sync_clock_on() const;
   /// Whether STATUS at now_ is known without working the motion out (inside the cached run).
   /// The first tick at which it would stop being so, as the state stands, is status_horizon().
   bool status_known_without_sync() const {
