@@ -32,6 +32,17 @@ std::string flags_text(const RegisterInfo& r) {
   return s;
 }
 
+/// The command table's "Argument bytes" cell of an opcode.
+std::string argument_text(const Opcode& op) {
+  switch (op.command) {
+    case Command::SetParam: return "register length (1–3)";
+    case Command::GetParam: return "0 (answer: register length)";
+    case Command::GetStatus: return "0 (answer: 2)";
+    case Command::Reserved: return "— (treated as unknown: WRONG_CMD)";
+    default: return std::to_string(op.arg_bytes);
+  }
+}
+
 }  // namespace
 
 std::string register_table_markdown(const Variant& v) {
@@ -114,21 +125,8 @@ std::string variant_command_table_markdown(const Variant& v) {
         list += (list.empty() ? "" : ", ") + hex2(b);
       }
     }
-    std::string args;
-    switch (c) {
-      case Command::SetParam: args = "register length (1–3)"; break;
-      case Command::GetParam: args = "0 (answer: register length)"; break;
-      case Command::GetStatus: args = "0 (answer: 2)"; break;
-      case Command::Reserved: args = "— (treated as unknown: WRONG_CMD)"; break;
-      default: {
-        for (unsigned b = 0; b < 256; ++b)
-          if (v.opcodes[b].command == c) {
-            args = std::to_string(v.opcodes[b].arg_bytes);
-            break;
-          }
-      }
-    }
-    out += "| " + std::string(to_string(c)) + " | " + list + " | " + args + " |\n";
+    const auto first = std::find_if(v.opcodes.begin(), v.opcodes.end(), [c](const Opcode& o) { return o.command == c; });
+    out += "| " + std::string(to_string(c)) + " | " + list + " | " + argument_text(*first) + " |\n";
   }
   out += "| (any other byte) | | — (no command: WRONG_CMD) |\n";
   return out;
@@ -159,15 +157,7 @@ std::string command_table_markdown() {
       }
       e = x;
     }
-    std::string args;
-    switch (op.command) {
-      case Command::SetParam: args = "register length (1–3)"; break;
-      case Command::GetParam: args = "0 (answer: register length)"; break;
-      case Command::GetStatus: args = "0 (answer: 2)"; break;
-      case Command::Reserved: args = "— (treated as unknown: WRONG_CMD)"; break;
-      default: args = std::to_string(op.arg_bytes); break;
-    }
-    out += "| " + std::string(to_string(op.command)) + " | " + list + " | " + args + " |\n";
+    out += "| " + std::string(to_string(op.command)) + " | " + list + " | " + argument_text(op) + " |\n";
     b = e + 1;
   }
   return out;
