@@ -388,7 +388,7 @@ void RecordingChain::look_at_outputs() {
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), levels.sw);
     }
     const std::uint8_t busy = levels.busy, flag = levels.flag;
-    if (busy != busy_[k]) {
+    if (busy != busy_[k] && c.variant().pins.busy_sync) {  // an L6474 has no BUSY pin to observe
       busy_[k] = busy;
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::BUSY), busy);
     }
