@@ -19,9 +19,13 @@ Board::Board(const BoardConfig& config, LineSink log, HostClock& host)
     cs->wired = cc.gpiochip.has_value();
     ChainState::PinLevels initial{};
     initial.fill(true);
-    initial[static_cast<unsigned>(Pin::STCK)] = false;  // SW open (pulled up), STBY_RST high (running), STCK low
+    // SW open (pulled up), STBY_RST high (running), STCK and DIR low.
+    initial[static_cast<unsigned>(Pin::STCK)] = false;
+    initial[static_cast<unsigned>(Pin::DIR)] = false;
     cs->wire.assign(cs->chain.size(), initial);
-    cs->last.assign(cs->chain.size(), ChainState::PinLevels{true, true, true, true, true});
+    ChainState::PinLevels all_high{};
+    all_high.fill(true);
+    cs->last.assign(cs->chain.size(), all_high);
     cs->checker = std::make_unique<ChainChecker>(sanitizer_, cs->chain, cs->name, numbering_);
     cs->bus = std::make_unique<ChainBus>(cs->chain, cs->chain, *cs->checker);
     // The chips' diagnostics (WRONG_CMD, NOTPERF_CMD, dropped bits and answers) are rules the
@@ -242,8 +246,10 @@ bool Board::level_of(const ChainState& c, std::size_t chip, Pin pin) const {
   const Chip& ch = c.chain.chip(chip);
   if (pin == Pin::BUSY) return ch.busy_sync_pin();
   if (pin == Pin::FLAG) return ch.flag_pin();
+  if (!variant_has_pin(ch.variant(), pin)) return true;  // an input the chip lacks: nothing pulls it low
   if (c.wired) return c.wire[chip][static_cast<unsigned>(pin)];
   if (pin == Pin::SW) return ch.sw_pin();
+  if (pin == Pin::DIR) return ch.dir_pin();
   return pin == Pin::STBY_RST ? ch.spi_enabled() : false;
 }
 
@@ -252,7 +258,7 @@ bool Board::level(std::size_t chain, std::size_t chip, Pin pin) const { return l
 bool Board::set_input(std::size_t chain, std::size_t chip, Pin pin, bool level) {
   if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
   ChainState& c = *chains_[chain];
-  if (chip >= c.chain.size()) return false;
+  if (chip >= c.chain.size() || !variant_has_pin(c.chain.peek_chip(chip).variant(), pin)) return false;
   c.prediction_valid = false;
   if (c.wired) {
     bool& wire = c.wire[chip][static_cast<unsigned>(pin)];
@@ -266,7 +272,7 @@ bool Board::set_input(std::size_t chain, std::size_t chip, Pin pin, bool level) 
 bool Board::drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool level) {
   if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
   ChainState& c = *chains_[chain];
-  if (chip >= c.chain.size()) return false;
+  if (chip >= c.chain.size() || !variant_has_pin(c.chain.peek_chip(chip).variant(), pin)) return false;
   catch_up(c);
   set_input(chain, chip, pin, level);
   emit_changes(c, c.chain.now());

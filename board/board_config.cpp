@@ -33,7 +33,7 @@ struct KeySpec {
 };
 
 // Every key, in the order the docs table lists them.
-constexpr std::array<KeySpec, 28> kKeys{{
+constexpr std::array<KeySpec, 29> kKeys{{
     {"chips", Scope::chain, "chips=2xL6470,L6480"},
     {"bus", Scope::chain, "bus=0"},
     {"cs", Scope::chain, "cs=1"},
@@ -48,6 +48,7 @@ constexpr std::array<KeySpec, 28> kKeys{{
     {"sw_pin", Scope::chain, "sw_pin=D5"},
     {"stck_pin", Scope::chain, "stck_pin=D7"},
     {"stby_rst_pin", Scope::chain, "stby_rst_pin=D6"},
+    {"dir_pin", Scope::chain, "dir_pin=D4"},
     {"spi", Scope::chain, "spi=SPI1"},
     {"time", Scope::board, "time=virtual"},
     {"scale", Scope::board, "scale=10"},
@@ -74,10 +75,10 @@ std::string key_list(Scope scope) {
   std::string out;
   for (const KeySpec& k : kKeys) {
     if (k.scope != scope) continue;
-    // The chip pins' keys, shortened: busy/flag/sw/stck/stby_rst_pin.
+    // The chip pins' keys, shortened: busy/flag/sw/stck/stby_rst/dir_pin.
     if (k.name.size() > 4 && k.name.substr(k.name.size() - 4) == "_pin" && k.name != "cs_pin") {
       if (k.name != "busy_pin") continue;
-      out += ", busy/flag/sw/stck/stby_rst_pin";
+      out += ", busy/flag/sw/stck/stby_rst/dir_pin";
       continue;
     }
     out += (out.empty() ? "" : ", ") + std::string(k.name);
@@ -123,6 +124,7 @@ std::string_view key_alias(std::string_view key) {
       {"gpio", "gpiochip"},    {"record", "trace"},   {"chipselect", "cs"},    {"ss_pin", "cs_pin"},
       {"ss", "cs_pin"},        {"nss", "cs_pin"},     {"busy", "busy_pin"},    {"flag", "flag_pin"},
       {"sw", "sw_pin"},        {"stck", "stck_pin"},  {"stby", "stby_rst_pin"}, {"stby_pin", "stby_rst_pin"},
+      {"dir", "dir_pin"},      {"direction_pin", "dir_pin"},
       {"reset_pin", "stby_rst_pin"}, {"rst_pin", "stby_rst_pin"}, {"stbyrst_pin", "stby_rst_pin"},
       {"spi_bus", "spi"},      {"controller", "spi"}, {"call_cost", "call_time"}, {"loop_cost", "loop_time"},
       {"time_limit", "limit"}, {"run_limit", "limit"}, {"apb", "apb_clock"},  {"pclk", "apb_clock"},
@@ -674,6 +676,43 @@ struct Parser {
     return true;
   }
 
+  // A chip pin given to a chip that has no such pin (dir_pin= for an L6470, sw_pin= for an
+  // L6474): refused, once numbering= is known. One pin for the whole chain needs one chip with it.
+  bool check_chip_pins(const BoardConfig& cfg) {
+    for (std::size_t i = 0; i < cfg.chains.size(); ++i) {
+      const ChainConfig& c = cfg.chains[i];
+      const ChipNumbering numbers(cfg.numbering, c.chips.size());
+      for (unsigned p = 0; p < kPinsPerChip; ++p) {
+        const Pin pin = static_cast<Pin>(p);
+        const ChipPinList& list = c.pins.chip[p];
+        const auto has = [&](std::size_t index) { return variant_has_pin(*c.chips[index], pin); };
+        std::optional<std::size_t> lacking;  // a chain index
+        if (list.size() == 1 && list[0]) {
+          bool any = false;
+          for (std::size_t k = 0; k < c.chips.size(); ++k) any = any || has(k);
+          if (!any) lacking = 0;
+        } else {
+          for (std::size_t u = 0; u < list.size() && !lacking; ++u)
+            if (list[u] && !has(numbers.index_of(u))) lacking = numbers.index_of(u);
+        }
+        if (!lacking) continue;
+        clause_no = chain_clause[i];
+        line_no = chain_line[i];
+        const std::string key = pin_key(pin);
+        std::string owners;  // "a pin of L6474"
+        for (const Variant* v : all_variants())
+          if (variant_has_pin(*v, pin)) owners += (owners.empty() ? "" : ", ") + std::string(v->name);
+        if (list.size() == 1)
+          return fail(key + "= names a pin for this chain, but none of its chips has a " + pin_name(pin) +
+                      " pin (a pin of " + owners + ")");
+        return fail(key + "= gives " + numbers.label(*lacking) + " a pin, but it is an " +
+                    std::string(c.chips[*lacking]->name) + ", which has no " + pin_name(pin) + " pin (a pin of " +
+                    owners + "): write '-' for it");
+      }
+    }
+    return true;
+  }
+
   // Chains without gpiochip= get the lowest numbers no chain asked for, in order.
   bool assign_default_gpiochips(BoardConfig& cfg) {
     std::set<unsigned> used;
@@ -766,7 +805,7 @@ ParseResult parse_board_config(std::string_view text, std::string_view origin) {
     }
     line_start = line_end + 1;
   }
-  if (!p.assign_default_gpiochips(cfg)) return {std::nullopt, {p.error}};
+  if (!p.assign_default_gpiochips(cfg) || !p.check_chip_pins(cfg)) return {std::nullopt, {p.error}};
   if (cfg.chains.empty() && cfg.socket.empty())
     return {std::nullopt, {"l6470emu: config " + shown_text(origin, 200) +
                            ": no chain (write e.g. 'bus=0 cs=0 chips=L6470' or 'socket=PATH')"}};

@@ -80,7 +80,7 @@ struct ConfigError {
 /// key=value, each key at most once per clause. A clause with chips= is a chain:
 ///   chips=L6470,2xL6480 [bus=0..32767] [cs=0..255] [path=/dev/NAME] [gpiochip=0..1023|none]
 ///   [speed=HZ] [mode=0..3] [bufsiz=N] [axis.K=ITEM,... (a motor, load, stops and switches behind chip K)]
-///   [cs_pin=PIN] [busy_pin=|flag_pin=|sw_pin=|stck_pin=|stby_rst_pin=PIN or PIN,PIN,... one per chip]
+///   [cs_pin=PIN] [busy_pin=|flag_pin=|sw_pin=|stck_pin=|stby_rst_pin=|dir_pin=PIN or PIN,PIN,... one per chip]
 ///   [spi=SPI|SPI1..SPI9|HSPI|VSPI|FSPI|hspiN] (the microcontroller side of a firmware run)
 /// Board-wide keys may stand in any clause, a chain's or one of their own, each at most once in
 /// the whole description: time=wall|virtual, scale=F (wall time), idle=SECONDS|off (virtual

@@ -23,6 +23,7 @@ void Board::apply_input(ChainState& c, std::size_t chip, Pin pin, bool level) {
   Chip& ch = c.chain.chip(chip);
   if (pin == Pin::SW) ch.set_sw_pin(level);
   if (pin == Pin::STCK) ch.set_stck_pin(level);
+  if (pin == Pin::DIR) ch.set_dir_pin(level);
   if (pin == Pin::STBY_RST) ch.set_stby_rst_pin(level);
 }
 

@@ -145,12 +145,14 @@ CoverageUniverse::CoverageUniverse(const Variant& v) : variant_(v.name) {
         add(CoverageCategory::refusals, "SetParam(" + std::string(r.name) + ")",
             std::string(r.access == Access::WS ? "WS: written while the motor runs" : "WH: written while the bridges are enabled"));
   add(CoverageCategory::refusals, "SetParam of a read-only register", "SetParam of an R register");
-  add(CoverageCategory::refusals, "Move while the motor runs", "Move sent while the motor is not stopped");
-  add(CoverageCategory::refusals, "StepClock while the motor runs", "StepClock sent while the motor is not stopped");
-  for (const Command c : {Command::GoTo, Command::GoTo_DIR, Command::GoHome, Command::GoMark})
-    add(CoverageCategory::refusals, std::string(to_string(c)) + " while BUSY", std::string(to_string(c)) + " sent before the last command ended");
-  add(CoverageCategory::refusals, "motion command while a fault holds HiZ",
-      "a motion command while thermal shutdown, UVLO or an overcurrent keeps the bridges off");
+  if (v.motion_engine) {  // the L6474 has no motion command to refuse
+    add(CoverageCategory::refusals, "Move while the motor runs", "Move sent while the motor is not stopped");
+    add(CoverageCategory::refusals, "StepClock while the motor runs", "StepClock sent while the motor is not stopped");
+    for (const Command c : {Command::GoTo, Command::GoTo_DIR, Command::GoHome, Command::GoMark})
+      add(CoverageCategory::refusals, std::string(to_string(c)) + " while BUSY", std::string(to_string(c)) + " sent before the last command ended");
+    add(CoverageCategory::refusals, "motion command while a fault holds HiZ",
+        "a motion command while thermal shutdown, UVLO or an overcurrent keeps the bridges off");
+  }
   if (v.reset_device_needs_hiz)
     add(CoverageCategory::refusals, "ResetDevice while the bridges are enabled", "ResetDevice sent with the bridges on");
   add(CoverageCategory::refusals, "an opcode that is no command", "a byte the chip does not know as an opcode (WRONG_CMD)");
@@ -173,19 +175,25 @@ CoverageUniverse::CoverageUniverse(const Variant& v) : variant_(v.name) {
   fault(TraceFault::POWER_CYCLE, "a brown-out: the chip restarted");
   fault(TraceFault::MISO_FLIP, "a bit of the chip's answer flipped on the wire");
   fault(TraceFault::LOST_FRAME, "the chip missed a frame");
-  add(CoverageCategory::events, "SW closed", "the SW pin went low (a switch closed)");
-  add(CoverageCategory::events, "SW opened", "the SW pin went high again");
+  if (v.pins.sw) {
+    add(CoverageCategory::events, "SW closed", "the SW pin went low (a switch closed)");
+    add(CoverageCategory::events, "SW opened", "the SW pin went high again");
+  }
   add(CoverageCategory::events, "STBY_RST reset", "STBY\\RST held low, then released");
   // Step modes.
   std::uint8_t finest = 0;
   for (const Variant* t : tables) finest = std::max(finest, t->max_step_sel);
+  // The L6474 moves by STCK pulses: its step mode is the one its Enable drives them in.
+  const std::string driven_by = v.motion_engine ? "a motion command" : "Enable (the size of its STCK steps)";
   for (std::uint8_t s = 0; s <= finest && s < 8; ++s)
-    add(CoverageCategory::step_modes, std::string(step_mode_name(s)), "a motion command with STEP_SEL = " + std::to_string(s));
-  // Pin edges.
-  for (const char* pin : {"BUSY", "FLAG"})
+    add(CoverageCategory::step_modes, std::string(step_mode_name(s)), driven_by + " with STEP_SEL = " + std::to_string(s));
+  // Pin edges (BUSY only on a part that has the pin).
+  for (const char* pin : {"BUSY", "FLAG"}) {
+    if (std::string_view(pin) == "BUSY" && !v.pins.busy_sync) continue;
     for (const char* edge : {"falling", "rising"})
       add(CoverageCategory::pin_edges, std::string(pin) + " " + edge,
           std::string("the program waited for ") + pin + " " + edge + " (an edge event, or a read in a loop)");
+  }
   // Sanitizer rules.
   for (const RuleInfo& r : rule_table()) add(CoverageCategory::rules_broken, std::string(r.name), std::string(r.about));
 }

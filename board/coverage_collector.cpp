@@ -117,7 +117,7 @@ void CoverageCollector::command(std::size_t chain, std::size_t k, const Chip& c,
       mark(s, CoverageCategory::commands, name);
       break;
   }
-  if (is_motion_command(op.command)) {
+  if (is_motion_command(op.command) || op.command == Command::Enable) {  // the L6474's step mode: Enable's
     s.pending = op;
     s.pending_step_sel = c.profile().step_sel;
     s.has_pending = true;

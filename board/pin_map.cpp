@@ -55,7 +55,7 @@ std::string to_string(const McuPin& pin) {
 }
 
 const char* pin_key(Pin p) {
-  static const char* const keys[] = {"busy_pin", "flag_pin", "sw_pin", "stck_pin", "stby_rst_pin"};
+  static const char* const keys[] = {"busy_pin", "flag_pin", "sw_pin", "stck_pin", "stby_rst_pin", "dir_pin"};
   return keys[static_cast<unsigned>(p)];
 }
 

@@ -1,6 +1,6 @@
 // Which microcontroller pin each wire of a chain goes to, for the firmware fronts: the chain's
-// chip select and each chip's BUSY, FLAG, SW, STCK and STBY_RST, and the SPI controller it hangs
-// on. Names and parsing only; levels and edges live in Board and firmware/.
+// chip select and each chip's BUSY, FLAG, SW, STCK, STBY_RST and DIR, and the SPI controller it
+// hangs on. Names and parsing only; levels and edges live in Board and firmware/.
 #pragma once
 
 #include <array>
@@ -41,7 +41,7 @@ std::string to_string(const McuPin& pin);
 using ChipPinList = std::vector<std::optional<McuPin>>;
 
 /// The microcontroller side of one chain (the description's cs_pin=, busy_pin=, flag_pin=,
-/// sw_pin=, stck_pin=, stby_rst_pin= and spi= keys).
+/// sw_pin=, stck_pin=, stby_rst_pin=, dir_pin= and spi= keys).
 struct ChainPins {
   /// The pin driving the chain's chip select (cs_pin=); none: nothing selects it.
   std::optional<McuPin> cs;
@@ -64,7 +64,7 @@ struct ChainPins {
   bool operator==(const ChainPins&) const = default;
 };
 
-/// The description key of a chip pin: "busy_pin", "flag_pin", "sw_pin", "stck_pin", "stby_rst_pin".
+/// The description key of a chip pin: "busy_pin", "flag_pin", "sw_pin", "stck_pin", "stby_rst_pin", "dir_pin".
 const char* pin_key(Pin p);
 
 /// Canonical name of an SPI controller (spi=): "SPI", "SPI1".."SPI9", "HSPI", "VSPI", "FSPI",

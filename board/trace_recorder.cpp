@@ -70,6 +70,7 @@ ChainTraceRecorder::~ChainTraceRecorder() = default;
 void ChainTraceRecorder::set_input(std::size_t chip, Pin pin, bool level) {
   if (pin == Pin::SW) recording_.set_sw_pin(chip, level);
   if (pin == Pin::STCK) recording_.set_stck_pin(chip, level);
+  if (pin == Pin::DIR) recording_.set_dir_pin(chip, level);
   if (pin == Pin::STBY_RST) recording_.set_stby_rst_pin(chip, level);
 }
 

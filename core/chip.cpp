@@ -40,6 +40,11 @@ void Chip::reset_logic() {
   const std::int64_t travel = motion_.travel;  // the shaft does not move with a reset
   motion_ = MotionState{};
   motion_.travel = travel;
+  if (!variant_->motion_engine) {
+    // No generator to leave: the part is always where the others are in step-clock mode.
+    motion_.activity = Activity::step_clock;
+    motion_.dir = dir_level_;
+  }
   refresh_profile();
   set_collecting(false);
   args_seen_ = 0;
@@ -84,10 +89,17 @@ std::uint8_t Chip::decode_byte(std::uint8_t byte) {
   }
   const Opcode& op = variant_->opcodes[byte];
   switch (op.command) {
-    case Command::Unknown:
-      wrong_command(byte, classify_opcode(byte).command == Command::Unknown ? "no such command"
-                                                                            : "no register at this address");
+    case Command::Unknown: {
+      const Command raw = classify_opcode(byte).command;
+      if (raw == Command::SetParam || raw == Command::GetParam)
+        wrong_command(byte, "no register at this address");
+      else if (raw == Command::Unknown)
+        wrong_command(byte, "no such command");
+      else  // a command of the parts with a motion engine, sent to one without (the L6474)
+        wrong_command(byte, ("no such command on an " + std::string(variant_->name) + " (" +
+                             std::string(to_string(raw)) + " on the others)").c_str());
       break;
+    }
     case Command::Reserved:
       wrong_command(byte, "reserved opcode");
       break;
@@ -198,6 +210,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       soft_stop(motion_, profile_, op.command == Command::SoftHiZ);
       return;
     case Command::HardStop:
+    case Command::Enable:  // HardStop's opcode on the L6474, which is always in step-clock mode
       if (hiz_forced()) {
         hard_hiz(motion_);
         return;
@@ -205,6 +218,7 @@ void Chip::execute(const Opcode& op, std::uint32_t arg) {
       hard_stop(motion_);
       return;
     case Command::HardHiZ:
+    case Command::Disable:
       hard_hiz(motion_);
       return;
     case Command::Reserved:
@@ -410,7 +424,7 @@ bool Chip::busy_sync_pin() const {
 
 Chip::OutputLevels Chip::output_levels() const {
   OutputLevels o;
-  const bool plain = stby_level_ && !axis_ && (reg(Reg::STEP_MODE) & kStepModeSyncEn) == 0;
+  const bool plain = stby_level_ && !axis_ && !sync_clock_on();
   if (plain && now_ < status_until_ && layout_.busy >= 0) {
     // Inside the run of uniform ticks the cached STATUS is good for: BUSY is its bit and the
     // motion neither starts nor ends, so nothing needs working out.
@@ -441,11 +455,12 @@ Chip::OutputLevels Chip::output_levels() const {
   return o;
 }
 
+bool Chip::sync_clock_on() const { return variant_->pins.busy_sync && (reg(Reg::STEP_MODE) & kStepModeSyncEn) != 0; }
+
 bool Chip::busy_level() const {
-  if (!stby_level_) return true;
-  const std::uint32_t step_mode = reg(Reg::STEP_MODE);
-  if ((step_mode & kStepModeSyncEn) != 0) {
-    const unsigned sync_sel = (step_mode >> 4) & 7u;
+  if (!stby_level_ || !variant_->pins.busy_sync) return true;  // no pin: nothing pulls it low
+  if (sync_clock_on()) {
+    const unsigned sync_sel = (reg(Reg::STEP_MODE) >> 4) & 7u;
     return ((motion_.el_pos >> (7 - sync_sel)) & 1u) != 0;
   }
   return !motion_busy(motion_, profile_);
@@ -491,7 +506,7 @@ void Chip::set_sw_pin(bool level) {
 
 void Chip::drive_sw(bool level) {
   touched();
-  if (level == sw_level_) return;
+  if (level == sw_level_ || !variant_->pins.sw) return;  // no SW input: nothing to drive
   sw_level_ = level;
   if (!stby_level_) return;
   if (!level)
@@ -533,8 +548,17 @@ void Chip::set_stck_pin(bool level) {
   touched();
   const bool rising = level && !stck_level_;
   stck_level_ = level;
-  if (rising && stby_level_ && motion_.activity == Activity::step_clock) take_microstep(motion_, profile_);
+  // Without a motion engine (the L6474) an edge moves the motor only with the bridges enabled.
+  if (rising && stby_level_ && motion_.activity == Activity::step_clock && (variant_->motion_engine || !motion_.hiz))
+    take_microstep(motion_, profile_);
   if (axis_) axis_after_change();
+}
+
+void Chip::set_dir_pin(bool level) {
+  sync();
+  touched();
+  dir_level_ = level;
+  if (variant_->pins.dir) motion_.dir = level;
 }
 
 void Chip::set_stby_rst_pin(bool level) {
@@ -718,7 +742,12 @@ DriveInputs Chip::drive_inputs() const {
   };
   const bool gate_driver = variant_->has(Reg::GATECFG1);
   DriveInputs d;
-  if (table_->has(Reg::TVAL_RUN)) {
+  if (table_->has(Reg::TVAL)) {
+    // One torque value whatever the motor does (the L6474). EN_TQREG's ADC_OUT is not modelled.
+    d.mode = DriveMode::current_ma;
+    const auto tval = static_cast<std::uint8_t>(value(Reg::TVAL));
+    d.level = {tval, tval, tval, tval};
+  } else if (table_->has(Reg::TVAL_RUN)) {
     d.mode = gate_driver ? DriveMode::current_sense : DriveMode::current_ma;
     d.level = {static_cast<std::uint8_t>(value(Reg::TVAL_HOLD)), static_cast<std::uint8_t>(value(Reg::TVAL_RUN)),
                static_cast<std::uint8_t>(value(Reg::TVAL_ACC)), static_cast<std::uint8_t>(value(Reg::TVAL_DEC))};

@@ -120,18 +120,27 @@ class alignas(64) Chip {
 
   // ---- pins (the physical world; host programs only see SPI and these) ------
 
-  /// BUSY\SYNC output level: false = pulled low (busy, or the SYNC clock low).
+  /// BUSY\SYNC output level: false = pulled low (busy, or the SYNC clock low). Always high on
+  /// a part without the pin (the L6474).
   bool busy_sync_pin() const;
+  /// Whether BUSY\SYNC outputs the SYNC clock (STEP_MODE.SYNC_EN on a part with the pin).
+  bool sync_clock_on() const;
   /// FLAG output level: false = pulled low (an enabled alarm is active).
   bool flag_pin() const;
-  /// SW input level; false = switch closed (pin pulled to ground). Edges act at now().
+  /// SW input level; false = switch closed (pin pulled to ground). Edges act at now(). A part
+  /// without a SW input (the L6474) ignores it.
   void set_sw_pin(bool level);
   bool sw_pin() const {
     if (axis_) sync();  // the axis's switches drive it
     return sw_level_;
   }
-  /// STCK input level; a rising edge in step-clock mode makes one microstep.
+  /// STCK input level; a rising edge in step-clock mode makes one microstep (on a part without
+  /// a motion engine, the L6474: each rising edge while the bridges are enabled).
   void set_stck_pin(bool level);
+  /// DIR input level (the L6474's; the other parts have no such pin and ignore it): the
+  /// direction STCK steps in, high = forward. STATUS DIR shows it.
+  void set_dir_pin(bool level);
+  bool dir_pin() const { return dir_level_; }
   /// STBY\RST input; low holds the logic in reset with SPI silent, rising edge = power-up state.
   void set_stby_rst_pin(bool level);
   /// The ADC_OUT conversion of the ADCIN pin, 0..31 (larger values saturate).
@@ -372,6 +381,7 @@ class alignas(64) Chip {
 
   bool sw_level_ = true;
   bool stck_level_ = false;
+  bool dir_level_ = false;
   std::uint8_t adc_code_ = 0;
 
   DiagnosticSink sink_;

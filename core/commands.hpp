@@ -11,6 +11,8 @@ namespace l6470emu {
 enum class Command : std::uint8_t {
   NOP, SetParam, GetParam, Run, StepClock, Move, GoTo, GoTo_DIR, GoUntil, ReleaseSW,
   GoHome, GoMark, ResetPos, ResetDevice, SoftStop, HardStop, SoftHiZ, HardHiZ, GetStatus,
+  Enable,    ///< the L6474's: bridges on (HardStop's opcode, 0xB8); no other part decodes it
+  Disable,   ///< the L6474's: bridges in high impedance (HardHiZ's opcode, 0xA8)
   Reserved,  ///< 0xEB / 0xF8, "RESERVED COMMAND": treated as unknown (UNCONFIRMED)
   Unknown,   ///< no such command, or a parameter address the variant lacks
 };
@@ -41,8 +43,22 @@ constexpr std::string_view to_string(Command c) {
   constexpr std::string_view names[] = {
       "NOP", "SetParam", "GetParam", "Run", "StepClock", "Move", "GoTo", "GoTo_DIR",
       "GoUntil", "ReleaseSW", "GoHome", "GoMark", "ResetPos", "ResetDevice", "SoftStop",
-      "HardStop", "SoftHiZ", "HardHiZ", "GetStatus", "RESERVED", "unknown"};
+      "HardStop", "SoftHiZ", "HardHiZ", "GetStatus", "Enable", "Disable", "RESERVED", "unknown"};
   return names[static_cast<unsigned>(c)];
+}
+
+/// What an opcode means on a part without a motion engine (the L6474): NOP, SetParam, GetParam
+/// and GetStatus as on the others, HardStop's opcode as Enable and HardHiZ's as Disable; every
+/// other command is no command there (WRONG_CMD). The reserved opcodes stay reserved.
+constexpr Opcode without_motion_engine(Opcode op) {
+  switch (op.command) {
+    case Command::NOP: case Command::SetParam: case Command::GetParam: case Command::GetStatus:
+    case Command::Reserved: case Command::Unknown:
+      return op;
+    case Command::HardStop: op.command = Command::Enable; return op;
+    case Command::HardHiZ: op.command = Command::Disable; return op;
+    default: return Opcode{};  // Command::Unknown, no argument bytes
+  }
 }
 
 /// Classifies an opcode byte without regard to which registers exist.

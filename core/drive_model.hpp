@@ -14,7 +14,7 @@ namespace l6470emu {
 /// How the chip sets the phase current.
 enum class DriveMode : std::uint8_t {
   voltage,        ///< L6470, L6480, powerSTEP01 with CM_VM = 0: KVAL sets the voltage amplitude
-  current_ma,     ///< L6472: TVAL is a current, 31.25 mA·(n+1)
+  current_ma,     ///< L6472, L6474: TVAL is a current, 31.25 mA·(n+1)
   current_sense,  ///< L6482, powerSTEP01 with CM_VM = 1: TVAL is a sense voltage, 7.8 mV·(n+1)
 };
 

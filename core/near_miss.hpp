@@ -24,7 +24,7 @@ std::string closest_names(std::string_view word, const std::vector<std::string>&
 /// "did you mean L6470 or L6472? " for a misspelt variant name, else "".
 std::string variant_suggestion(std::string_view name);
 
-/// The variant names, comma separated: "L6470, L6472, L6480, L6482, powerSTEP01".
+/// The variant names, comma separated: "L6470, L6472, L6480, L6482, powerSTEP01, L6474".
 std::string known_variant_list();
 
 }  // namespace l6470emu

@@ -16,6 +16,7 @@ enum class Reg : std::uint8_t {
   OCD_TH, STALL_TH, FS_SPD, STEP_MODE, ALARM_EN, CONFIG, STATUS,
   GATECFG1, GATECFG2,
   TVAL_HOLD, TVAL_RUN, TVAL_ACC, TVAL_DEC, T_FAST, TON_MIN, TOFF_MIN,
+  TVAL,  ///< the L6474's one torque register (0x09), where the others have four
   count
 };
 

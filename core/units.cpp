@@ -30,6 +30,9 @@ constexpr std::string_view kSlopeNote =
 constexpr std::string_view kL6472Note = "UNCONFIRMED: one third-party header (no L6472 table was read)";
 constexpr std::string_view kL6482OcdNote = "the L6482's scale: one ST library (its cSPIN header)";
 constexpr std::string_view kTvalNote = "7.8 mV in the sources: 128 steps up to 1 V make it 7.8125 mV";
+// The L6474's scales: ST's drivers (31.25 mA per TVAL step up to 4 A, 0.5 us per TON_MIN/TOFF_MIN
+// step up to 64 us, 2 us per T_FAST step, 375 mA per OCD_TH step), docs/l6474.md.
+constexpr std::string_view kL6474Note = "ST's L6474 drivers' conversions (docs/l6474.md)";
 
 // Registers every variant has.
 #define L6470EMU_MOTION_SCALES(INFINITE_ACC)                                                                                     \
@@ -111,6 +114,12 @@ constexpr UnitScale kL6472[] = {
               "UNCONFIRMED: the L6470's scale, assumed for the L6472 (same width)"},
     speed_scale("FS_SPD", Reg::FS_SPD, 10, 1u << 10, 1),
 };
+constexpr UnitScale kL6474[] = {
+    UnitScale{"TVAL", Reg::TVAL, 0, 7, 2, 125, 4, PhysicalUnit::mA, false, kL6474Note},
+    L6470EMU_CURRENT_TIMES(kL6474Note),
+    L6470EMU_ADC_SCALE,
+    UnitScale{"OCD_TH", Reg::OCD_TH, 0, 4, 2, 375, 1, PhysicalUnit::mA, false, kL6474Note},
+};
 #undef L6470EMU_MOTION_SCALES
 #undef L6470EMU_VOLTAGE_SCALES
 #undef L6470EMU_ADC_SCALE
@@ -181,6 +190,7 @@ std::span<const UnitScale> unit_scales(const Variant& variant) {
   if (&variant == &l6480()) return kL6480;
   if (&variant == &l6482()) return kL6482;
   if (&variant == &powerstep01() || &variant == powerstep01().current_mode) return kPowerstep01;
+  if (&variant == &l6474()) return kL6474;
   return {};
 }
 

@@ -17,7 +17,7 @@ namespace l6470emu {
 enum class PhysicalUnit : std::uint8_t {
   step_per_s,        ///< full steps per second, whatever STEP_SEL says
   step_per_s2,       ///< full steps per second²
-  mA,                ///< a current (integrated bridges: L6470, L6472)
+  mA,                ///< a current (integrated bridges: L6470, L6472, L6474)
   mV,                ///< a voltage (gate drivers: V_DS of the MOSFETs, or the sense-resistor voltage)
   fraction_of_VS,    ///< KVAL: the share of the supply voltage applied (0 … 255/256)
   s_per_step,        ///< BEMF compensation slope: share of VS per step/s

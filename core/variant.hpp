@@ -1,5 +1,6 @@
 // A chip variant as data: its register table, STATUS layout, ALARM_EN meaning
-// and a few capabilities. There is no class per variant; the model reads these.
+// and a few capabilities (pins, whether it has a motion engine). There is no class per
+// variant; the model reads these.
 #pragma once
 
 #include <array>
@@ -18,6 +19,13 @@ struct ReservedBit {
   Reg reg;
   std::uint8_t bit;
   std::string_view source;  ///< where it is stated: "§9.1.19 Table 17, note 1: write 0"
+};
+
+/// The pins a part has beside FLAG, STCK and STBY\RST (which every member has).
+struct VariantPins {
+  bool busy_sync = true;  ///< BUSY\SYNC output (not on the L6474)
+  bool sw = true;         ///< SW input (not on the L6474)
+  bool dir = false;       ///< DIR input: the direction STCK steps in (the L6474 only)
 };
 
 /// Everything that distinguishes one family member from another.
@@ -44,6 +52,12 @@ struct Variant {
   std::array<Opcode, 256> opcodes{};
   /// Bits to be written 0 (STEP_MODE bit 3 on the L6470/L6480, CONFIG bit 6), for the sanitizer.
   std::span<const ReservedBit> reserved_bits{};
+  /// False on the L6474: no speed profile generator and no motion commands (their opcodes are
+  /// unknown commands); the position moves one microstep at each STCK rising edge while the
+  /// bridges are enabled, in the direction the DIR pin gives. Set by drop_motion_engine().
+  bool motion_engine = true;
+  /// The pins the part has.
+  VariantPins pins{};
 
   /// The register at `address`, or nullptr when the variant has none there.
   constexpr const RegisterInfo* at_address(std::uint8_t address) const {
@@ -85,6 +99,15 @@ constexpr Variant make_variant(std::string_view name, std::span<const RegisterIn
   return v;
 }
 
+/// Makes `v` a part without a motion engine (the L6474): its opcodes become
+/// without_motion_engine()'s (Enable, Disable, GetStatus, GetParam, SetParam, NOP), and it has
+/// DIR where the others have BUSY\SYNC and SW.
+constexpr void drop_motion_engine(Variant& v) {
+  v.motion_engine = false;
+  v.pins = VariantPins{.busy_sync = false, .sw = false, .dir = true};
+  for (Opcode& op : v.opcodes) op = without_motion_engine(op);
+}
+
 /// Checks a register table at compile time: unique ascending addresses in 0x01..0x1F,
 /// widths of 1..24 bits, reset values inside the width, live registers read-only or positions.
 constexpr bool register_table_is_consistent(std::span<const RegisterInfo> table) {
@@ -110,6 +133,8 @@ const Variant& l6482();
 /// The powerSTEP01 (voltage or current mode by STEP_MODE.CM_VM, power stage in package),
 /// in its power-up voltage mode; current_mode points at its current-mode reading.
 const Variant& powerstep01();
+/// The L6474 (easySPIN: current mode, integrated bridges, no motion engine: STCK and DIR move it).
+const Variant& l6474();
 
 /// Every family member, in the order above.
 std::span<const Variant* const> all_variants();

@@ -14,7 +14,7 @@ bool same_name(std::string_view a, std::string_view b) {
 }
 
 std::span<const Variant* const> all_variants() {
-  static const std::array<const Variant*, 5> kAll{&l6470(), &l6472(), &l6480(), &l6482(), &powerstep01()};
+  static const std::array<const Variant*, 6> kAll{&l6470(), &l6472(), &l6480(), &l6482(), &powerstep01(), &l6474()};
   return kAll;
 }
 

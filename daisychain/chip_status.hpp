@@ -31,7 +31,7 @@ class ChipStatus {
   /// The bridges are in high impedance (HiZ).
   bool hiz() const { return bit(layout_->hiz); }
   /// A command is under way (BUSY is low).
-  bool busy() const { return !bit(layout_->busy); }
+  bool busy() const { return low(layout_->busy); }
   /// SW is closed now (SW_F).
   bool switch_closed() const { return bit(layout_->sw_f); }
   /// A switch turn-on event happened (SW_EVN, latched).
@@ -40,6 +40,7 @@ class ChipStatus {
   Direction direction() const { return bit(layout_->dir) ? Direction::forward : Direction::reverse; }
   /// MOT_STATUS: stopped, accelerating, decelerating or at constant speed.
   MotStatus motor_status() const {
+    if (layout_->mot_status < 0) return MotStatus::stopped;  // no motion engine (the L6474)
     return static_cast<MotStatus>((raw_ >> layout_->mot_status) & 3u);
   }
   /// The last command could not be performed (NOTPERF_CMD; CMD_ERROR on the gate-driver parts).
@@ -47,16 +48,17 @@ class ChipStatus {
   /// The last command did not exist (WRONG_CMD; CMD_ERROR on the gate-driver parts).
   bool wrong_cmd() const { return bit(layout_->wrong_cmd); }
   /// Undervoltage lockout of the motor supply (UVLO, active low in the register).
-  bool uvlo() const { return !bit(layout_->uvlo); }
+  bool uvlo() const { return low(layout_->uvlo); }
   /// ADC undervoltage (UVLO_ADC, gate-driver parts; false where the layout has no such flag).
-  bool uvlo_adc() const { return layout_->uvlo_adc >= 0 && !bit(layout_->uvlo_adc); }
+  bool uvlo_adc() const { return low(layout_->uvlo_adc); }
   /// The die temperature class (TH_WRN / TH_SD, or TH_STATUS on the gate-driver parts).
   Thermal thermal() const;
   /// Overcurrent (OCD, active low).
-  bool overcurrent() const { return !bit(layout_->ocd); }
-  /// Stall or step loss on bridge A / B (STEP_LOSS_A/B, STALL_A/B; active low).
-  bool step_loss_a() const { return !bit(layout_->step_loss_a); }
-  bool step_loss_b() const { return !bit(layout_->step_loss_b); }
+  bool overcurrent() const { return low(layout_->ocd); }
+  /// Stall or step loss on bridge A / B (STEP_LOSS_A/B, STALL_A/B; active low; false on a part
+  /// without stall detection).
+  bool step_loss_a() const { return low(layout_->step_loss_a); }
+  bool step_loss_b() const { return low(layout_->step_loss_b); }
   /// Either bridge stalled.
   bool stalled() const { return step_loss_a() || step_loss_b(); }
   /// Step-clock mode (SCK_MOD / STCK_MOD).
@@ -74,6 +76,8 @@ class ChipStatus {
 
  private:
   bool bit(std::int8_t at) const { return at >= 0 && ((raw_ >> at) & 1u) != 0; }
+  /// An active-low field that is there and low (a field the layout lacks is never active).
+  bool low(std::int8_t at) const { return at >= 0 && ((raw_ >> at) & 1u) == 0; }
 
   std::uint16_t raw_;
   const StatusLayout* layout_;

@@ -117,6 +117,7 @@ class Decoder {
         case TracePin::BUSY: what = level ? "BUSY output high (released)" : "BUSY output low (busy)"; break;
         case TracePin::FLAG: what = level ? "FLAG output high (no alarm)" : "FLAG output low (alarm)"; break;
         case TracePin::SW_AXIS: what = level ? "SW high: the axis's switch opened" : "SW low: the axis's switch closed"; break;
+        case TracePin::DIR: what = level ? "DIR pin high (forward)" : "DIR pin low (reverse)"; break;
       }
       // STCK edges are as frequent as the steps: show them only with --nops.
       if (e.pin == TracePin::STCK && !options_.show_nops) return;

@@ -17,6 +17,7 @@ namespace {
 
 struct ChipWires {
   int busy, flag, sw, stck, stby, abs_pos, coil_a, coil_b;
+  int dir = -1;  // a chip with a DIR input (the L6474) only
 };
 
 }  // namespace
@@ -34,6 +35,7 @@ void export_emulated_vcd(const TracePasses& passes, Chain& chain, std::ostream& 
                 w.wire(scope, "SW", c.sw_pin()),          w.wire(scope, "STCK", false),
                 w.wire(scope, "STBY", c.spi_enabled()),   w.number(scope, "ABS_POS", c.position()),
                 w.number(scope, "COIL_A", d.coil_a),      w.number(scope, "COIL_B", d.coil_b)};
+    if (c.variant().pins.dir) wires[k].dir = w.wire(scope, "DIR", c.dir_pin());
   }
   ProtocolTracker tracker(chain);
   const Tick step = std::max<Tick>(options.sample_ticks, 1);
@@ -87,6 +89,7 @@ void export_emulated_vcd(const TracePasses& passes, Chain& chain, std::ostream& 
       if (e.pin == TracePin::SW || e.pin == TracePin::SW_AXIS) w.change(ns, wires[e.chip].sw, e.value);
       if (e.pin == TracePin::STCK) w.change(ns, wires[e.chip].stck, e.value);
       if (e.pin == TracePin::STBY) w.change(ns, wires[e.chip].stby, e.value);
+      if (e.pin == TracePin::DIR && wires[e.chip].dir >= 0) w.change(ns, wires[e.chip].dir, e.value);
     }
     look(e.tick);
     end_ns = std::max(end_ns, ns);

@@ -57,6 +57,9 @@ std::string opcode_name(std::uint8_t opcode, const Variant& table) {
     case Command::Unknown: {
       if (raw.command == Command::SetParam || raw.command == Command::GetParam)
         return std::string(to_string(raw.command)) + "(" + hex_value(raw.param, 8) + ", no such register)";
+      // A command of the parts with a motion engine sent to one without (the L6474): say which.
+      if (raw.command != Command::Unknown && raw.command != Command::Reserved)
+        return "unknown opcode " + hex_value(opcode, 8) + " (" + opcode_name(opcode, l6470()) + " on the others)";
       return "unknown opcode " + hex_value(opcode, 8);
     }
     default:
@@ -95,8 +98,15 @@ std::string describe_value(const RegisterInfo& r, std::uint32_t v, const StatusL
     case Reg::STEP_MODE: {
       const unsigned sel = v & 7u;
       std::string out = s + " = STEP_SEL " + std::to_string(sel) + (sel == 0 ? " (full step)" : " (1/" + std::to_string(1u << sel) + " step)");
-      if (v & 0x80u) out += ", SYNC_EN, SYNC_SEL " + std::to_string((v >> 4) & 7u);
+      // SYNC_EN drives the BUSY\SYNC pin: a part without one (the L6474, whose STATUS has no
+      // BUSY either) gives bits 7:4 no meaning.
+      if ((v & 0x80u) && layout.busy >= 0) out += ", SYNC_EN, SYNC_SEL " + std::to_string((v >> 4) & 7u);
       return out;
+    }
+    case Reg::TVAL: {  // the L6474's: 31.25 mA per step from 31.25 mA
+      char buf[32];
+      std::snprintf(buf, sizeof buf, " = %g mA", (v + 1) * 31.25);
+      return s + buf;
     }
     case Reg::STATUS:
       return s + " [" + describe_status(layout, static_cast<std::uint16_t>(v)) + "]";

@@ -49,6 +49,9 @@ class ChainHost {
   void hard_stop(std::size_t k);
   void soft_hiz(std::size_t k);
   void hard_hiz(std::size_t k);
+  /// The L6474's Enable (bridges on) and Disable (high impedance): HardStop's and HardHiZ's opcodes.
+  void enable(std::size_t k) { hard_stop(k); }
+  void disable(std::size_t k) { hard_hiz(k); }
 
   // ---- typed forms (Direction, SwitchAction, ChipStatus) -----------------------------------
 

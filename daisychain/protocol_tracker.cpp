@@ -327,6 +327,7 @@ void ProtocolTracker::apply(const TraceEvent& e) {
     switch (e.pin) {
       case TracePin::SW: chip.set_sw_pin(e.value != 0); break;
       case TracePin::STCK: chip.set_stck_pin(e.value != 0); break;
+      case TracePin::DIR: chip.set_dir_pin(e.value != 0); break;
       case TracePin::STBY:
         if ((e.value != 0) != chip.spi_enabled()) {
           chip.set_stby_rst_pin(e.value != 0);

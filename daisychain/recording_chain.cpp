@@ -28,7 +28,6 @@ void RecordingChain::emit(const TraceEvent& e) { sink_.write(e); }
 
 namespace {
 
-constexpr std::uint32_t kStepModeSyncEn = 1u << 7;  // STEP_MODE.SYNC_EN: BUSY\SYNC is a clock
 /// How far ahead a recording looks for BUSY/FLAG changes when time passes (64 ms): nothing to
 /// look at again until then, unless something is done to the chain.
 constexpr Tick kLookAheadTicks = ticks_from_ms(64);
@@ -43,7 +42,7 @@ Tick RecordingChain::first_output_change(std::size_t k, Tick to, bool& unsure) c
   const Chip& chip = chain_.chip(k);
   const Tick from = chain_.now();
   if (!chip.spi_enabled()) return kNever;  // held in standby: BUSY high, nothing moves
-  const bool sync = (chip.peek(Reg::STEP_MODE) & kStepModeSyncEn) != 0;
+  const bool sync = chip.sync_clock_on();
   unsure = unsure || sync;
   const bool busy0 = chip.busy_sync_pin(), flag0 = chip.flag_pin();
   const bool axis = chip.has_axis(), sw0 = chip.sw_pin();
@@ -347,6 +346,10 @@ void RecordingChain::set_stck_pin(std::size_t chip, bool level) {
   chain_.chip(chip).set_stck_pin(level);
   backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STCK), level);
 }
+void RecordingChain::set_dir_pin(std::size_t chip, bool level) {
+  chain_.chip(chip).set_dir_pin(level);
+  backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::DIR), level);
+}
 void RecordingChain::set_stby_rst_pin(std::size_t chip, bool level) {
   chain_.chip(chip).set_stby_rst_pin(level);
   backdoor(chip, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::STBY), level);
@@ -407,7 +410,7 @@ void RecordingChain::look_at_outputs() {
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::SW_AXIS), levels.sw);
     }
     const std::uint8_t busy = levels.busy, flag = levels.flag;
-    if (busy != busy_[k]) {
+    if (busy != busy_[k] && c.variant().pins.busy_sync) {  // an L6474 has no BUSY pin to observe
       busy_[k] = busy;
       backdoor(k, TraceEventKind::pin, static_cast<std::uint8_t>(TracePin::BUSY), busy);
     }

@@ -55,6 +55,7 @@ class RecordingChain final : public SpiDevice {
   // written after the frame's line (a trace line's time never goes back).
   void set_sw_pin(std::size_t chip, bool level);
   void set_stck_pin(std::size_t chip, bool level);
+  void set_dir_pin(std::size_t chip, bool level);
   void set_stby_rst_pin(std::size_t chip, bool level);
   void set_adc_input(std::size_t chip, std::uint8_t code);
   void set_undervoltage(std::size_t chip, bool active);

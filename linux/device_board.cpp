@@ -42,10 +42,12 @@ DeviceBoard::DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostCloc
       g->label = ("l6470emu " + cd->name).substr(0, 31);
       g->chain = ci;
       const std::size_t n = board_.chip_count(ci);
-      g->lines.resize(n * kPinsPerChip);
+      g->layout.chips = n;
+      for (std::size_t k = 0; k < n; ++k) g->layout.dir = g->layout.dir || board_.chain(ci).peek_chip(k).variant().pins.dir;
+      g->lines.resize(g->layout.count());
       for (unsigned off = 0; off < g->lines.size(); ++off) {
         LineDev& l = g->lines[off];
-        l.name = line_name(n, off);
+        l.name = g->layout.name(off);
         l.flags = GPIO_V2_LINE_FLAG_INPUT;
       }
       cd->gpio = static_cast<int>(gpios_.size());
@@ -336,34 +338,35 @@ long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::
 
 bool DeviceBoard::physical_level(GpioDev& g, unsigned offset) {
   const LineDev& l = g.lines[offset];
-  const Pin p = pin_of_line(offset);
+  const Pin p = g.layout.pin_of(offset);
   // The host drives a chip output: it reads its own value.
   if (pin_is_chip_output(p) && (l.flags & GPIO_V2_LINE_FLAG_OUTPUT)) return l.out_value;
-  return board_.level(g.chain, chip_of_line(offset), p);
+  return board_.level(g.chain, g.layout.chip_of(offset), p);
 }
 
 void DeviceBoard::set_chip_input(GpioDev& g, unsigned offset, bool level) {
   LineDev& l = g.lines[offset];
-  const Pin p = pin_of_line(offset);
+  const Pin p = g.layout.pin_of(offset);
   if (pin_is_chip_output(p)) {
     if (l.out_value != level)
       log_.line(g.name + ": the host drives " + l.name + ", an output of the chip (ignored by the chip)");
     l.out_value = level;
     return;
   }
-  board_.set_input(g.chain, chip_of_line(offset), p, level);
+  board_.set_input(g.chain, g.layout.chip_of(offset), p, level);
 }
 
 void DeviceBoard::watch_line(GpioDev& g, unsigned offset, bool watched) {
   // Edge detection (which needs an input line) starts from the level the line has now.
-  board_.watch_pin(g.chain, chip_of_line(offset), pin_of_line(offset), watched);
+  board_.watch_pin(g.chain, g.layout.chip_of(offset), g.layout.pin_of(offset), watched);
 }
 
 void DeviceBoard::report_edge(const PinEdge& e) {
   const ChainDev& c = *chains_[e.chain];
   if (c.gpio < 0) return;
   GpioDev& g = *gpios_[static_cast<std::size_t>(c.gpio)];
-  const LineDev& l = g.lines[line_offset(e.chip, e.pin)];
+  if (!g.layout.has(e.pin)) return;
+  const LineDev& l = g.lines[g.layout.offset(e.chip, e.pin)];
   if (!l.owner) return;
   // Edges are reported in logical terms, as the kernel does (active-low swaps them).
   const bool logical_rising = e.level != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
@@ -394,7 +397,7 @@ void DeviceBoard::send_line_event(Handle& h, unsigned index, bool rising, Tick t
   } else {
     return;
   }
-  if (n >= 0) board_.note_output_edge(g.chain, chip_of_line(off), pin_of_line(off), rising);  // handed to the host
+  if (n >= 0) board_.note_output_edge(g.chain, g.layout.chip_of(off), g.layout.pin_of(off), rising);  // handed to the host
   if (n < 0 && ++h.dropped == 1)
     log_.line(g.name + ": " + g.lines[off].name + ": event queue full, edge events dropped (the host does not read them)");
 }
@@ -434,13 +437,11 @@ bool DeviceBoard::drive_pin(std::size_t chain, std::size_t chip, Pin pin, bool l
   if (chain >= chains_.size() || pin_is_chip_output(pin)) return false;
   ChainDev& c = *chains_[chain];
   if (chip >= board_.chip_count(chain)) return false;
+  if (!variant_has_pin(board_.chain(chain).peek_chip(chip).variant(), pin)) return false;  // DIR on an L6470...
   board_.catch_up(chain);
-  if (c.gpio < 0) {
-    board_.set_input(chain, chip, pin, level);
-    return true;
-  }
+  if (c.gpio < 0) return board_.set_input(chain, chip, pin, level);
   GpioDev& g = *gpios_[static_cast<std::size_t>(c.gpio)];
-  const unsigned off = line_offset(chip, pin);
+  const unsigned off = g.layout.offset(chip, pin);
   if (g.lines[off].owner && (g.lines[off].flags & GPIO_V2_LINE_FLAG_OUTPUT))
     log_.line(g.name + ": " + g.lines[off].name + " is driven by a host program; the physical world overrides it");
   set_chip_input(g, off, level);
@@ -453,7 +454,10 @@ bool DeviceBoard::pin_level(std::size_t chain, std::size_t chip, Pin pin) {
   std::lock_guard lock(m_);
   ChainDev& c = *chains_.at(chain);
   board_.catch_up(chain);
-  if (c.gpio >= 0) return physical_level(*gpios_[static_cast<std::size_t>(c.gpio)], line_offset(chip, pin));
+  if (c.gpio >= 0) {
+    GpioDev& g = *gpios_[static_cast<std::size_t>(c.gpio)];
+    if (g.layout.has(pin)) return physical_level(g, g.layout.offset(chip, pin));
+  }
   return board_.level(chain, chip, pin);
 }
 

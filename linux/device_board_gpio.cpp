@@ -236,7 +236,7 @@ long DeviceBoard::request_lines(Handle& chip, HandleKind kind, const std::vector
     l.debounce_us = debounce[i];
     if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && values[i] >= 0)
       set_chip_input(g, offsets[i], (values[i] != 0) != ((fl & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
-    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && pin_is_chip_output(pin_of_line(offsets[i])))
+    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && pin_is_chip_output(g.layout.pin_of(offsets[i])))
       log_.line(g.name + ": line " + l.name + " requested as an output by \"" + r.consumer +
                 "\", but the chip drives it (the host reads back its own value)");
     edges = edges || (fl & kV2EdgeFlags);
@@ -285,7 +285,7 @@ long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>&
 bool DeviceBoard::logical_value(Handle& h, unsigned index) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned off = h.offsets[index];
-  board_.note_output_read(g.chain, chip_of_line(off), pin_of_line(off));  // the host looks (BUSY, FLAG)
+  board_.note_output_read(g.chain, g.layout.chip_of(off), g.layout.pin_of(off));  // the host looks (BUSY, FLAG)
   return physical_level(g, off) != ((g.lines[off].flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
 }
 

@@ -32,6 +32,7 @@ struct DeviceBoard::GpioDev {
   std::string name;   // "gpiochip0"
   std::string label;  // "l6470emu spidev0.0"
   std::size_t chain = 0;
+  GpioLines layout;  // which line is which chip's which pin
   std::vector<LineDev> lines;
 };
 

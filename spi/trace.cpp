@@ -15,6 +15,7 @@ std::string_view to_string(TracePin pin) {
     case TracePin::BUSY: return "BUSY";
     case TracePin::FLAG: return "FLAG";
     case TracePin::SW_AXIS: return "SW";
+    case TracePin::DIR: return "DIR";
   }
   return "?";
 }

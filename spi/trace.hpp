@@ -61,6 +61,7 @@ enum class TracePin : std::uint8_t {
   /// SW as the chip's mechanical axis drove it (observed, like BUSY and FLAG: replay checks it
   /// and does not drive it); written `pin K SW LEVEL axis`.
   SW_AXIS,
+  DIR,   ///< input (the L6474's); the direction STCK steps in, high = forward
 };
 
 /// Whether a pin event is an observation of the chip (BUSY, FLAG, SW_AXIS), which replay

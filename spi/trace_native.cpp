@@ -493,12 +493,12 @@ bool NativeTraceReader::parse_line(std::string_view line, TraceEvent& e) {
     if (kind == "pin") {
       e.kind = TraceEventKind::pin;
       bool found = false;
-      for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG})
+      for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG, TracePin::DIR})
         if (name == to_string(p)) {
           e.pin = p;
           found = true;
         }
-      if (!found) fail("unknown pin " + quoted(name) + " (SW, STCK, STBY, BUSY or FLAG)");
+      if (!found) fail("unknown pin " + quoted(name) + " (SW, STCK, STBY, BUSY, FLAG or DIR)");
       if (value != "0" && value != "1") fail("pin level " + quoted(value) + " is not 0 or 1");
       e.value = value == "1";
       // `pin K SW L axis`: the level the chip's axis drove SW to, an observation.

@@ -33,7 +33,8 @@ constexpr FaultSpec kFaults[] = {
     {CampaignFault::block, "block", "STEP_LOSS_A", "a hard stop in the way of the rotor where it is: the motor stalls against it (boards with an axis)"},
 };
 
-bool is_motion(Command c) { return is_motion_command(c); }
+// Enable is where an L6474 (no motion command) starts to be driven: its phase like a motion's.
+bool is_motion(Command c) { return is_motion_command(c) || c == Command::Enable; }
 bool is_config(Command c) { return c == Command::SetParam || c == Command::ResetDevice || c == Command::ResetPos; }
 bool is_poll(Command c) { return c == Command::GetStatus || c == Command::GetParam; }
 
@@ -94,6 +95,9 @@ std::string fault_unavailable(CampaignFault fault, const Variant& variant, bool 
     case CampaignFault::stall_b:
       if ((fault == CampaignFault::stall_a ? variant.status.step_loss_a : variant.status.step_loss_b) < 0)
         return std::string(variant.name) + " has no stall detection";
+      break;
+    case CampaignFault::sw_close:
+      if (!variant.pins.sw) return std::string(variant.name) + " has no SW input";
       break;
     case CampaignFault::block:
       if (!has_axis) return "the chip has no axis (axis.K= in the board description)";
@@ -165,7 +169,9 @@ std::vector<ChipRun> read_clean_run(const std::string& trace_path, std::size_t c
     }
     const std::uint16_t status = chip.status();
     const StatusLayout& l = chip.status_layout();
-    c.final_status = {{"HiZ", (status >> l.hiz) & 1u}, {"BUSY", (status >> l.busy) & 1u}, {"DIR", (status >> l.dir) & 1u}};
+    c.final_status = {{"HiZ", (status >> l.hiz) & 1u}};
+    if (l.busy >= 0) c.final_status.emplace_back("BUSY", (status >> l.busy) & 1u);  // not on an L6474
+    c.final_status.emplace_back("DIR", (status >> l.dir) & 1u);
   }
   return chips;
 }

@@ -123,7 +123,7 @@ int usage_error(const CLI::App& app, const CLI::ParseError& e, std::ostream& err
              message.find("ubcommand") != std::string::npos) {
     line = "a subcommand is required: " + plain_list(subcommand_names(app)) + " (l6470emu --help)";
   } else {
-    line = shown(message) == message ? message : message.substr(0, 200);
+    line = shown(message) == message ? message : message.substr(0, 320);
     if (line.find("did you mean") == std::string::npos) line += help;
   }
   err << who << ": " << line << "\n";

@@ -269,9 +269,11 @@ std::string units_table_markdown() {
       if (!merged) rows.push_back(row);
     }
   }
+  std::string every;  // the list a row of every variant has
+  for (const Variant* v : all_variants()) every += (every.empty() ? "" : ", ") + std::string(v->name);
   std::string out = "| Register | Variants | Physical value of n | Range | Source note |\n|---|---|---|---|---|\n";
   for (const Row& r : rows) {
-    const std::string variants = r.variants == "L6470, L6472, L6480, L6482, powerSTEP01" ? "all" : r.variants;
+    const std::string variants = r.variants == every ? "all" : r.variants;
     out += "| " + r.name + " | " + variants + " | " + r.value + " | " + r.range + " | " + r.note + " |\n";
   }
   return out;
@@ -287,7 +289,7 @@ void add_units_command(CLI::App& app) {
   u->add_option("VALUE", a->value,
                 "a register value (0x041, 65) or a physical value with its unit (200step/s, '3.5 A', 16%, 4us, inf); "
                 "none: the register's formula and range");
-  u->add_option("--variant", a->variant, "the chip: L6470 (default), L6472, L6480, L6482, powerSTEP01");
+  u->add_option("--variant", a->variant, "the chip: L6470 (default), L6472, L6480, L6482, powerSTEP01, L6474");
   u->add_flag("--saturate", a->saturate, "a physical value out of range gives the nearest end instead of an error");
   u->callback([a] {
     const int status = run_units(*a, std::cout, std::cerr);

@@ -56,8 +56,11 @@ int main(int argc, char** argv) {
   auto* tables = app.add_subcommand("tables", "print the tables the model uses, as Markdown");
   tables->add_option("--table", table, "which table")
       ->check(l6470emu::one_of({"l6470-registers", "l6470-status", "commands", "variant-registers", "variant-status",
-                                "variant-differences", "sanitizer-rules", "units"}));
-  tables->add_option("--update-readme", readme, "rewrite the generated blocks of this Markdown file instead (docs/reference/tables.md, docs/linux.md)");
+                                "variant-differences", "sanitizer-rules", "units", "l6474-registers", "l6474-status",
+                                "l6474-commands"}));
+  tables->add_option("--update-readme", readme,
+                     "rewrite the generated blocks of this Markdown file instead (docs/reference/tables.md, docs/linux.md, "
+                     "docs/l6474.md)");
 
   l6470emu::ServeCommands serve_commands(app);  // serve, ctl
   l6470emu::RunCommand run_command(app);         // run

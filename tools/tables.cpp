@@ -4,6 +4,7 @@
 #include "board/check_rules.hpp"
 #include "tools/cmd_units.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <string>
@@ -26,27 +27,36 @@ std::string flags_text(const RegisterInfo& r) {
   if (r.is_signed()) s += "22-bit two's complement; ";
   if (r.is_live()) s += "computed by the model; ";
   if (r.flags & kWriteConflict) s += "write condition is a quirk (docs/quirks.md); ";
+  if (r.flags & kUnconfirmed) s += "UNCONFIRMED (one source); ";
   if (!s.empty()) s.resize(s.size() - 2);
   return s;
+}
+
+/// The command table's "Argument bytes" cell of an opcode.
+std::string argument_text(const Opcode& op) {
+  switch (op.command) {
+    case Command::SetParam: return "register length (1–3)";
+    case Command::GetParam: return "0 (answer: register length)";
+    case Command::GetStatus: return "0 (answer: 2)";
+    case Command::Reserved: return "— (treated as unknown: WRONG_CMD)";
+    default: return std::to_string(op.arg_bytes);
+  }
 }
 
 }  // namespace
 
 std::string register_table_markdown(const Variant& v) {
   std::string out = "| Addr | Register | Bits | SPI bytes | Reset | Write | Notes |\n|---|---|---|---|---|---|---|\n";
-  for (const auto& r : v.registers) {
-    char row[160];
-    std::snprintf(row, sizeof row, "| 0x%02X | %s | %u | %u | 0x%0*X | %s | %s |\n", r.address,
-                  std::string(r.name).c_str(), r.bits, r.spi_bytes(), (r.bits + 3) / 4, r.reset,
-                  std::string(to_string(r.access)).c_str(), flags_text(r).c_str());
+  for (unsigned a = 1; a < 32; ++a) {
+    char row[192];
+    if (const RegisterInfo* r = v.at_address(static_cast<std::uint8_t>(a)))
+      std::snprintf(row, sizeof row, "| 0x%02X | %s | %u | %u | 0x%0*X | %s | %s |\n", r->address,
+                    std::string(r->name).c_str(), r->bits, r->spi_bytes(), (r->bits + 3) / 4, r->reset,
+                    std::string(to_string(r->access)).c_str(), flags_text(*r).c_str());
+    else
+      std::snprintf(row, sizeof row, "| 0x%02X | (none) | | | | | WRONG_CMD |\n", a);
     out += row;
   }
-  for (unsigned a = 1; a < 32; ++a)
-    if (!v.at_address(static_cast<std::uint8_t>(a))) {
-      char row[96];
-      std::snprintf(row, sizeof row, "| 0x%02X | (none) | | | | | WRONG_CMD |\n", a);
-      out += row;
-    }
   return out;
 }
 
@@ -87,7 +97,38 @@ std::string status_table_markdown(const Variant& v) {
   put(l.sck_mod, "SCK_MOD (step-clock mode)");
   std::string out = "| Bit | Field |\n|---|---|\n";
   for (int bit = 15; bit >= 0; --bit)
-    out += "| " + std::to_string(bit) + " | " + (names[bit].empty() ? "(unused)" : names[bit]) + " |\n";
+    out += "| " + std::to_string(bit) + " | " +
+           (!names[bit].empty() ? names[bit] : ((l.unused_ones >> bit) & 1u) ? "(unused, reads 1)" : "(unused, reads 0)") + " |\n";
+  return out;
+}
+
+std::string variant_command_table_markdown(const Variant& v) {
+  // The commands the variant's own opcode table decodes, each with its opcodes (a run of
+  // SetParam/GetParam opcodes written first–last, holes left out).
+  std::string out = "| Command | Opcodes | Argument bytes |\n|---|---|---|\n";
+  std::vector<Command> order;
+  for (unsigned b = 0; b < 256; ++b) {
+    const Command c = v.opcodes[b].command;
+    if (c != Command::Unknown && std::find(order.begin(), order.end(), c) == order.end()) order.push_back(c);
+  }
+  for (const Command c : order) {
+    std::string list;
+    for (unsigned b = 0; b < 256; ++b) {
+      if (v.opcodes[b].command != c) continue;
+      if (c == Command::SetParam || c == Command::GetParam) {
+        if (b > 0 && v.opcodes[b - 1].command == c && b < 255 && v.opcodes[b + 1].command == c) continue;
+        const bool starts = b == 0 || v.opcodes[b - 1].command != c;
+        const bool ends = b == 255 || v.opcodes[b + 1].command != c;
+        list += starts ? (list.empty() ? "" : ", ") + hex2(b) : "";
+        if (ends && !starts) list += "–" + hex2(b);
+      } else {
+        list += (list.empty() ? "" : ", ") + hex2(b);
+      }
+    }
+    const auto first = std::find_if(v.opcodes.begin(), v.opcodes.end(), [c](const Opcode& o) { return o.command == c; });
+    out += "| " + std::string(to_string(c)) + " | " + list + " | " + argument_text(*first) + " |\n";
+  }
+  out += "| (any other byte) | | — (no command: WRONG_CMD) |\n";
   return out;
 }
 
@@ -116,15 +157,7 @@ std::string command_table_markdown() {
       }
       e = x;
     }
-    std::string args;
-    switch (op.command) {
-      case Command::SetParam: args = "register length (1–3)"; break;
-      case Command::GetParam: args = "0 (answer: register length)"; break;
-      case Command::GetStatus: args = "0 (answer: 2)"; break;
-      case Command::Reserved: args = "— (treated as unknown: WRONG_CMD)"; break;
-      default: args = std::to_string(op.arg_bytes); break;
-    }
-    out += "| " + std::string(to_string(op.command)) + " | " + list + " | " + args + " |\n";
+    out += "| " + std::string(to_string(op.command)) + " | " + list + " | " + argument_text(op) + " |\n";
     b = e + 1;
   }
   return out;
@@ -242,8 +275,21 @@ std::string variant_differences_markdown() {
     for (const Variant* v : all_variants()) out += " " + cell(*v) + " |";
     out += "\n";
   };
+  row("motion", [](const Variant& v) {
+    return std::string(v.motion_engine ? "speed profile generator" : "none: STCK pulses in the direction of DIR");
+  });
+  row("pins besides FLAG, STCK, STBY\\RST", [](const Variant& v) {
+    std::string p;
+    if (v.pins.busy_sync) p += "BUSY\\SYNC";
+    if (v.pins.sw) p += std::string(p.empty() ? "" : ", ") + "SW";
+    if (v.pins.dir) p += std::string(p.empty() ? "" : ", ") + "DIR";
+    return p;
+  });
   row("finest microstep", [](const Variant& v) { return "1/" + std::to_string(1 << v.max_step_sel); });
-  row("ACC = 0xFFF", [](const Variant& v) { return std::string(v.infinite_acceleration ? "infinite acceleration" : "ordinary value"); });
+  row("ACC = 0xFFF", [](const Variant& v) {
+    if (!v.has(Reg::ACC)) return std::string("–");
+    return std::string(v.infinite_acceleration ? "infinite acceleration" : "ordinary value");
+  });
   row("CONFIG / STATUS at", [](const Variant& v) { return hex2(v.find(Reg::CONFIG)->address) + " / " + hex2(v.find(Reg::STATUS)->address); });
   row("command errors", [](const Variant& v) {
     return std::string(v.status.wrong_cmd == v.status.notperf_cmd ? "CMD_ERROR (bit 7)" : "WRONG_CMD (8), NOTPERF_CMD (7)");
@@ -253,6 +299,7 @@ std::string variant_differences_markdown() {
     return std::to_string(v.find(Reg::OCD_TH)->bits) + " / " + (s ? std::to_string(s->bits) : std::string("–"));
   });
   row("ResetDevice with bridges on", [](const Variant& v) {
+    if (v.opcodes[0xC0].command != Command::ResetDevice) return std::string("– (no ResetDevice)");
     return std::string(v.reset_device_needs_hiz ? "refused (CMD_ERROR) †" : "performed");
   });
   out += "\n**UNCONFIRMED choices** (each is covered by a test):\n\n";
@@ -277,6 +324,9 @@ std::string generated_block(std::string_view name) {
   if (name == "l6470-registers") return register_table_markdown(l6470());
   if (name == "l6470-status") return status_table_markdown(l6470());
   if (name == "commands") return command_table_markdown();
+  if (name == "l6474-registers") return register_table_markdown(l6474());
+  if (name == "l6474-status") return status_table_markdown(l6474());
+  if (name == "l6474-commands") return variant_command_table_markdown(l6474());
   if (name == "units") return units_table_markdown();
   return "";
 }

@@ -18,6 +18,10 @@ std::string status_table_markdown(const Variant& v);
 /// The opcodes the decoder accepts and their argument bytes.
 std::string command_table_markdown();
 
+/// The commands `v`'s own opcode table decodes (the L6474's: Enable, Disable ...), with their
+/// opcodes and argument bytes.
+std::string variant_command_table_markdown(const Variant& v);
+
 /// One table of every variant's registers: a row per address, a column per variant (and the
 /// powerSTEP01's current-mode reading), each cell "NAME bits/reset/access".
 std::string variant_registers_markdown();
@@ -34,7 +38,8 @@ std::string variant_differences_markdown();
 std::string sanitizer_rules_markdown();
 
 /// The generated block called `name` ("l6470-registers", "l6470-status", "commands", "variant-registers",
-/// "variant-status", "variant-differences", "sanitizer-rules", "units"), or "" if unknown.
+/// "variant-status", "variant-differences", "sanitizer-rules", "units", "l6474-registers",
+/// "l6474-status", "l6474-commands"), or "" if unknown.
 std::string generated_block(std::string_view name);
 
 /// Replaces every `<!-- BEGIN generated:NAME -->` ... `<!-- END generated:NAME -->` block of

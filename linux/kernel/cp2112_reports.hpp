@@ -1,8 +1,9 @@
 // The HID reports of a Silicon Labs CP2112 (USB HID to SMBus bridge with 8 GPIO pins), as far
 // as Linux's hid-cp2112 driver uses them, answered for one emulated chip: the bridge's GPIO
-// pins are the chip's BUSY, FLAG, SW, STCK and STBY_RST lines (offsets as in gpio_lines.hpp;
-// pins 5..7 unused). The driver reads and changes pins through feature reports 0x02 (direction),
-// 0x03 (levels) and 0x04 (set outputs); probing reads 0x05, 0x06 and 0x20; sysfs reads 0x21..0x24.
+// pins are the chip's BUSY, FLAG, SW, STCK, STBY_RST and DIR lines (pins 0..5 in Pin's order;
+// 6 and 7 unused, and like DIR on a chip without one they read high). The driver reads and
+// changes pins through feature reports 0x02 (direction), 0x03 (levels) and 0x04 (set outputs);
+// probing reads 0x05, 0x06 and 0x20; sysfs reads 0x21..0x24.
 // No I/O here: linux/kernel/uhid_cp2112.cpp carries the reports over /dev/uhid.
 #pragma once
 

@@ -1,9 +1,9 @@
 // The chips' GPIO lines on real gpiochips: for each emulated chip the daemon impersonates a
 // CP2112 USB HID bridge through /dev/uhid; the stock kernel's hid-cp2112 driver binds to it and
 // registers a gpiochip "cp2112_gpio" with 8 lines (0 BUSY, 1 FLAG, 2 SW, 3 STCK, 4 STBY_RST,
-// 5..7 unused). Every get, set or direction change of a host program becomes a HID report
-// answered from the DeviceBoard; edge events come from the driver polling the levels every 10
-// jiffies. Needs /dev/uhid (root, `modprobe uhid`) and the hid-cp2112 module.
+// 5 DIR (an L6474's; high on the others), 6 and 7 unused). Every get, set or direction change
+// of a host program becomes a HID report answered from the DeviceBoard; edge events come from
+// the driver polling the levels every 10 jiffies. Needs /dev/uhid (root, `modprobe uhid`) and the hid-cp2112 module.
 #pragma once
 
 #include <cstddef>

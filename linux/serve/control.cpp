@@ -123,7 +123,7 @@ std::string control_help(std::optional<NumberFrom> numbering) {
          "  dump                                every register of every chip, STATUS decoded, open files\n"
          "  clients                             the connected programs (pid), each through shared memory or the socket\n"
          "  sw open|closed --chip K             the limit switch on the SW pin (closed = pulled low)\n"
-         "  pin SW|STCK|STBY_RST 0|1 --chip K   drive an input pin of a chip\n"
+         "  pin SW|STCK|STBY_RST|DIR 0|1 --chip K   drive an input pin of a chip (DIR: an L6474's)\n"
          "  fault uvlo|uvlo-adc|ocd|stall-a|stall-b on|off --chip K\n"
          "  fault reset|lost-frame|miso-flip [BIT] --chip K   a brown-out; the chip deaf to, or one bit of its answer\n"
          "                                 flipped in, the chain's next frame\n"
@@ -255,7 +255,7 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
       level = a.words[0] == "open";
     } else {
       if (a.words.size() != 2 || (a.words[1] != "0" && a.words[1] != "1")) {
-        out = "ctl: usage: pin SW|STCK|STBY_RST 0|1 --chip K\n";
+        out = "ctl: usage: pin SW|STCK|STBY_RST|DIR 0|1 --chip K\n";
         return 2;
       }
       if (a.words[0] == "SW")
@@ -264,13 +264,18 @@ int run_control(DeviceBoard& board, const std::string& command, std::string& out
         pin = Pin::STCK;
       else if (a.words[0] == "STBY_RST" || a.words[0] == "STBY" || a.words[0] == "RST")
         pin = Pin::STBY_RST;
+      else if (a.words[0] == "DIR")
+        pin = Pin::DIR;
       else {
-        out = "ctl: pin must be SW, STCK or STBY_RST (BUSY and FLAG are the chip's outputs)\n";
+        out = "ctl: pin must be SW, STCK, STBY_RST or DIR (BUSY and FLAG are the chip's outputs)\n";
         return 2;
       }
       level = a.words[1] == "1";
     }
-    board.drive_pin(ci, k, pin, level);
+    if (!board.drive_pin(ci, k, pin, level)) {
+      out = "ctl: " + label(k) + " has no " + pin_name(pin) + " pin\n";
+      return 2;
+    }
     o << label(k) << ": " << pin_name(pin) << " " << (level ? "high" : "low") << "\n";
   } else if (cmd == "fault") {
     std::size_t k = 0;

@@ -37,8 +37,9 @@ LINE_REQ_FLAG_OPEN_DRAIN = 1
 LINE_REQ_FLAG_OPEN_SOURCE = 2
 LINE_REQ_FLAG_ACTIVE_LOW = 4
 
-#: The pins of each chip, in gpiochip line order (offset = 5 * chip + index).
-PINS = ("BUSY", "FLAG", "SW", "STCK", "STBY_RST")
+#: The pins of each chip, in gpiochip line order: offset = 5 * chip + index for the first five;
+#: DIR (an L6474's) on a chain with one, offset = 5 * chips + chip.
+PINS = ("BUSY", "FLAG", "SW", "STCK", "STBY_RST", "DIR")
 
 #: Where the host's CLOCK_MONOTONIC stands at tick 0 (as under the preload in virtual time), ns.
 MONOTONIC_ORIGIN_NS = 1_000_000_000_000
@@ -138,7 +139,8 @@ class Board:
 
     def line(self, chip: int = 0, pin: Union[str, int] = "BUSY", *, chain: int = 0) -> "Line":
         """Pin `pin` of chip `chip` of chain `chain` as a libgpiod line (not yet requested)."""
-        return self.gpiochip(chain).get_line(5 * chip + _pin_index(pin))
+        gpiochip = self.gpiochip(chain)
+        return gpiochip.get_line(gpiochip._offset(chip, _pin_index(pin)))
 
     def chain_count(self) -> int:
         return self._core.chain_count()
@@ -195,7 +197,7 @@ class Board:
         return int(self._core.level(chain, chip, _pin_index(pin)))
 
     def drive(self, chip: int, pin: Union[str, int], level: int, *, chain: int = 0) -> None:
-        """Drives an input pin (SW, STCK, STBY_RST) as the physical world would."""
+        """Drives an input pin (SW, STCK, STBY_RST; DIR on an L6474) as the physical world would."""
         self._core.drive(chain, chip, _pin_index(pin), bool(level))
 
     def fault(self, chip: int, fault, value: Optional[int] = None, *, chain: int = 0) -> None:
@@ -479,14 +481,14 @@ class Line:
 
     @property
     def _where(self):
-        return self._chip._chain, self._offset // 5, self._offset % 5
+        return (self._chip._chain,) + self._chip._chip_and_pin(self._offset)
 
     def offset(self) -> int:
         return self._offset
 
     def name(self) -> str:
-        pin = PINS[self._offset % 5]
-        return pin if self._chip._chips == 1 else f"{pin}{self._offset // 5}"
+        k, pin = self._chip._chip_and_pin(self._offset)
+        return PINS[pin] if self._chip._chips == 1 else f"{PINS[pin]}{k}"
 
     def consumer(self) -> Optional[str]:
         return self._consumer
@@ -535,20 +537,22 @@ class Line:
         if self._type == LINE_REQ_DIR_OUT:
             return self._value
         core = self._chip._board._core
-        if PINS[self._offset % 5] in ("BUSY", "FLAG"):
+        if PINS[self._where[2]] in ("BUSY", "FLAG"):
             core.note_output_read(*self._where)  # the driver looks (coverage: BUSY, FLAG's alarms observed)
         return self._logical(core.level(*self._where))
 
     def set_value(self, value: int) -> None:
-        """Drives an output line (SW, STCK, STBY_RST reach the chip; BUSY and FLAG are the chip's)."""
+        """Drives an output line (SW, STCK, STBY_RST and DIR reach the chip; BUSY and FLAG are the chip's;
+        the DIR line of a chip without a DIR pin is connected to nothing)."""
         self._needs_request()
         if self._type != LINE_REQ_DIR_OUT:
             raise PermissionError(errno.EPERM, "the line is not an output", self.name())
         self._value = 1 if value else 0
         chain, chip, pin = self._where
-        if PINS[pin] in ("BUSY", "FLAG"):
-            return  # the chip drives it; the host reads back its own value
-        self._chip._board._core.drive(chain, chip, pin, bool(self._logical(bool(self._value))))
+        core = self._chip._board._core
+        if PINS[pin] in ("BUSY", "FLAG") or not core.has_pin(chain, chip, pin):
+            return  # the chip drives it (the host reads back its own value), or has no such pin
+        core.drive(chain, chip, pin, bool(self._logical(bool(self._value))))
 
     def _collect(self) -> None:
         edges, _dropped = self._chip._board._core.take_edges(*self._where)
@@ -653,13 +657,31 @@ class LineBulk:
 
 class GpioChip:
     """An emulated gpiochip (the pins of one chain), as gpiod.Chip: name, label, num_lines,
-    get_line, get_lines, get_all_lines, find_line. Line offset = 5 * chip + pin (PINS order)."""
+    get_line, get_lines, get_all_lines, find_line. Line offset = 5 * chip + pin (PINS order) for
+    the first five pins; on a chain with an L6474, whose DIR pin the others lack, one DIR line per
+    chip after them: offset = 5 * chips + chip (as the preload library's gpiochips)."""
 
     def __init__(self, board: Board, chain: int):
         self._board = board
         self._chain = chain
         self._chips = board._core.chip_count(chain)
-        self._lines = [Line(self, k) for k in range(5 * self._chips)]
+        dir_index = PINS.index("DIR")
+        self._dir = any(board._core.has_pin(chain, k, dir_index) for k in range(self._chips))
+        self._lines = [Line(self, k) for k in range((6 if self._dir else 5) * self._chips)]
+
+    def _offset(self, chip: int, pin: int) -> int:
+        """The line offset of pin index `pin` of chip `chip`."""
+        if PINS[pin] == "DIR":
+            if not self._dir:
+                raise ValueError(f"no chip of {self.name()} has a DIR pin (the L6474's)")
+            return 5 * self._chips + chip
+        return 5 * chip + pin
+
+    def _chip_and_pin(self, offset: int):
+        """(chip, pin index) of a line offset."""
+        if offset >= 5 * self._chips:
+            return offset - 5 * self._chips, PINS.index("DIR")
+        return offset // 5, offset % 5
 
     def name(self) -> str:
         n = self._board._core.gpiochip(self._chain)

@@ -41,7 +41,7 @@ std::size_t chip_arg(PyBoard& b, std::size_t chain, long long chip) {
 
 Pin pin_arg(long long pin) {
   if (pin < 0 || pin >= static_cast<long long>(kPinsPerChip))
-    throw py::value_error("pin " + std::to_string(pin) + ": 0..4 (BUSY, FLAG, SW, STCK, STBY_RST)");
+    throw py::value_error("pin " + std::to_string(pin) + ": 0..5 (BUSY, FLAG, SW, STCK, STBY_RST, DIR)");
   return static_cast<Pin>(pin);
 }
 
@@ -115,6 +115,10 @@ void bind_board(py::module_& m) {
     std::vector<std::string> out;
     for (std::size_t k = 0; k < ch.size(); ++k) out.emplace_back(ch.chip(k).variant().name);
     return out;
+  });
+  b.def("has_pin", [](PyBoard& s, long long c, long long k, long long p) {
+    const std::size_t chain = chain_arg(s, c);
+    return variant_has_pin(s.board().chain(chain).chip(chip_arg(s, chain, k)).variant(), pin_arg(p));
   });
   b.def("gpiochip", [](PyBoard& s, long long c) -> py::object {
     const ChainConfig& cc = s.board().chain_config(chain_arg(s, c));
@@ -190,8 +194,12 @@ void bind_board(py::module_& m) {
   });
   b.def("drive", [](PyBoard& s, long long c, long long k, long long p, bool level) {
     const std::size_t chain = chain_arg(s, c);
-    if (!s.board().drive_pin(chain, chip_arg(s, chain, k), pin_arg(p), level))
+    const std::size_t chip = chip_arg(s, chain, k);
+    if (s.board().drive_pin(chain, chip, pin_arg(p), level)) return;
+    if (pin_is_chip_output(pin_arg(p)))
       throw py::value_error(std::string(pin_name(pin_arg(p))) + " is the chip's output: it cannot be driven");
+    const std::string variant(s.board().chain(chain).chip(chip).variant().name);
+    throw py::value_error("chip " + std::to_string(k) + " is an " + variant + ", which has no " + pin_name(pin_arg(p)) + " pin");
   });
   b.def("watch", [](PyBoard& s, long long c, long long k, long long p, bool on) {
     const std::size_t chain = chain_arg(s, c);

@@ -323,11 +323,14 @@ Time does not advance by itself: call advance() between frames as a bus would ta
       {"go_home", &ChainHost::go_home},         {"go_mark", &ChainHost::go_mark},     {"reset_pos", &ChainHost::reset_pos},
       {"reset_device", &ChainHost::reset_device}, {"soft_stop", &ChainHost::soft_stop}, {"hard_stop", &ChainHost::hard_stop},
       {"soft_hiz", &ChainHost::soft_hiz},       {"hard_hiz", &ChainHost::hard_hiz},
+      {"enable", &ChainHost::enable},           {"disable", &ChainHost::disable},
   };
   const char* simple_docs[] = {"GoHome: to position 0.", "GoMark: to MARK.", "ResetPos: ABS_POS = 0.",
                                "ResetDevice: registers to their reset values.", "SoftStop: decelerate to a stop.",
                                "HardStop: stop at once.", "SoftHiZ: decelerate, then bridges off.",
-                               "HardHiZ: bridges off at once."};
+                               "HardHiZ: bridges off at once.",
+                               "Enable, an L6474's command (HardStop's opcode 0xB8): bridges on.",
+                               "Disable, an L6474's command (HardHiZ's opcode 0xA8): bridges off at once."};
   for (std::size_t i = 0; i < std::size(simple); ++i) {
     const auto fn = simple[i].second;
     c.def(simple[i].first, [fn](PyChain& p, py::handle chip) { (p.host().*fn)(chip_arg(p, chip)); after_spi(p); }, py::arg("chip"),
@@ -427,7 +430,15 @@ Time does not advance by itself: call advance() between frames as a bus would ta
       .def("sw_pin", [](PyChain& p, py::handle chip) { return p.chain().chip(chip_arg(p, chip)).sw_pin(); }, py::arg("chip"),
            "SW input level.")
       .def("set_stck_pin", [](PyChain& p, py::handle chip, py::handle level) { p.set_stck_pin(chip_arg(p, chip), level_arg(level, "level")); },
-           py::arg("chip"), py::arg("level"), "STCK input level; a rising edge in step-clock mode makes one microstep.")
+           py::arg("chip"), py::arg("level"),
+           "STCK input level; a rising edge in step-clock mode makes one microstep (an L6474: each rising edge while "
+           "its bridges are enabled, in the direction of its DIR pin).")
+      .def("set_dir_pin", [](PyChain& p, py::handle chip, py::handle level) { p.set_dir_pin(chip_arg(p, chip), level_arg(level, "level")); },
+           py::arg("chip"), py::arg("level"),
+           "DIR input level of an L6474 (the direction STCK steps in: True/1 = forward); other parts have no DIR pin "
+           "and ignore it.")
+      .def("dir_pin", [](PyChain& p, py::handle chip) { return p.chain().chip(chip_arg(p, chip)).dir_pin(); }, py::arg("chip"),
+           "DIR input level.")
       .def("set_stby_rst_pin",
            [](PyChain& p, py::handle chip, py::handle level) { p.set_stby_rst_pin(chip_arg(p, chip), level_arg(level, "level")); },
            py::arg("chip"), py::arg("level"), "STBY/RST input: low holds the logic in reset (SPI silent); rising edge = power-up state.")

@@ -6,8 +6,8 @@
 
 PYBIND11_MODULE(_l6470emu, m) {
   m.doc() =
-      "Register-level emulator of the ST L6470-family SPI motion engines (L6470, L6472, L6480,\n"
-      "L6482, powerSTEP01): daisy chains in virtual time, byte-exact SPI, pins, faults, traces.";
+      "Register-level emulator of the ST L6470-family SPI stepper drivers (L6470, L6472, L6480,\n"
+      "L6482, powerSTEP01, L6474): daisy chains in virtual time, byte-exact SPI, pins, faults, traces.";
   m.attr("__version__") = L6470EMU_VERSION;
   m.attr("TICKS_PER_SECOND") = 4'000'000;
   // The bounds on the work a trace may ask for (max_frames=, max_points=): spi/trace.hpp and

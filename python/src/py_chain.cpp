@@ -127,6 +127,15 @@ void PyChain::set_stck_pin(std::size_t chip, bool level) {
   look();
 }
 
+void PyChain::set_dir_pin(std::size_t chip, bool level) {
+  if (rec_)
+    rec_->set_dir_pin(chip, level);
+  else
+    chain_->chip(chip).set_dir_pin(level);
+  if (coverage_) coverage_->input(0, chip, Pin::DIR, level);
+  look();
+}
+
 void PyChain::set_stby_rst_pin(std::size_t chip, bool level) {
   if (rec_)
     rec_->set_stby_rst_pin(chip, level);

@@ -66,6 +66,7 @@ class PyChain {
   // The physical world, recorded when recording.
   void set_sw_pin(std::size_t chip, bool level);
   void set_stck_pin(std::size_t chip, bool level);
+  void set_dir_pin(std::size_t chip, bool level);
   void set_stby_rst_pin(std::size_t chip, bool level);
   void set_adc_input(std::size_t chip, std::uint8_t code);
   /// A backdoor event as in a trace: UVLO/UVLO_ADC/OCD/STALL_A/STALL_B 0 or 1, THERMAL 0..3, ADCIN 0..31.

@@ -91,7 +91,7 @@ void bind_registers(py::module_& m) {
         for (const Variant* v : all_variants()) out.emplace_back(v->name);
         return out;
       },
-      "The chip variants by name: L6470, L6472, L6480, L6482, powerSTEP01.");
+      "The chip variants by name: L6470, L6472, L6480, L6482, powerSTEP01, L6474.");
   m.def(
       "register_table",
       [](const std::string& variant, bool current_mode) {

@@ -115,6 +115,7 @@ TEST(Units, OutOfRangeValuesAreRefusedWithAReasonOrSaturated) {
 
 TEST(Units, AccOfAllOnesIsInfiniteWhereItMeansInfiniteAcceleration) {
   for (const Variant* v : all_variants()) {
+    if (!v->has(Reg::ACC)) continue;  // the L6474: no speed profile
     const UnitScale& acc = scale(*v, "ACC");
     EXPECT_EQ(acc.top_is_infinite, v->infinite_acceleration) << v->name;
     EXPECT_FALSE(scale(*v, "DEC").top_is_infinite) << v->name;
@@ -134,7 +135,8 @@ TEST(Units, EveryScaleFitsItsRegisterAndEveryPhysicalRegisterHasOne) {
                                   Reg::FS_SPD,    Reg::INT_SPEED, Reg::KVAL_HOLD, Reg::KVAL_RUN,   Reg::KVAL_ACC,
                                   Reg::KVAL_DEC,  Reg::ST_SLP,   Reg::FN_SLP_ACC, Reg::FN_SLP_DEC, Reg::K_THERM,
                                   Reg::ADC_OUT,   Reg::OCD_TH,   Reg::STALL_TH,   Reg::TVAL_HOLD,  Reg::TVAL_RUN,
-                                  Reg::TVAL_ACC,  Reg::TVAL_DEC, Reg::T_FAST,     Reg::TON_MIN,    Reg::TOFF_MIN};
+                                  Reg::TVAL_ACC,  Reg::TVAL_DEC, Reg::T_FAST,     Reg::TON_MIN,    Reg::TOFF_MIN,
+                                  Reg::TVAL};
   for (const Variant* v : all_variants()) {
     for (const Variant* table : {v, v->current_mode}) {
       if (table == nullptr) continue;
@@ -156,6 +158,23 @@ TEST(Units, ScalesAreDescribedInWords) {
   EXPECT_EQ(describe_scale(l6480(), scale(l6480(), "FS_SPD")), "(n + 0.5) · 15.2587890625 step/s, n = bits 9..0");
   EXPECT_EQ(describe_scale(l6470(), scale(l6470(), "K_THERM")), "(n + 32) · 0.03125 x");
   EXPECT_EQ(describe_scale(l6482(), scale(l6482(), "TOFF_FAST")), "(n + 1) · 2 µs, n = bits 7..4");
+  EXPECT_EQ(describe_scale(l6474(), scale(l6474(), "TVAL")), "(n + 1) · 31.25 mA");
+}
+
+TEST(Units, L6474TvalIs31p25mAPerStepUpTo4AAndItsTimesAreTheL6472s) {
+  // ST's L6474 drivers: TVAL 31.25 mA to 4 A, TON_MIN/TOFF_MIN 0.5 to 64 us, OCD_TH 375 mA steps.
+  EXPECT_EQ(phys(l6474(), "TVAL", 0), 31.25);
+  EXPECT_EQ(phys(l6474(), "TVAL", 0x29), 1312.5);
+  EXPECT_EQ(phys(l6474(), "TVAL", 127), 4000.0);
+  EXPECT_EQ(reg(l6474(), "TVAL", 1312.5), 0x29u);
+  EXPECT_EQ(phys(l6474(), "TON_MIN", 0x29), 21.0);
+  EXPECT_EQ(phys(l6474(), "TOFF_MIN", 127), 64.0);
+  EXPECT_EQ(phys(l6474(), "TOFF_FAST", 1), 4.0);   // T_FAST reset 0x19: 4 us and 20 us
+  EXPECT_EQ(phys(l6474(), "FAST_STEP", 9), 20.0);
+  EXPECT_EQ(phys(l6474(), "OCD_TH", 0x8), 3375.0);
+  EXPECT_EQ(find_unit_scale(l6474(), "MAX_SPEED"), nullptr);
+  EXPECT_EQ(why_no_unit_scale(l6474(), "MAX_SPEED"),
+            "L6474 has no MAX_SPEED (a register of L6470, L6472, L6480, L6482, powerSTEP01)");
 }
 
 TEST(NearMiss, SuggestsTheClosestNames) {

@@ -77,7 +77,15 @@ struct Rig {
 };
 
 bool is_gate_driver(const Variant& v) { return v.name == "L6480" || v.name == "L6482" || v.name == "powerSTEP01"; }
-bool is_sixteenth_part(const Variant& v) { return v.name == "L6472" || v.name == "L6482"; }
+bool is_sixteenth_part(const Variant& v) { return v.name == "L6472" || v.name == "L6482" || v.name == "L6474"; }
+
+/// The parts with a motion engine (all but the L6474).
+std::vector<const Variant*> motion_variants() {
+  std::vector<const Variant*> out;
+  for (const Variant* v : all_variants())
+    if (v->motion_engine) out.push_back(v);
+  return out;
+}
 
 std::string variant_label(const ::testing::TestParamInfo<const Variant*>& i) { return std::string(i.param->name); }
 
@@ -136,7 +144,12 @@ TEST_P(FinestStep, StepSel7MovesElPosBy1OnThe128thPartsAndBy8OnThe16thParts) {
   const std::uint32_t per_microstep = is_sixteenth_part(v) ? 8 : 1;
   Rig rig(v);
   ASSERT_EQ(rig.get(0x16, 1), 0x07u);
-  rig.send({0x59});  // StepClock forward
+  if (v.motion_engine) {
+    rig.send({0x59});  // StepClock forward
+  } else {
+    rig.chip().set_dir_pin(true);  // the L6474: DIR forward, then Enable (HardStop's opcode)
+    rig.send({kHardStop});
+  }
   rig.pulse_stck();
   EXPECT_EQ(rig.get(0x02, 2), per_microstep);
   EXPECT_EQ(rig.get(0x01, 3), 1u);
@@ -250,7 +263,7 @@ TEST(VariantMicrostepping, PowerStep01Steps128thsInCurrentModeAsInVoltageMode) {
 // ---------------------------------------------------------------- ACC = 0xFFF
 
 class InfiniteAcceleration : public ::testing::TestWithParam<const Variant*> {};
-INSTANTIATE_TEST_SUITE_P(VariantAcceleration, InfiniteAcceleration, ::testing::ValuesIn(all_variants()), variant_label);
+INSTANTIATE_TEST_SUITE_P(VariantAcceleration, InfiniteAcceleration, ::testing::ValuesIn(motion_variants()), variant_label);
 
 TEST_P(InfiniteAcceleration, Acc0xFFFSkipsTheRampsExceptOnTheL6472WhereItIsAnOrdinaryAcceleration) {
   // Spec §6.2/§8: 0xFFF = infinite acceleration on the L6470/L6480/L6482/powerSTEP01; reserved on
@@ -325,7 +338,7 @@ TEST(VariantThresholds, TheL6472AndL6482HaveNoStallThAt0x14) {
 }
 
 TEST(VariantBoostMode, FsSpdBit10IsWritableOnTheGateDriverPartsAndMaskedOnTheL6470AndL6472) {
-  for (const Variant* v : all_variants()) {
+  for (const Variant* v : motion_variants()) {  // the L6474 has no FS_SPD
     SCOPED_TRACE(std::string(v->name));
     Rig rig(*v);
     rig.set(0x15, 0x0400 | 0x027, 2);  // BOOST_MODE + the reset threshold

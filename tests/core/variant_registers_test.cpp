@@ -1,4 +1,4 @@
-// The register maps of all five family members (spec §2.1-§2.5, §8) checked row by row
+// The register maps of all six family members (spec §2.1-§2.5, §8; the L6474: docs/l6474.md) checked row by row
 // and through SPI: reset values, SPI lengths, widths, write conditions, holes, read-only
 // registers, and the look-up of variants by name. Expected tables are written from the spec.
 #include <gtest/gtest.h>
@@ -175,6 +175,24 @@ const Table kPowerStep01CurrentMode = [] {
   return t;
 }();
 
+// docs/l6474.md: the position registers, one TVAL, the L6472's current-control timings, no
+// speed profile registers; CONFIG and STATUS where the L6470 has them. Reset values UNCONFIRMED.
+const Table kL6474 = {
+    {0x01, Reg::ABS_POS, "ABS_POS", 22, 3, 0x000000, WS},
+    {0x02, Reg::EL_POS, "EL_POS", 9, 2, 0x000, WS},
+    {0x03, Reg::MARK, "MARK", 22, 3, 0x000000, WR},
+    {0x09, Reg::TVAL, "TVAL", 7, 1, 0x29, WR},
+    {0x0E, Reg::T_FAST, "T_FAST", 8, 1, 0x19, WH},
+    {0x0F, Reg::TON_MIN, "TON_MIN", 7, 1, 0x29, WH},
+    {0x10, Reg::TOFF_MIN, "TOFF_MIN", 7, 1, 0x29, WH},
+    {0x12, Reg::ADC_OUT, "ADC_OUT", 5, 1, std::nullopt, R},
+    {0x13, Reg::OCD_TH, "OCD_TH", 4, 1, 0x8, WR},
+    {0x16, Reg::STEP_MODE, "STEP_MODE", 8, 1, 0x07, WH},
+    {0x17, Reg::ALARM_EN, "ALARM_EN", 8, 1, 0xFF, WS},
+    {0x18, Reg::CONFIG, "CONFIG", 16, 2, 0x2E88, WH},
+    {0x19, Reg::STATUS, "STATUS", 16, 2, std::nullopt, R},
+};
+
 // ---------------------------------------------------------------- the cases
 
 struct Case {
@@ -214,6 +232,11 @@ Case case_for(const Variant* v, bool current_mode) {
     c.holes = {0x1C, 0x1D, 0x1E, 0x1F};
     c.cmd_error = true;
     c.after_get_status = 0xE603;
+  } else if (n == "L6474") {
+    c.table = &kL6474;
+    c.holes = {0x04, 0x05, 0x06, 0x07, 0x08, 0x0A, 0x0B, 0x0C, 0x0D, 0x11, 0x14, 0x15,
+               0x1A, 0x1B, 0x1C, 0x1D, 0x1E, 0x1F};
+    c.after_get_status = 0xFE03;  // bits 15:13 and 1 read 1 (docs/l6474.md), HiZ, no flag
   }
   return c;
 }
@@ -225,6 +248,14 @@ std::vector<Case> all_cases() {
   std::vector<Case> out;
   for (const Variant* v : all_variants()) out.push_back(case_for(v, false));
   out.push_back(case_for(&powerstep01(), true));
+  return out;
+}
+
+/// The cases of the parts with a motion engine (Run, ResetDevice): all but the L6474's.
+std::vector<Case> motion_cases() {
+  std::vector<Case> out;
+  for (const Case& c : all_cases())
+    if (c.variant->motion_engine) out.push_back(c);
   return out;
 }
 
@@ -308,6 +339,12 @@ class EveryVariantsRegisterMap : public ::testing::TestWithParam<Case> {
 INSTANTIATE_TEST_SUITE_P(VariantRegisters, EveryVariantsRegisterMap, ::testing::ValuesIn(all_cases()),
                          [](const ::testing::TestParamInfo<Case>& i) { return i.param.label; });
 
+/// The same, on the parts that run a motor by themselves and reset by ResetDevice.
+class EveryMotionVariantsRegisterMap : public EveryVariantsRegisterMap {};
+
+INSTANTIATE_TEST_SUITE_P(VariantRegisters, EveryMotionVariantsRegisterMap, ::testing::ValuesIn(motion_cases()),
+                         [](const ::testing::TestParamInfo<Case>& i) { return i.param.label; });
+
 // ---------------------------------------------------------------- the table rows
 
 TEST_P(EveryVariantsRegisterMap, IsOneTheSpecDescribes) {
@@ -363,7 +400,7 @@ TEST_P(EveryVariantsRegisterMap, ReadsEveryResetValueOverSpiAfterPowerUpWithTheS
   }
 }
 
-TEST_P(EveryVariantsRegisterMap, ReadsEveryResetValueOverSpiAfterResetDevice) {
+TEST_P(EveryMotionVariantsRegisterMap, ReadsEveryResetValueOverSpiAfterResetDevice) {
   ASSERT_NE(kase().table, nullptr);
   Rig rig(kase());
   // Move everything away from reset (bridges in HiZ so WH writes land), run, latch an error.
@@ -444,7 +481,7 @@ WriteOutcome try_write(Rig& rig, const Row& r) {
   return {after == value, (status & kBit7) != 0};
 }
 
-TEST_P(EveryVariantsRegisterMap, AcceptsWrOnlyWhileTheMotorRuns) {
+TEST_P(EveryMotionVariantsRegisterMap, AcceptsWrOnlyWhileTheMotorRuns) {
   ASSERT_NE(kase().table, nullptr);
   for (const Row& r : table()) {
     if (r.access == R) continue;
@@ -504,7 +541,7 @@ TEST_P(EveryVariantsRegisterMap, RefusesSetParamOfEachReadOnlyRegisterAtTheComma
                                                static_cast<std::uint8_t>(want)}));
     EXPECT_EQ(rig.get_status(), kase().after_get_status) << "GetStatus cleared it";
   }
-  EXPECT_EQ(read_only, 3) << "SPEED, ADC_OUT, STATUS";
+  EXPECT_EQ(read_only, kase().variant->motion_engine ? 3 : 2) << "SPEED (the motion engine's), ADC_OUT, STATUS";
 }
 
 TEST_P(EveryVariantsRegisterMap, WithTheNotperfQuirkConsumesTheValueOfAReadOnlyRegisterThenRaisesBit7) {
@@ -589,16 +626,17 @@ TEST(VariantHoles, L6470HasNoRegisterAt0x1AUpTo0x1FWhereTheGateDriverPartsKeepCo
 
 // ---------------------------------------------------------------- look-up by name
 
-TEST(VariantLookUp, AllVariantsListsTheFiveFamilyMembersInOrder) {
+TEST(VariantLookUp, AllVariantsListsTheSixFamilyMembersInOrder) {
   const auto all = all_variants();
-  ASSERT_EQ(all.size(), 5u);
-  const std::string_view names[] = {"L6470", "L6472", "L6480", "L6482", "powerSTEP01"};
-  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(all[i]->name, names[i]);
+  ASSERT_EQ(all.size(), 6u);
+  const std::string_view names[] = {"L6470", "L6472", "L6480", "L6482", "powerSTEP01", "L6474"};
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(all[i]->name, names[i]);
   EXPECT_EQ(all[0], &l6470());
   EXPECT_EQ(all[1], &l6472());
   EXPECT_EQ(all[2], &l6480());
   EXPECT_EQ(all[3], &l6482());
   EXPECT_EQ(all[4], &powerstep01());
+  EXPECT_EQ(all[5], &l6474());
 }
 
 TEST(VariantLookUp, FindsEachVariantByItsNameInAnyCase) {
@@ -611,11 +649,13 @@ TEST(VariantLookUp, FindsEachVariantByItsNameInAnyCase) {
   EXPECT_EQ(find_variant("powerstep01"), &powerstep01());
   EXPECT_EQ(find_variant("POWERSTEP01"), &powerstep01());
   EXPECT_EQ(find_variant("PowerStep01"), &powerstep01());
+  EXPECT_EQ(find_variant("L6474"), &l6474());
+  EXPECT_EQ(find_variant("l6474"), &l6474());
 }
 
 TEST(VariantLookUp, FindsNothingForOtherNames) {
   EXPECT_EQ(find_variant(""), nullptr);
-  EXPECT_EQ(find_variant("L6474"), nullptr);
+  EXPECT_EQ(find_variant("L6475"), nullptr);
   EXPECT_EQ(find_variant("L647"), nullptr);
   EXPECT_EQ(find_variant("L64700"), nullptr);
   EXPECT_EQ(find_variant(" L6470"), nullptr);
@@ -628,7 +668,7 @@ TEST(VariantLookUp, FindsThePowerStep01InItsVoltageModeWithTheCurrentModeReading
   EXPECT_EQ(v->at_address(0x09)->id, Reg::KVAL_HOLD);
   ASSERT_NE(v->current_mode, nullptr);
   EXPECT_EQ(v->current_mode->at_address(0x09)->id, Reg::TVAL_HOLD);
-  for (const Variant* other : {&l6470(), &l6472(), &l6480(), &l6482()}) EXPECT_EQ(other->current_mode, nullptr);
+  for (const Variant* other : {&l6470(), &l6472(), &l6480(), &l6482(), &l6474()}) EXPECT_EQ(other->current_mode, nullptr);
 }
 
 // ---------------------------------------------------------------- the UNCONFIRMED choices
@@ -663,6 +703,13 @@ const Covered kCovered[] = {
     {"powerSTEP01", "ResetDevice while the bridges are enabled", "VariantResetDevice.*"},
     {"powerSTEP01", "STALL_A on STATUS bit 14", "VariantStatus.Stall*"},
     {"powerSTEP01", "1/128 microstepping in both modes", "VariantMicrostepping.PowerStep01*"},
+    {"L6474", "reset values of TVAL", "VariantRegisters/EveryVariantsRegisterMap.ReadsEveryResetValue*/L6474, L6474.AThreeChipChain*"},
+    {"L6474", "STATUS bits 15, 14, 13 and 1", "VariantStatus/EveryVariantsStatus.*/L6474, L6474.StatusReads*"},
+    {"L6474", "only while the bridges are enabled", "L6474.StckEdgesAreIgnored*"},
+    {"L6474", "DIR high steps forward", "L6474.DirHighIsForward*"},
+    {"L6474", "Enable while a fault", "L6474.EnableWhileAFault*"},
+    {"L6474", "STEP_SEL 101..111", "L6474.StepSel5To7*, VariantMicrostepping/FinestStep.*/L6474"},
+    {"L6474", "ALARM_EN bits 4, 5 and 6", "VariantAlarms.L6474*"},
 };
 
 /// Glob match with '*' (any run) and '?' (any one character), as in --gtest_filter.

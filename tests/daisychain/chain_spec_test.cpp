@@ -30,8 +30,8 @@ TEST(ChainSpec, RejectsWhatIsNoChainInOneLine) {
     return std::string("(no error)");
   };
   EXPECT_EQ(error_of("L6499"),
-            "unknown chip variant \"L6499\" (did you mean L6470, L6472, L6480 or L6482? known: L6470, L6472, L6480, "
-            "L6482, powerSTEP01)");
+            "unknown chip variant \"L6499\" (did you mean L6470, L6472, L6480, L6482 or L6474? known: L6470, L6472, "
+            "L6480, L6482, powerSTEP01, L6474)");
   EXPECT_EQ(error_of("0"), "chain item \"0\" has no chips");
   EXPECT_EQ(error_of("300"), "a chain has at most 256 chips");
   EXPECT_EQ(error_of(""), "empty chain description (e.g. 3, 3*L6470 or L6470,L6480)");

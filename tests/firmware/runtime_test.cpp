@@ -125,6 +125,35 @@ TEST(FirmwarePins, OneStbyRstLineResetsEveryChipOnIt) {
   EXPECT_FALSE(r.rt.read_pin(2)) << "both chips were reset: UVLO latched again";
 }
 
+TEST(FirmwarePins, AnL6474IsSteppedThroughItsStckAndDirPinsAsOnTheXNucleoIhm01a1) {
+  // The shield's wiring: FLAG D2, DIR D7, STBY_RST D8, STCK D9, CS D10.
+  Rig r("chips=L6474 cs_pin=D10 flag_pin=D2 dir_pin=D7 stby_rst_pin=D8 stck_pin=D9");
+  for (const int p : {10, 9, 8, 7}) {
+    r.rt.set_pin_mode(p, McuPinMode::output);
+    r.rt.write_pin(p, p != 9 && p != 7);  // CS and STBY_RST high, STCK and DIR low
+  }
+  for (const std::uint8_t b : {0xD0, 0x00, 0x00}) r.byte_frame(10, b);
+  EXPECT_TRUE(r.rt.read_pin(2)) << "flags read: FLAG released";
+  r.byte_frame(10, 0xB8);  // Enable
+  auto pulses = [&](int n) {
+    for (int i = 0; i < n; ++i) {
+      r.rt.write_pin(9, true);
+      r.rt.sleep_until(r.rt.now() + 40);
+      r.rt.write_pin(9, false);
+      r.rt.sleep_until(r.rt.now() + 40);
+    }
+  };
+  r.rt.write_pin(7, true);
+  pulses(12);
+  r.rt.write_pin(7, false);
+  pulses(20);
+  std::uint32_t abs_pos = 0;
+  r.byte_frame(10, 0x21);  // GetParam(ABS_POS)
+  for (int i = 0; i < 3; ++i) abs_pos = abs_pos << 8 | r.byte_frame(10, 0x00);
+  EXPECT_EQ(sign_extend(abs_pos, 22), -8);
+  EXPECT_TRUE(r.rt.read_pin(2)) << "no alarm";
+}
+
 TEST(FirmwarePins, AnUnconnectedPinReadsWhatItDrivesOrItsPull) {
   Rig r("chips=L6470 cs_pin=10");
   EXPECT_FALSE(r.rt.read_pin(40));

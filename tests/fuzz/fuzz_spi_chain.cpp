@@ -286,10 +286,14 @@ class Harness {
   void pin() {
     const std::size_t k = pick_chip();
     const bool level = in_.ConsumeBool();
-    switch (in_.ConsumeIntegralInRange<int>(0, 2)) {
+    switch (in_.ConsumeIntegralInRange<int>(0, 3)) {
       case 0:
         fast_->chip(k).set_sw_pin(level);
         ref_->chip(k).set_sw_pin(level);
+        break;
+      case 3:  // an L6474's direction; the other parts have no DIR pin
+        fast_->chip(k).set_dir_pin(level);
+        ref_->chip(k).set_dir_pin(level);
         break;
       case 1:
         fast_->chip(k).set_stck_pin(level);

@@ -11,8 +11,9 @@ namespace l6470emu::test {
 namespace {
 
 struct FakeChip {
-  std::map<Pin, bool> level{{Pin::BUSY, true}, {Pin::FLAG, true}, {Pin::SW, true}, {Pin::STCK, false},
-                            {Pin::STBY_RST, true}};
+  // DIR reads high as the board reads the DIR of a chip without one (an L6470).
+  std::map<Pin, bool> level{{Pin::BUSY, true},      {Pin::FLAG, true}, {Pin::SW, true}, {Pin::STCK, false},
+                            {Pin::STBY_RST, true}, {Pin::DIR, true}};
   std::vector<std::pair<Pin, bool>> driven;
   Cp2112Pins pins() {
     return {[this](Pin p) { return level[p]; }, [this](Pin p, bool v) {
@@ -44,7 +45,9 @@ TEST(Cp2112Reports, InputsReadTheChipsLevelsAndUnusedPinsReadHigh) {
   EXPECT_EQ(got[0], 0x03);
   EXPECT_EQ(got[1] & 0x01, 0) << "BUSY low";
   EXPECT_EQ(got[1] & 0x02, 0x02) << "FLAG high";
-  EXPECT_EQ(got[1] & 0xE0, 0xE0);
+  EXPECT_EQ(got[1] & 0xE0, 0xE0) << "DIR (pin 5) high, pins 6 and 7 unused";
+  chip.level[Pin::DIR] = false;  // an L6474 whose DIR is driven low
+  EXPECT_EQ(r.get(0x03)[1] & 0x20, 0);
 }
 
 TEST(Cp2112Reports, AnOutputTheHostDrivesReachesTheChipAndReadsBack) {

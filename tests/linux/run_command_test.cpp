@@ -171,6 +171,39 @@ TEST_F(RunCommand, AllExpectationsHeldIsStatusZeroAndTheJUnitReportIsWellFormed)
   EXPECT_EQ(check.out, "ok\n") << check.err;
 }
 
+TEST_F(RunCommand, AnL6474DriverStepsItThroughItsGpiochipsStckAndDirLines) {
+  // An X-NUCLEO-IHM01A1-style driver under `run --chain L6474`: configure, Enable, DIR and STCK
+  // pulses through libgpiod on the chip's own lines (the DIR line after the usual five). The
+  // scenario checks the position the pulses made.
+  const std::string scenario = file("s.yaml", R"(steps:
+  - at: end
+    expect: {register: ABS_POS, value: -7}
+  - at: end
+    expect: {command: Enable, count: 1}
+  - at: end
+    expect: {status: {HiZ: 0, DIR: 0}}
+)");
+  const RunResult r = run({"--chain", "L6474", "--scenario", scenario},
+                          python("import gpiod\n"
+                                 "chip = gpiod.Chip('gpiochip0')\n"
+                                 "assert chip.num_lines() == 6, chip.num_lines()\n"
+                                 "stck, dirl = chip.find_line('STCK'), chip.find_line('DIR')\n"
+                                 "assert dirl.offset() == 5\n"
+                                 "stck.request(consumer='t', type=gpiod.LINE_REQ_DIR_OUT, default_val=0)\n"
+                                 "dirl.request(consumer='t', type=gpiod.LINE_REQ_DIR_OUT, default_val=1)\n"
+                                 "status()\n"
+                                 "for b in (0x16, 0x8C, 0xB8): s.xfer2([b])\n"
+                                 "def pulses(n):\n"
+                                 "    for _ in range(n):\n"
+                                 "        stck.set_value(1); time.sleep(0.0001); stck.set_value(0); time.sleep(0.0001)\n"
+                                 "pulses(3)\n"
+                                 "dirl.set_value(0)\n"
+                                 "pulses(10)\n"
+                                 "st = status()\n"
+                                 "sys.exit(0 if st == 0xFE02 else 3)\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.out << r.err;
+}
+
 TEST_F(RunCommand, AFailedExpectationIsAFailureElementInTheJUnitReport) {
   const std::string junit = path("report.xml");
   run({"--chain", "chips=L6470", "--scenario", file("s.yaml", kSwitchScenario), "--junit", junit},

@@ -81,14 +81,14 @@ def test_bad_names_and_variants_say_what_was_meant():
         units.to_register("TVAL_RUN", 1)
     with pytest.raises(ValueError, match=r"CONFIG has no physical unit"):
         units.scale("CONFIG")
-    with pytest.raises(ValueError, match=r"did you mean L6470 or L6472\?"):
+    with pytest.raises(ValueError, match=r"did you mean L6470, L6472 or L6474\?"):
         units.scale("ACC", "L6471")
     with pytest.raises(TypeError):
         units.speed_to_reg("200")
 
 
 def test_a_bad_variant_in_a_chain_says_what_was_meant_as_the_board_description_does():
-    with pytest.raises(ValueError, match=r'chips: unknown chip variant "L6471" \(did you mean L6470 or L6472\? known: '):
+    with pytest.raises(ValueError, match=r'chips: unknown chip variant "L6471" \(did you mean L6470, L6472 or L6474\? known: '):
         l6470emu.Chain(["L6471"])
     with pytest.raises(ValueError, match=r"did you mean powerSTEP01\?"):
         l6470emu.register_table("powrSTEP01")

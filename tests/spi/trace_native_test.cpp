@@ -56,7 +56,8 @@ TEST(NativeTrace, RoundTripsEveryKindOfEventExactly) {
   partial.miso_known = known;
   t.write(partial);
   t.write(frame_at(40, 0, mosi, {}));  // MISO not captured
-  for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG, TracePin::SW_AXIS}) {
+  for (TracePin p : {TracePin::SW, TracePin::STCK, TracePin::STBY, TracePin::BUSY, TracePin::FLAG, TracePin::SW_AXIS,
+                     TracePin::DIR}) {
     TraceEvent e;
     e.kind = TraceEventKind::pin;
     e.tick = 50;
@@ -140,7 +141,7 @@ TEST(NativeTrace, RejectsMalformedLinesWithFileAndLineNumber) {
   EXPECT_EQ(error_of(head + "x frame D0\n"), "t.trace:2: unknown line \"x frame D0\" (expected '<time> frame|repeat|pin|fault|load|advance|axis|stops|supply|wire ...')");
   EXPECT_EQ(error_of(head + "0 blink\n"),
             "t.trace:2: unknown event \"blink\" (frame, repeat, pin, fault, load, advance, axis, stops, supply or wire)");
-  EXPECT_EQ(error_of(head + "0 pin 0 RESET 1\n"), "t.trace:2: unknown pin \"RESET\" (SW, STCK, STBY, BUSY or FLAG)");
+  EXPECT_EQ(error_of(head + "0 pin 0 RESET 1\n"), "t.trace:2: unknown pin \"RESET\" (SW, STCK, STBY, BUSY, FLAG or DIR)");
   EXPECT_EQ(error_of(head + "0 pin 300 SW 1\n"), "t.trace:2: chip \"300\" is not a chip number (0..255)");
   EXPECT_EQ(error_of(head + "0 fault 0 UVLO maybe\n"), "t.trace:2: UVLO \"maybe\" is not on or off");
   EXPECT_EQ(error_of(head + "0 frame D0\nchain 3\n"), "t.trace:3: 'chain' must come before the first event");

@@ -73,6 +73,33 @@ TEST(CampaignPlan, FaultsFollowTheVariantAndTheBoard) {
   EXPECT_EQ(find_campaign_fault("thermal"), nullptr);
 }
 
+TEST(CampaignPlan, AnL6474IsOfferedOnlyTheFaultsItHas) {
+  // No stall detection, no ADC undervoltage, no SW input; overcurrent, thermal and UVLO it has.
+  for (CampaignFault f : {CampaignFault::stall_a, CampaignFault::stall_b, CampaignFault::uvlo_adc, CampaignFault::sw_close})
+    EXPECT_NE(fault_unavailable(f, l6474(), false), "") << static_cast<int>(f);
+  EXPECT_EQ(fault_unavailable(CampaignFault::sw_close, l6474(), false), "L6474 has no SW input");
+  for (CampaignFault f : {CampaignFault::ocd, CampaignFault::thermal_warning, CampaignFault::thermal_bridge_shutdown,
+                          CampaignFault::thermal_device_shutdown, CampaignFault::uvlo, CampaignFault::reset,
+                          CampaignFault::stby_pulse, CampaignFault::miso_flip, CampaignFault::lost_frame})
+    EXPECT_EQ(fault_unavailable(f, l6474(), false), "") << static_cast<int>(f);
+  EXPECT_EQ(fault_unavailable(CampaignFault::sw_close, l6470(), false), "");
+}
+
+TEST(CampaignPlan, AnL6474sPhasesAreAfterItsConfigurationAndAtItsEnable) {
+  // Enable is where an L6474 starts to be driven (its steps come from STCK, not from SPI).
+  ChipRun c;
+  c.chain_name = "spidev0.0";
+  c.variant = &l6474();
+  c.commands = {at(Command::SetParam, 1000, 0x16), at(Command::SetParam, 2000, 0x09), at(Command::Enable, 3000)};
+  for (Tick t = 10'000; t <= 50'000; t += 10'000) c.commands.push_back(at(Command::GetStatus, t));
+  c.commands.push_back(at(Command::Disable, 60'000));
+  const auto points = injection_points(c, PointSelection::phases);
+  ASSERT_GE(points.size(), 3u);
+  EXPECT_EQ(points[0].name, "after_config");
+  EXPECT_EQ(points[1].name, "at_Enable");
+  EXPECT_EQ(points.back().name, "before_last_command");
+}
+
 TEST(CampaignPlan, AConditionFaultIsRaisedAtItsTickAndClearedTenMillisecondsLater) {
   ChipRun c = a_driver_run();
   c.number = 2;

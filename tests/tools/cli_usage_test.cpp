@@ -78,7 +78,8 @@ TEST(UsageErrors, MissingAndBadValuesAreOneLineWithStatusTwo) {
                      "l6470emu convert: --to: 'vdc' is not one of auto, native, vcd, ioctl; did you mean 'vcd'?");
   expect_usage_error("tables --table comands",
                      "l6470emu tables: --table: 'comands' is not one of l6470-registers, l6470-status, commands, "
-                     "variant-registers, variant-status, variant-differences, sanitizer-rules, units; did you mean 'commands'?");
+                     "variant-registers, variant-status, variant-differences, sanitizer-rules, units, l6474-registers, "
+                     "l6474-status, l6474-commands; did you mean 'commands'?");
   expect_usage_error("serve --time-scale 0", "l6470emu serve: --time-scale: Value 0 not in range 0.000001 to "
                                              "1000000.000000 (l6470emu serve --help)");
   expect_usage_error("plot --dpi", "l6470emu plot: --dpi: 1 required TEXT missing (l6470emu plot --help)");
@@ -132,8 +133,8 @@ TEST(UnitsCommand, BadRegistersVariantsAndValuesAreOneLineWithStatusTwo) {
                      "l6470emu units: unknown register 'MAX_SPED'; did you mean 'MAX_SPEED'? (l6470emu units --variant "
                      "L6470 lists them)");
   expect_usage_error("units --variant L6471 ACC 1",
-                     "l6470emu units: --variant: unknown chip variant 'L6471' (did you mean L6470 or L6472? known: L6470, "
-                     "L6472, L6480, L6482, powerSTEP01)");
+                     "l6470emu units: --variant: unknown chip variant 'L6471' (did you mean L6470, L6472 or L6474? known: "
+                     "L6470, L6472, L6480, L6482, powerSTEP01, L6474)");
   expect_usage_error("units TVAL_RUN 100mA",
                      "l6470emu units: L6470 has no TVAL_RUN (a register of L6472, L6482, powerSTEP01); --variant names "
                      "the chip");

@@ -1,5 +1,6 @@
 // The generated tables of the documents (registers, STATUS, commands, variants, units in
-// docs/reference/tables.md; the sanitizer's rules in docs/linux.md) are the model's own tables.
+// docs/reference/tables.md; the sanitizer's rules in docs/linux.md; the L6474's register map,
+// STATUS and commands in docs/l6474.md) are the model's own tables.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -32,6 +33,27 @@ TEST(Docs, TheLinuxPagesSanitizerRulesMatchTheModel) {
   ASSERT_NE(text.find("<!-- BEGIN generated:sanitizer-rules -->"), std::string::npos);
   EXPECT_EQ(refresh_generated_blocks(text), text)
       << "docs/linux.md's rules table is stale: run build/l6470emu tables --update-readme docs/linux.md";
+}
+
+TEST(Docs, TheL6474PagesTablesMatchTheModel) {
+  std::ifstream in(std::string(L6470EMU_SOURCE_DIR) + "/docs/l6474.md");
+  std::stringstream s;
+  s << in.rdbuf();
+  const std::string text = s.str();
+  for (const char* name : {"l6474-registers", "l6474-status", "l6474-commands"})
+    EXPECT_NE(text.find(std::string("<!-- BEGIN generated:") + name + " -->"), std::string::npos) << name;
+  EXPECT_EQ(refresh_generated_blocks(text), text)
+      << "docs/l6474.md is stale: run build/l6470emu tables --update-readme docs/l6474.md";
+}
+
+TEST(VariantCommandTableMarkdown, ListsTheL6474sSixCommandsAndNothingThatMoves) {
+  const std::string t = variant_command_table_markdown(l6474());
+  for (const char* row : {"| NOP | 0x00 | 0 |", "| SetParam | 0x01–0x03, 0x09, 0x0E–0x10, 0x12–0x13, 0x16–0x19 |",
+                          "| GetParam | 0x21–0x23, 0x29, 0x2E–0x30, 0x32–0x33, 0x36–0x39 |", "| Disable | 0xA8 | 0 |",
+                          "| Enable | 0xB8 | 0 |", "| GetStatus | 0xD0 | 0 (answer: 2) |"})
+    EXPECT_NE(t.find(row), std::string::npos) << row << "\n" << t;
+  for (const char* absent : {"Move", "Run", "GoTo", "HardStop", "ResetDevice"})
+    EXPECT_EQ(t.find(absent), std::string::npos) << absent;
 }
 
 TEST(Docs, TheTablesPageHasEveryGeneratedBlock) {
