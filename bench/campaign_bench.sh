@@ -34,9 +34,16 @@ bench() {
     t1=$(now)
     best_clean=$(echo "$t1 - $t0" | bc -l | awk -v b="$best_clean" '{print ($1 < b ? $1 : b)}')
     for mode in yes no; do
+      rm -f "$work/c.json"
       t0=$(now)
-      "$l6470emu" campaign --chain "chips=L6470" -j "$jobs" --snapshots "$mode" --json "$work/c.json" -- "$@" >/dev/null 2>&1 || true
+      status=0
+      "$l6470emu" campaign --chain "chips=L6470" -j "$jobs" --snapshots "$mode" --json "$work/c.json" -- "$@" >/dev/null 2>"$work/err" || status=$?
       t1=$(now)
+      # A campaign that did not run its reruns (status other than 0 or 1, an incomplete report) is no figure.
+      if [ "$status" -gt 1 ] || ! /usr/bin/python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1]))["complete"] else 1)' "$work/c.json" 2>/dev/null; then
+        echo "campaign_bench: $name, snapshots $mode: exit $status, not counted: $(tail -1 "$work/err")" >&2
+        continue
+      fi
       if [ "$mode" = yes ]; then
         best_yes=$(echo "$t1 - $t0" | bc -l | awk -v b="$best_yes" '{print ($1 < b ? $1 : b)}')
       else

@@ -5,7 +5,9 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <poll.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -212,6 +214,13 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
     limit_at = start + std::chrono::nanoseconds(static_cast<std::int64_t>(static_cast<double>(*timeout) * 250.0 /
                                                                            config.time.scale));
   const auto guard_at = start + run.wall_guard_limit;
+  // Readable once the program ended: the wait below returns then, not at its next 5 ms look.
+  struct PidFd {
+    int fd;
+    ~PidFd() {
+      if (fd >= 0) close(fd);
+    }
+  } ended{static_cast<int>(syscall(SYS_pidfd_open, run.pid, 0))};
   const auto kill_now = [&run](bool& why) {
     why = true;
     kill(run.pid, SIGKILL);
@@ -237,7 +246,12 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
       signalled = false;
     }
     if (run.progress) run.progress->update();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (ended.fd >= 0) {
+      pollfd p{ended.fd, POLLIN, 0};
+      poll(&p, 1, 5);
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
   }
 }
 
