@@ -1,12 +1,16 @@
 // The OS-free Board on its own, as a single-threaded firmware front would use it in virtual
 // time: bytes clocked one at a time under a chip select the front drives, a watched BUSY edge
-// at its exact tick, two chains sharing one bus. Nothing from linux/ is linked.
+// at its exact tick, two chains sharing one bus, an L6474 stepped by its STCK and DIR pins.
+// Nothing from linux/ is linked.
 #include <gtest/gtest.h>
 
 #include <array>
+#include <string>
 #include <vector>
 
 #include "board/board.hpp"
+#include "board/coverage.hpp"
+#include "daisychain/host.hpp"
 #include "spi/message.hpp"
 #include "support/test_support.hpp"
 
@@ -243,6 +247,116 @@ TEST(BoardEdges, APredictedEdgeStaysExactWhileTimeMovesInSmallStepsAndANewComman
   v.board.advance_to(second + 1);
   ASSERT_EQ(edges.size(), 4u);
   EXPECT_EQ(edges[3].tick, second);
+}
+
+// ---------------------------------------------------------------- the L6474 on a board
+
+// Its DIR pin in the board description (dir_pin=) and the pin API, a description giving a chip a
+// pin its part lacks refused with one line, STCK and DIR driven through the board moving
+// ABS_POS exactly, and the coverage points it has and has not.
+
+std::string error_of(const std::string& text) {
+  const ParseResult p = parse_board_config(text, "T");
+  EXPECT_FALSE(p.config) << text;
+  return p.error.message;
+}
+
+McuPin arduino(unsigned n) { return McuPin{McuPin::Kind::arduino, static_cast<std::uint16_t>(n)}; }
+
+void pulses(Board& board, std::size_t chip, int n) {
+  for (int i = 0; i < n; ++i) {
+    ASSERT_TRUE(board.drive_pin(0, chip, Pin::STCK, true));
+    ASSERT_TRUE(board.drive_pin(0, chip, Pin::STCK, false));
+  }
+}
+
+std::int32_t position(const Board& board, std::size_t chip) { return board.chain(0).peek_chip(chip).position(); }
+
+TEST(L6474Board, TheXNucleoIhm01a1WiringIsADescriptionWithDirPin) {
+  const BoardConfig c = config_of("chips=L6474 cs_pin=D10 flag_pin=D2 dir_pin=D7 stby_rst_pin=D8 stck_pin=D9");
+  const ChainPins& p = c.chains.at(0).pins;
+  EXPECT_EQ(chip_mcu_pin(p, Pin::DIR, 0), arduino(7));
+  EXPECT_EQ(chip_mcu_pin(p, Pin::STCK, 0), arduino(9));
+  EXPECT_EQ(std::string(pin_key(Pin::DIR)), "dir_pin");
+  EXPECT_NE(describe_board_config(c).find("dir_pin=7"), std::string::npos) << describe_board_config(c);
+  // One DIR line for two chips, or one each; "dir=" is taken for dir_pin= in the suggestion.
+  EXPECT_EQ(chip_mcu_pin(config_of("chips=2xL6474 dir_pin=D7").chains[0].pins, Pin::DIR, 1), arduino(7));
+  EXPECT_NE(error_of("chips=L6474 dir=D7").find("did you mean dir_pin=?"), std::string::npos);
+  EXPECT_EQ(chip_mcu_pin(config_of("chips=2xL6474 dir_pin=D7,D4").chains[0].pins, Pin::DIR, 1), arduino(4));
+}
+
+TEST(L6474Board, APinForAChipThatLacksItIsRefusedWithOneLineNamingIt) {
+  EXPECT_EQ(error_of("chips=2xL6470 dir_pin=D7"),
+            "l6470emu: config T, clause 1: dir_pin= names a pin for this chain, but none of its chips has a DIR pin "
+            "(a pin of L6474)");
+  EXPECT_EQ(error_of("chips=L6474 sw_pin=D5"),
+            "l6470emu: config T, clause 1: sw_pin= names a pin for this chain, but none of its chips has a SW pin "
+            "(a pin of L6470, L6472, L6480, L6482, powerSTEP01)");
+  EXPECT_EQ(error_of("chips=L6470,L6474 dir_pin=D7,D4"),
+            "l6470emu: config T, clause 1: dir_pin= gives chip 0 a pin, but it is an L6470, which has no DIR pin "
+            "(a pin of L6474): write '-' for it");
+  EXPECT_EQ(error_of("chips=L6474,L6470 busy_pin=D3,D4"),
+            "l6470emu: config T, clause 1: busy_pin= gives chip 0 a pin, but it is an L6474, which has no BUSY pin "
+            "(a pin of L6470, L6472, L6480, L6482, powerSTEP01): write '-' for it");
+  // numbering=mosi counts the other way: chip 0 is then the L6474.
+  EXPECT_TRUE(parse_board_config("chips=L6470,L6474 dir_pin=D4,- numbering=mosi", "T").config);
+  EXPECT_TRUE(parse_board_config("chips=L6470,L6474 dir_pin=-,D4", "T").config);
+  // One pin for a mixed chain reaches the chips that have the pin.
+  EXPECT_TRUE(parse_board_config("chips=L6470,L6474 dir_pin=D4 busy_pin=D3", "T").config);
+}
+
+TEST(L6474Board, StckAndDirDrivenThroughTheBoardMoveAbsPosByExactlyThePulses) {
+  VirtualBoard v("bus=0 cs=0 chips=L6470,2xL6474; time=virtual");
+  v.board.with_chain(0, [](Chain& c) {
+    ChainHost h(c);
+    h.enable(2);
+    h.step_clock(0, true);  // the L6470 in step-clock mode, forward
+  });
+  ASSERT_TRUE(v.board.drive_pin(0, 2, Pin::DIR, true));
+  EXPECT_TRUE(v.board.pin_level(0, 2, Pin::DIR));
+  pulses(v.board, 2, 300);
+  ASSERT_TRUE(v.board.drive_pin(0, 2, Pin::DIR, false));
+  pulses(v.board, 2, 100);
+  EXPECT_EQ(position(v.board, 2), 200);
+  EXPECT_EQ(position(v.board, 1), 0);
+  pulses(v.board, 1, 5);
+  EXPECT_EQ(position(v.board, 1), 0) << "in HiZ its STCK moves nothing";
+  // The L6470 has no DIR pin: the board refuses the drive, and its steps keep StepClock's direction.
+  EXPECT_FALSE(v.board.drive_pin(0, 0, Pin::DIR, false));
+  EXPECT_TRUE(v.board.pin_level(0, 0, Pin::DIR)) << "a pin the chip lacks reads high";
+  pulses(v.board, 0, 3);
+  EXPECT_EQ(position(v.board, 0), 3);
+  // Nor does the L6474 have SW or BUSY: no drive, and BUSY stays released.
+  EXPECT_FALSE(v.board.drive_pin(0, 2, Pin::SW, false));
+  EXPECT_TRUE(v.board.pin_level(0, 2, Pin::BUSY));
+}
+
+TEST(L6474Board, AWatchedDirReportsItsEdges) {
+  VirtualBoard v("bus=0 cs=0 chips=L6474; time=virtual");
+  std::vector<PinEdge> edges;
+  v.board.set_edge_sink([&](const PinEdge& e) { edges.push_back(e); });
+  v.board.watch_pin(0, 0, Pin::DIR, true);
+  ASSERT_TRUE(v.board.advance(100));
+  ASSERT_TRUE(v.board.drive_pin(0, 0, Pin::DIR, true));
+  ASSERT_EQ(edges.size(), 1u);
+  EXPECT_EQ(edges[0].pin, Pin::DIR);
+  EXPECT_TRUE(edges[0].level);
+  EXPECT_EQ(edges[0].tick, Tick{100});
+}
+
+TEST(L6474Coverage, TheUniverseHasEnableDisableAndNoMotionSwitchOrBusyPoint) {
+  const CoverageUniverse& u = coverage_universe(l6474());
+  EXPECT_GE(u.find(CoverageCategory::commands, "Enable"), 0);
+  EXPECT_GE(u.find(CoverageCategory::commands, "Disable"), 0);
+  EXPECT_EQ(u.find(CoverageCategory::commands, "Move FWD"), -1);
+  EXPECT_EQ(u.find(CoverageCategory::refusals, "Move while the motor runs"), -1);
+  EXPECT_EQ(u.find(CoverageCategory::events, "SW closed"), -1);
+  EXPECT_EQ(u.find(CoverageCategory::events, "STALL_A"), -1);
+  EXPECT_EQ(u.find(CoverageCategory::pin_edges, "BUSY falling"), -1);
+  EXPECT_GE(u.find(CoverageCategory::pin_edges, "FLAG falling"), 0);
+  EXPECT_GE(u.find(CoverageCategory::step_modes, "1/16"), 0);
+  EXPECT_EQ(u.find(CoverageCategory::step_modes, "1/32"), -1);
+  EXPECT_GE(u.find(CoverageCategory::registers_written, "TVAL"), 0);
 }
 
 }  // namespace
