@@ -16,13 +16,14 @@
 #include "linux/preload/real.hpp"
 
 namespace l6470emu::preload {
-namespace {
 
 std::string link_of(const std::string& path) {
-  char buf[256];
+  char buf[4096];
   const ssize_t n = real::readlink(path.c_str(), buf, sizeof buf - 1);
   return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
 }
+
+namespace {
 
 bool is_number(const char* s) {
   if (!*s) return false;

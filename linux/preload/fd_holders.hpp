@@ -2,7 +2,13 @@
 // every descriptor a waiter polls that the board does not own (docs/linux.md, Deadlocks).
 #pragma once
 
+#include <string>
+
 namespace l6470emu::preload {
+
+/// What the /proc link at `path` names ("/proc/self/fd/3" -> "pipe:[123]" or a file's path), ""
+/// when it cannot be read.
+std::string link_of(const std::string& path);
 
 /// Whether `fd` is a pipe that no other process holds an end of, in a process with no child
 /// (whose end would be a SIGCHLD, and its handler may write the pipe). Read from /proc, which

@@ -25,8 +25,10 @@
 #include <string>
 #include <vector>
 
+#include "linux/clock.hpp"
 #include "linux/fork_plan.hpp"
 #include "linux/log.hpp"
+#include "linux/preload/fd_holders.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/run.hpp"
 #include "linux/preload/state.hpp"
@@ -51,12 +53,6 @@ struct Server {
 
 Server* g_server = nullptr;  // never freed: read at exit
 std::atomic<bool> g_snapshot_forking{false};
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  syscall(SYS_clock_gettime, CLOCK_MONOTONIC, &ts);
-  return std::int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
-}
 
 void write_file(const std::string& path, const std::string& text) {
   const int fd = real::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -236,10 +232,7 @@ void become_rerun(const ForkPlan::Job& job, const ForkPlan& plan, DeviceBoard& b
     if (!d) continue;
     while (const dirent* e = real::readdir(d)) {
       if (e->d_name[0] == '.') continue;
-      char target[4096];
-      const std::string link = std::string("/proc/self/fd/") + e->d_name;
-      const ssize_t n = real::readlink(link.c_str(), target, sizeof target - 1);
-      if (n <= 0 || std::string(target, static_cast<std::size_t>(n)) != from) continue;
+      if (link_of(std::string("/proc/self/fd/") + e->d_name) != from) continue;
       if (!continue_recording(std::atoi(e->d_name), from, to)) refuse("a rerun's recording " + to + " cannot be written");
     }
     real::closedir(d);
