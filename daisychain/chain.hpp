@@ -87,6 +87,14 @@ class Chain final : public SpiDevice {
   /// Whether chip `i` takes part in the frame under way (or the next one): not in standby, and
   /// not missing it for a lost frame.
   bool hears_frame(std::size_t i) const { return listening(i); }
+  /// The bits a MISO flip fault inverts in byte `byte` of the frame under way (as the host reads
+  /// it, most significant bit first), 0 when none: for a host that reads MISO a bit at a time.
+  std::uint8_t miso_flip_mask(std::uint64_t byte) const {
+    std::uint8_t mask = 0;
+    for (const auto& [k, m] : flips_)
+      if (k == byte) mask = static_cast<std::uint8_t>(mask | m);
+    return mask;
+  }
 
   /// CS frames that clocked at least one byte, since the chain was made.
   std::uint64_t frames() const { return frames_; }
@@ -122,6 +130,10 @@ class Chain final : public SpiDevice {
   void deselect_wire() override;
   /// One CS frame of a host with `wire` settings: select_wire, exchange_wire, deselect_wire.
   void frame(std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx, const WireSettings& wire);
+  /// A falling CK edge between two bytes of a frame (a host clocking at the pins, whose byte
+  /// starts there): each listening chip's SDO latch takes the top bit of its register. Bytes of
+  /// exchange_wire take their own edges; this is the one a mode-0-shaped host makes after a byte.
+  void falling_clock_edge();
   /// Chip `i`'s SDO latch (0 or 1) as of now: the bit its SDO shows until the next falling CK edge.
   std::uint8_t sdo_latch(std::size_t i) const;
   /// Whether some chip was in standby at the last CS falling edge (its bytes are lost).

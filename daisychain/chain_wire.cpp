@@ -114,6 +114,17 @@ void Chain::exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std:
   if (!flips_.empty()) apply_flips(at, rx.first(tx.size()));
 }
 
+void Chain::falling_clock_edge() {
+  if (!selected_) return;  // CS high: the chips ignore the clock
+  if (!standby_in_frame_) {
+    latch_at_ = LatchAt::register_msb;
+    return;
+  }
+  if (latch_.size() != chips_.size()) latch_.assign(chips_.size(), 0);
+  for (std::size_t i = 0; i < chips_.size(); ++i) latch_[i] = listening(i) ? static_cast<std::uint8_t>(shift_register(i) >> 7) : 0;
+  latch_at_ = LatchAt::stored;
+}
+
 void Chain::deselect_wire() {
   if (!selected_) return;
   answers_loaded_ = bytes_in_frame_ > 0;
