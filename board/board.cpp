@@ -192,12 +192,60 @@ void Board::drive_chip_select(std::size_t chain, bool selected) {
   // Through the chain's bus, as a host's CS edge: t_disCS (a CS low too soon after a rise
   // misses the chips' answer load) and the sanitizer's frame checks apply.
   c.bus->set_device(spi_of(c));
-  if (selected)
+  if (selected) {
     c.bus->select_wire();
-  else
+    if (c.chain.selected()) c.pin_bus.cs_fell(c.chain);
+  } else if (c.chain.selected()) {
+    spi_frame_ends(c);
     c.bus->deselect_wire();
+  }
   emit_changes(c, c.chain.now());
 }
+
+void Board::spi_frame_ends(ChainState& c) {
+  // A frame's own rule at the pins (SPI_PINS): clocks that stopped inside a byte. (A frame with
+  // no clock at all is the front's to judge: a pin set to output low before it is driven high
+  // makes one at every start.)
+  const std::uint64_t whole = c.pin_bus.bytes_in_frame();
+  if (const unsigned bits = c.pin_bus.cs_rising(); bits != 0)
+    c.checker->spi_pins(whole, "the frame ended " + std::to_string(bits) + " bit" + (bits == 1 ? "" : "s") + " into byte " +
+                                   std::to_string(whole) + ": the chips decode what the last whole byte left in their "
+                                   "registers and the bits are lost");
+}
+
+void Board::drive_spi_clock(std::size_t chain, bool level) {
+  ChainState& c = state(chain);
+  PinLevelBus& pins = c.pin_bus;
+  if (level == pins.ck()) return;
+  const Tick now = time_.now();
+  if (!pins.selected()) {
+    pins.set_ck(level, now, *c.bus, c.chain);  // counted, nothing shifts
+    return;
+  }
+  // Only the eighth rising edge of a byte reaches the chips; the others are the bus's own.
+  const bool byte_ends = level && pins.bits_pending() == 7;
+  if (byte_ends) {
+    catch_up(c);
+    c.prediction_valid = false;
+    c.touched = true;
+    record_outputs(c);
+    c.bus->set_device(spi_of(c));
+  }
+  if (pins.set_ck(level, now, *c.bus, c.chain)) c.checker->first_clock_edge(now);
+  if (byte_ends) emit_changes(c, c.chain.now());
+}
+
+void Board::drive_spi_data(std::size_t chain, bool level) { state(chain).pin_bus.set_sdi(level); }
+
+std::optional<bool> Board::spi_data_out(std::size_t chain) const {
+  const ChainState& c = state(chain);
+  if (!c.pin_bus.selected()) return std::nullopt;
+  return c.pin_bus.sdo(c.chain);
+}
+
+const PinLevelBus& Board::spi_pins(std::size_t chain) const { return state(chain).pin_bus; }
+
+void Board::report_spi_pins(std::size_t chain, std::string what) { state(chain).checker->spi_pins(std::nullopt, std::move(what)); }
 
 bool Board::chip_selected(std::size_t chain) const { return state(chain).chain.selected(); }
 

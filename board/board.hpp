@@ -22,6 +22,7 @@
 #include "board/sanitizer.hpp"
 #include "board/pins.hpp"
 #include "daisychain/chain.hpp"
+#include "daisychain/pin_level_bus.hpp"
 #include "daisychain/chip_numbering.hpp"
 #include "spi/message.hpp"
 #include "spi/trace.hpp"
@@ -147,6 +148,25 @@ class Board {
   /// tick (the front moves the board's time there).
   Tick clock_bytes(std::span<const std::size_t> chains, std::span<const std::uint8_t> tx, std::span<std::uint8_t> rx,
                    const BusSettings& settings);
+
+  // ---- SPI at the pins (sck_pin=, mosi_pin=, miso_pin=): a front bit-bangs the bus ----------
+  // CS goes through drive_chip_select. Edges act at the board's time; the chain hears them as
+  // PinLevelBus says (daisychain/pin_level_bus.hpp): each eighth rising CK edge clocks a byte
+  // through the chain's bus (recorded, checked, edges reported) in the mode the edges make.
+
+  /// Drives chain `chain`'s CK input now. A frame's first edge sooner than t_setCS after CS fell
+  /// is named (CS_SETUP_TIME); edges while CS is high shift nothing (counted: spi_pins()).
+  void drive_spi_clock(std::size_t chain, bool level);
+  /// Drives chain `chain`'s SDI input (the host's MOSI) now: sampled at the next rising CK edge.
+  void drive_spi_data(std::size_t chain, bool level);
+  /// The level chain `chain`'s chip 0 drives on SDO (the host's MISO) now; nullopt while CS is
+  /// high (SDO floats).
+  std::optional<bool> spi_data_out(std::size_t chain) const;
+  /// The pin-level state of chain `chain`'s bus (what the edges so far made).
+  const PinLevelBus& spi_pins(std::size_t chain) const;
+  /// A front saw the pins' rules broken around chain `chain` where only it can see it (clock
+  /// edges with no chip select low): SPI_PINS, as `what` says.
+  void report_spi_pins(std::size_t chain, std::string what);
 
   // ---- pins ---------------------------------------------------------------------
 
@@ -289,6 +309,8 @@ class Board {
   void record_outputs(ChainState& c);
   /// A recording whose file failed: said once in the log, and the chain goes on without it.
   void drop_failed_recording(ChainState& c);
+  /// CS is about to rise on a chain whose CS a front drives: the frame's pin-level rules.
+  void spi_frame_ends(ChainState& c);
   bool change_axis(std::size_t chain, std::size_t chip, bool needs_axis,
                    const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
                    const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);

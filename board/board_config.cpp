@@ -33,7 +33,7 @@ struct KeySpec {
 };
 
 // Every key, in the order the docs table lists them.
-constexpr std::array<KeySpec, 29> kKeys{{
+constexpr std::array<KeySpec, 32> kKeys{{
     {"chips", Scope::chain, "chips=2xL6470,L6480"},
     {"bus", Scope::chain, "bus=0"},
     {"cs", Scope::chain, "cs=1"},
@@ -50,6 +50,9 @@ constexpr std::array<KeySpec, 29> kKeys{{
     {"stby_rst_pin", Scope::chain, "stby_rst_pin=D6"},
     {"dir_pin", Scope::chain, "dir_pin=D4"},
     {"spi", Scope::chain, "spi=SPI1"},
+    {"sck_pin", Scope::chain, "sck_pin=D13"},
+    {"mosi_pin", Scope::chain, "mosi_pin=D11"},
+    {"miso_pin", Scope::chain, "miso_pin=D12"},
     {"time", Scope::board, "time=virtual"},
     {"scale", Scope::board, "scale=10"},
     {"idle", Scope::board, "idle=0.2"},
@@ -76,9 +79,9 @@ std::string key_list(Scope scope) {
   for (const KeySpec& k : kKeys) {
     if (k.scope != scope) continue;
     // The chip pins' keys, shortened: busy/flag/sw/stck/stby_rst/dir_pin.
-    if (k.name.size() > 4 && k.name.substr(k.name.size() - 4) == "_pin" && k.name != "cs_pin") {
-      if (k.name != "busy_pin") continue;
-      out += ", busy/flag/sw/stck/stby_rst/dir_pin";
+    if (k.name.size() > 4 && k.name.substr(k.name.size() - 4) == "_pin") {
+      if (k.name == "cs_pin") out += ", cs/sck/mosi/miso_pin";
+      if (k.name == "busy_pin") out += ", busy/flag/sw/stck/stby_rst/dir_pin";
       continue;
     }
     out += (out.empty() ? "" : ", ") + std::string(k.name);
@@ -129,7 +132,10 @@ std::string_view key_alias(std::string_view key) {
       {"spi_bus", "spi"},      {"controller", "spi"}, {"call_cost", "call_time"}, {"loop_cost", "loop_time"},
       {"time_limit", "limit"}, {"run_limit", "limit"}, {"apb", "apb_clock"},  {"pclk", "apb_clock"},
       {"sanitize", "check"},   {"sanitizer", "check"}, {"allow", "check.allow"}, {"check_allow", "check.allow"},
-      {"check-allow", "check.allow"},
+      {"check-allow", "check.allow"}, {"clk_pin", "sck_pin"}, {"sclk_pin", "sck_pin"}, {"clock_pin", "sck_pin"},
+      {"sck", "sck_pin"},      {"mosi", "mosi_pin"},  {"sdi_pin", "mosi_pin"}, {"copi_pin", "mosi_pin"},
+      {"dout_pin", "mosi_pin"}, {"miso", "miso_pin"}, {"sdo_pin", "miso_pin"}, {"cipo_pin", "miso_pin"},
+      {"din_pin", "miso_pin"},
   };
   const std::string k = lower(key);
   for (const auto& [alias, real] : kAliases)
@@ -445,10 +451,10 @@ struct Parser {
       if (!parse_uint(value, chain.mode, 0, 3)) return fail("mode must be an SPI mode from 0 to 3, not " + q);
     } else if (k == "bufsiz") {
       if (!parse_uint(value, chain.bufsiz, 1, 1u << 22)) return fail("bufsiz must be a number from 1 to 4194304, not " + q);
-    } else if (k == "cs_pin") {
+    } else if (k == "cs_pin" || k == "sck_pin" || k == "mosi_pin" || k == "miso_pin") {
       const auto pin = parse_mcu_pin(value);
       if (!pin) return fail(pin_error(k, value));
-      chain.pins.cs = *pin;
+      (k == "cs_pin" ? chain.pins.cs : k == "sck_pin" ? chain.pins.sck : k == "mosi_pin" ? chain.pins.mosi : chain.pins.miso) = *pin;
     } else if (k == "spi") {
       const auto name = parse_spi_controller(value);
       if (!name)
@@ -482,11 +488,24 @@ struct Parser {
 
   static std::string pin_error(std::string_view key, std::string_view value) {
     return std::string(key) + " must be a microcontroller pin: an Arduino pin (10, D10, A0 to A7, GPIO5; 0 to 127) or an " +
-           "STM32 port pin (PA0 to PK15), " + (key == "cs_pin" ? "" : "'-' for none, ") + "not " + quoted_text(value);
+           "STM32 port pin (PA0 to PK15), " + (pin_key_is_chip(key) ? "'-' for none, " : "") +
+           "not " + quoted_text(value);
   }
 
-  // The pin lists of a chain just read: one pin for every chip, or one per chip.
+  static bool pin_key_is_chip(std::string_view key) {
+    for (unsigned p = 0; p < kPinsPerChip; ++p)
+      if (key == pin_key(static_cast<Pin>(p))) return true;
+    return false;
+  }
+
+  // The pin lists of a chain just read: one pin for every chip, or one per chip. SPI at the
+  // pins: sck_pin= and mosi_pin= together, with a cs_pin= to select the chain.
   bool check_pin_lists(const ChainConfig& chain) {
+    if (chain.pins.sck.has_value() != chain.pins.mosi.has_value())
+      return fail(std::string(chain.pins.sck ? "sck_pin= needs mosi_pin=" : "mosi_pin= needs sck_pin=") +
+                  ": SPI at the pins needs its clock and its data pin (miso_pin= too, to read the chips)");
+    if (chain.pins.miso && !chain.pins.sck) return fail("miso_pin= needs sck_pin= and mosi_pin=: SPI at the pins needs its clock and its data pin");
+    if (chain.pins.sck && !chain.pins.cs) return fail("sck_pin= needs cs_pin=: nothing else selects a chain whose SPI is on pins");
     for (unsigned p = 0; p < kPinsPerChip; ++p) {
       const ChipPinList& list = chain.pins.chip[p];
       if (list.size() <= 1 || list.size() == chain.chips.size()) continue;
@@ -504,12 +523,15 @@ struct Parser {
     struct Use {
       McuPin pin;
       std::string key;
-      int kind;                 // 0 chip select, 1 chip output, 2 chip input
+      int kind;                 // 0 chip select, 1 chip output, 2 chip input, 3 an SPI pin
       std::size_t chain;        // index; cfg.chains.size() = this chain
     };
     std::vector<Use> uses;
     auto add = [&](const ChainConfig& c, std::size_t index) {
       if (c.pins.cs) uses.push_back({*c.pins.cs, "cs_pin", 0, index});
+      if (c.pins.sck) uses.push_back({*c.pins.sck, "sck_pin", 3, index});
+      if (c.pins.mosi) uses.push_back({*c.pins.mosi, "mosi_pin", 3, index});
+      if (c.pins.miso) uses.push_back({*c.pins.miso, "miso_pin", 3, index});
       for (unsigned p = 0; p < kPinsPerChip; ++p)
         for (const auto& pin : c.pins.chip[p])
           if (pin) uses.push_back({*pin, pin_key(static_cast<Pin>(p)), pin_is_chip_output(static_cast<Pin>(p)) ? 1 : 2, index});
@@ -522,11 +544,14 @@ struct Parser {
         const Use &x = uses[a], &y = uses[b];
         if (x.pin != y.pin) continue;
         const bool same_chain = x.chain == y.chain;
-        if (x.kind == y.kind && x.kind != 0) continue;  // outputs wired together, or one line driving several inputs
+        if (x.kind == y.kind && x.kind != 0 && x.kind != 3) continue;  // outputs wired together, or one line driving several inputs
+        if (x.kind == 3 && y.kind == 3 && x.key == y.key && !same_chain) continue;  // chains sharing a pin-level bus
         if (same_chain && x.key == y.key && x.kind != 0) continue;
         const std::string where = same_chain ? "of this chain" : "of the chain in clause " + std::to_string(chain_clause[x.chain]);
         const std::string why = x.kind == 0 || y.kind == 0
                                     ? "a chip select is a pin of its own (one chain, nothing else)"
+                                : x.kind == 3 || y.kind == 3
+                                    ? "an SPI pin is a pin of its own (chains may share one as the same sck/mosi/miso_pin=)"
                                     : "a chip output (BUSY, FLAG) and a chip input (SW, STCK, STBY_RST) cannot share a pin";
         return fail("pin " + to_string(x.pin) + " is " + x.key + "= " + where + " and " + y.key + "= here: " + why);
       }
@@ -831,6 +856,9 @@ std::string describe_board_config(const BoardConfig& config) {
       o << " axis." << k << "=" << (items.empty() ? "default" : items);
     }
     if (c.pins.cs) o << " cs_pin=" << to_string(*c.pins.cs);
+    if (c.pins.sck) o << " sck_pin=" << to_string(*c.pins.sck);
+    if (c.pins.mosi) o << " mosi_pin=" << to_string(*c.pins.mosi);
+    if (c.pins.miso) o << " miso_pin=" << to_string(*c.pins.miso);
     for (unsigned p = 0; p < kPinsPerChip; ++p)
       if (!c.pins.chip[p].empty()) o << " " << pin_key(static_cast<Pin>(p)) << "=" << pin_list_text(c.pins.chip[p]);
     if (!c.pins.spi.empty()) o << " spi=" << c.pins.spi;

@@ -37,6 +37,7 @@ struct Board::ChainState {
   std::unique_ptr<ChainTraceRecorder> recorder;  // the trace being recorded, if any
   std::unique_ptr<ChainChecker> checker;         // the sanitizer's checks of this chain
   std::unique_ptr<ChainBus> bus;                 // what begin_transfer hands out
+  PinLevelBus pin_bus;                           // SPI at the pins: the edges of the byte under way
   std::vector<Chip::CommandSink> command_observers;  // per chip: set_command_observer's sink
   bool touched = false;               // a transfer or a stimulus has reached the chips since power-up
   // The next change of a watched BUSY/FLAG as predict_next_edge found it (kNever: none), valid

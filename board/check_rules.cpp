@@ -70,6 +70,12 @@ constexpr std::array<RuleInfo, kRuleCount> kRules{{
      "§9.1.19 Table 17 note 1 (STEP_MODE bit 3 written 0); §9.1.21 Table 22 (CONFIG bit 6 RESERVED)",
      "CONFIRMED that the L6470's STEP_MODE bit 3 is to be written 0; UNCONFIRMED what a 1 there or in CONFIG bit 6 does "
      "(the model stores it)"},
+    {Rule::SPI_PINS, "SPI_PINS",
+     "a CS frame with no clock edge, a frame that ends inside a byte, or clock edges while no chip select is low",
+     "§8 Serial interface: a byte is eight CK rising edges with CS low; the byte in the register is decoded at the CS "
+     "rising edge",
+     "CONFIRMED that bytes take eight clocks with CS low; UNCONFIRMED what the chip decodes after a partial byte (the "
+     "model drops its bits)"},
 }};
 
 std::string upper(std::string_view s) {

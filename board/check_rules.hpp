@@ -40,6 +40,7 @@ enum class Rule : std::uint8_t {
   ANSWER_LOST,         ///< a GetParam/GetStatus answer replaced before all its bytes were clocked out
   STANDBY_BYTE,        ///< a command byte sent to a chip held in standby
   RESERVED_BITS,       ///< SetParam setting a bit the datasheet reserves (to be written 0)
+  SPI_PINS,            ///< SPI at the pins out of step: a CS frame with no clock, a frame ending inside a byte
   count
 };
 

@@ -41,10 +41,13 @@ std::string to_string(const McuPin& pin);
 using ChipPinList = std::vector<std::optional<McuPin>>;
 
 /// The microcontroller side of one chain (the description's cs_pin=, busy_pin=, flag_pin=,
-/// sw_pin=, stck_pin=, stby_rst_pin=, dir_pin= and spi= keys).
+/// sw_pin=, stck_pin=, stby_rst_pin=, dir_pin=, sck_pin=, mosi_pin=, miso_pin= and spi= keys).
 struct ChainPins {
   /// The pin driving the chain's chip select (cs_pin=); none: nothing selects it.
   std::optional<McuPin> cs;
+  /// SPI at the pins (sck_pin=, mosi_pin=, miso_pin=): the program drives CK and SDI and reads
+  /// SDO on these pins itself (bit-banged SPI); none: only an SPI controller reaches the chain.
+  std::optional<McuPin> sck, mosi, miso;
   /// Per chip pin (indexed by Pin): empty = not given; one entry = every chip of the chain on
   /// that pin (open-drain BUSY/FLAG wired together, one line driving every SW/STCK/STBY_RST);
   /// else one entry per chip in the order numbering= counts them (nullopt: that chip's pin is
@@ -56,7 +59,7 @@ struct ChainPins {
 
   /// Whether any pin is given.
   bool any() const {
-    if (cs) return true;
+    if (cs || sck || mosi || miso) return true;
     for (const auto& l : chip)
       if (!l.empty()) return true;
     return false;

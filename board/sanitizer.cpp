@@ -216,15 +216,22 @@ void ChainChecker::clocked_checks(std::span<const std::uint8_t> tx, const WireSe
     if (frame_bytes_ == 0 && wire.cs_setup_timed && wire.speed_hz != 0) {
       const Tick clocks = tx.size() * transfer_ticks(1, wire.speed_hz);
       const Tick first_edge = tick >= clocks ? tick - clocks : 0;
-      if (first_edge < cs_fall_ + kCsSetupMinTicks) {
-        const Tick setup = first_edge > cs_fall_ ? first_edge - cs_fall_ : 0;
-        sanitizer_.report(make(Rule::CS_SETUP_TIME, std::nullopt, std::uint64_t{0},
-                               "the first clock edge came " + std::to_string(setup * 250) +
-                                   " ns after CS fell (t_setCS is at least " + std::to_string(kCsSetupMinNs) + " ns)"));
-      }
+      if (first_edge < cs_fall_ + kCsSetupMinTicks) report_early_clock(first_edge);
     }
     if (keep_mosi_) mosi_.insert(mosi_.end(), tx.begin(), tx.end());
   }
+}
+
+void ChainChecker::report_early_clock(Tick first_edge) {
+  const Tick setup = first_edge > cs_fall_ ? first_edge - cs_fall_ : 0;
+  sanitizer_.report(make(Rule::CS_SETUP_TIME, std::nullopt, std::uint64_t{0},
+                         "the first clock edge came " + std::to_string(setup * 250) + " ns after CS fell (t_setCS is at least " +
+                             std::to_string(kCsSetupMinNs) + " ns)"));
+}
+
+void ChainChecker::spi_pins(std::optional<std::uint64_t> byte, std::string what) {
+  if (!on()) return;
+  sanitizer_.report(make(Rule::SPI_PINS, std::nullopt, byte, std::move(what)));
 }
 
 void ChainChecker::deselecting_checks() {

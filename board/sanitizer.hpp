@@ -148,6 +148,14 @@ class ChainChecker {
   /// A diagnostic of chip `chip` (chain index).
   void chip_diagnostic(std::size_t chip, const Diagnostic& d);
 
+  // ---- SPI at the pins (Board::drive_spi_clock): the edges a controller's bytes carry implicitly ----
+  /// The frame's first CK edge came at `tick` (CS_SETUP_TIME when sooner than t_setCS after CS fell).
+  void first_clock_edge(Tick tick) {
+    if (on() && in_frame_ && tick < cs_fall_ + kCsSetupMinTicks) report_early_clock(tick);
+  }
+  /// SPI_PINS: the frame under way broke the pins' rules (`what` says how); `byte`: where.
+  void spi_pins(std::optional<std::uint64_t> byte, std::string what);
+
   /// CS frames seen so far.
   std::uint64_t frames() const { return frame_; }
 
@@ -155,6 +163,7 @@ class ChainChecker {
   Violation make(Rule rule, std::optional<std::size_t> chip, std::optional<std::uint64_t> byte, std::string what) const;
   bool on() const { return sanitizer_.level() != CheckLevel::off; }
   void clocked_checks(std::span<const std::uint8_t> tx, const WireSettings& wire, Tick tick);
+  void report_early_clock(Tick first_edge);
   void check_cs_polarity(const WireSettings& wire);
   void check_split();
   void selected_checks(Tick tick, bool timed);

@@ -26,6 +26,8 @@ struct FirmwareRuntime::Line {
   int cs_chain = -1;              // the chain whose chip select it is
   std::vector<ChipRef> outputs;   // chip BUSY/FLAG on it (open drain: wired together)
   std::vector<ChipRef> inputs;    // chip SW/STCK/STBY_RST it drives
+  std::vector<std::size_t> sck_chains, mosi_chains, miso_chains;  // SPI at the pins: the chains it is CK, SDI or SDO of
+  std::uint64_t unselected_rising = 0;  // a CK line: rising edges while none of its chains was selected
   int applied = -1;               // what it last drove onto the board: -1 unknown, 0 low, 1 high, 2 released
   unsigned edges = 0;
   std::function<void(bool)> on_edge;
@@ -127,6 +129,8 @@ FirmwareRuntime::Line& FirmwareRuntime::make_line(int key) {
 void FirmwareRuntime::wire(const BoardConfig& config) {
   chip_line_.resize(config.chains.size());
   tracked_.resize(config.chains.size());
+  unmapped_at_select_.assign(config.chains.size(), 0);
+  unclocked_frames_.assign(config.chains.size(), 0);
   for (std::size_t i = 0; i < config.chains.size(); ++i) {
     const ChainConfig& c = config.chains[i];
     const std::size_t n = c.chips.size();
@@ -140,6 +144,9 @@ void FirmwareRuntime::wire(const BoardConfig& config) {
     } else {
       log(name + ": no cs_pin= in the board description: nothing selects this chain");
     }
+    if (c.pins.sck) make_line(key_of(*c.pins.sck)).sck_chains.push_back(i);
+    if (c.pins.mosi) make_line(key_of(*c.pins.mosi)).mosi_chains.push_back(i);
+    if (c.pins.miso) make_line(key_of(*c.pins.miso)).miso_chains.push_back(i);
     const ChipNumbering numbers(config.numbering, n);
     for (unsigned p = 0; p < kPinsPerChip; ++p) {
       const Pin pin = static_cast<Pin>(p);
@@ -192,14 +199,19 @@ void FirmwareRuntime::wire(const BoardConfig& config) {
 std::vector<int> FirmwareRuntime::wired_pins() const {
   std::vector<int> keys;
   for (const auto& l : lines_)
-    if (l->cs_chain >= 0 || !l->outputs.empty() || !l->inputs.empty()) keys.push_back(l->key);
+    if (wired(*l)) keys.push_back(l->key);
   std::sort(keys.begin(), keys.end());
   return keys;
 }
 
 bool FirmwareRuntime::pin_wired(int key) const {
   const Line* l = line(key);
-  return l && (l->cs_chain >= 0 || !l->outputs.empty() || !l->inputs.empty());
+  return l && wired(*l);
+}
+
+bool FirmwareRuntime::wired(const Line& l) {
+  return l.cs_chain >= 0 || !l.outputs.empty() || !l.inputs.empty() || !l.sck_chains.empty() || !l.mosi_chains.empty() ||
+         !l.miso_chains.empty();
 }
 
 // ---------------------------------------------------------------- time
@@ -278,6 +290,11 @@ McuPinMode FirmwareRuntime::pin_mode(int key) const {
 
 void FirmwareRuntime::write_pin(int key, bool level) {
   Line& l = make_line(key);
+  if (l.latch != level && !wired(l)) {
+    ++unmapped_writes_;
+    if (unmapped_driven_.size() < 16 && std::find(unmapped_driven_.begin(), unmapped_driven_.end(), key) == unmapped_driven_.end())
+      unmapped_driven_.push_back(key);
+  }
   l.latch = level;
   apply_drive(l);
   after_change();
@@ -311,6 +328,17 @@ bool FirmwareRuntime::line_level(const Line& l, bool tracked) {
     return driving ? level && l.latch : level;
   }
   if (driving) return l.latch;
+  if (!l.miso_chains.empty()) {
+    // SDO of every selected chain on the pin, driving it together (read as the AND, as bytes
+    // from a controller are); none selected: it floats, and reads as an unconnected input.
+    bool any = false, level = true;
+    for (const std::size_t chain : l.miso_chains)
+      if (const auto sdo = board_->spi_data_out(chain)) {
+        any = true;
+        level = level && *sdo;
+      }
+    if (any) return level;
+  }
   if (!l.inputs.empty()) {
     const ChipRef& r = l.inputs.front();
     if (r.pin == Pin::SW) {
@@ -332,12 +360,16 @@ void FirmwareRuntime::apply_drive(Line& l) {
     const bool selected = drive == 0;
     const auto chain = static_cast<std::size_t>(l.cs_chain);
     if (selected != board_->chip_selected(chain)) {
+      if (selected) unmapped_at_select_[chain] = unmapped_writes_;
+      if (!selected && !board_->spi_pins(chain).frame_clocked() && board_->chain(chain).bytes_in_frame() == 0)
+        unclocked_frame(chain);
       board_->drive_chip_select(chain, selected);
       dirty();
       check_rules();
     }
     return;
   }
+  if (!l.sck_chains.empty() || !l.mosi_chains.empty()) drive_spi_pins(l, drive);
   for (const ChipRef& r : l.inputs) {
     if (drive == 2 && r.pin == Pin::SW) continue;  // released: the switch decides
     // Released, STBY_RST is pulled up (running) and STCK down, as boards wire them.
@@ -345,6 +377,49 @@ void FirmwareRuntime::apply_drive(Line& l) {
     board_->drive_pin(r.chain, r.chip, r.pin, level);
     dirty();
   }
+}
+
+void FirmwareRuntime::unclocked_frame(std::size_t chain) {
+  // One such frame is every start's (a chip select set to output drives low until it is driven
+  // high). Pins the description does not map driven inside it, or a second one before any
+  // byte, are a bus the board cannot hear: bit-banged on pins it does not know.
+  const bool unmapped_inside = unmapped_writes_ != unmapped_at_select_[chain];
+  if (!unmapped_inside && (++unclocked_frames_[chain] < 2 || board_->chain(chain).frames() != 0)) return;
+  std::string pins;
+  for (const int key : unmapped_driven_) pins += (pins.empty() ? "" : ", ") + to_string(pin_of(key));
+  const std::string what =
+      "a chip-select frame with no clock edge: nothing reached the chips" +
+      (pins.empty() ? std::string()
+                    : "; the program drives pins " + pins +
+                          " the board description does not map (bit-banged SPI? map them with sck_pin=, mosi_pin=, miso_pin=)");
+  report_once("unclocked " + std::to_string(chain), board_->chain_name(chain) + ": " + what);
+  board_->report_spi_pins(chain, what);
+}
+
+void FirmwareRuntime::drive_spi_pins(Line& l, int drive) {
+  if (drive == 2) return;  // released: CK and SDI keep the level they had (no pull is modelled)
+  const bool level = drive == 1;
+  for (const std::size_t chain : l.mosi_chains) board_->drive_spi_data(chain, level);
+  if (l.sck_chains.empty()) return;
+  bool any_selected = false;
+  for (const std::size_t chain : l.sck_chains) {
+    const std::uint64_t bytes = board_->spi_pins(chain).bytes_in_frame();
+    any_selected = any_selected || board_->chip_selected(chain);
+    board_->drive_spi_clock(chain, level);
+    if (board_->spi_pins(chain).bytes_in_frame() != bytes) {
+      clocked_ = true;  // a whole byte reached the chips
+      dirty();
+    }
+  }
+  if (!any_selected && level && ++l.unselected_rising == 8) {
+    // A byte's worth of clocks with no chip select of the pin low: it shifts nothing.
+    const std::size_t chain = l.sck_chains.front();
+    const std::string pin = to_string(pin_of(l.key));
+    report_once("sck " + pin, board_->chain_name(chain) + ": clock edges on " + pin + " (sck_pin=) while no chip select of it "
+                              "is low: they shift nothing (is cs_pin= the pin the program drives?)");
+    board_->report_spi_pins(chain, "clock edges on " + pin + " (sck_pin=) while no chip select of the pin was low: nothing shifts");
+  }
+  check_rules();
 }
 
 void FirmwareRuntime::line_changed(Line& l) {

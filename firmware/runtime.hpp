@@ -214,6 +214,12 @@ class FirmwareRuntime {
   bool line_level(const Line& l, bool tracked);
   void line_changed(Line& l);
   void apply_drive(Line& l);
+  /// A line that is a chain's CK or SDI (sck_pin=, mosi_pin=) is driven to `drive` (0, 1, 2 released).
+  void drive_spi_pins(Line& l, int drive);
+  static bool wired(const Line& l);
+  /// CS is about to rise on chain `chain` after a frame with no clock edge: said once (and
+  /// SPI_PINS), with the pins the program drove that the description does not map.
+  void unclocked_frame(std::size_t chain);
   void set_board_watch(Line& l, bool watched);
   void deliver();
   void poll_levels();
@@ -251,6 +257,10 @@ class FirmwareRuntime {
   bool finished_ = false;
   std::vector<Controller> controllers_;
   std::vector<std::string> reported_;
+  std::vector<int> unmapped_driven_;  // pins the program drove that the description does not map (the first 16)
+  std::uint64_t unmapped_writes_ = 0;             // level changes of such pins so far
+  std::vector<std::uint64_t> unmapped_at_select_;  // per chain: unmapped_writes_ at its last CS falling edge
+  std::vector<std::uint64_t> unclocked_frames_;    // per chain: CS frames with no clock edge
   std::unique_ptr<ScenarioRunner> scenario_;
   Tick run_limit_ = kNever;
   Tick limit_ticks_ = 0;   // the earlier of limit= and the run's limit

@@ -252,7 +252,7 @@ TEST(BoardConfig, ACommentRunsToTheEndOfTheLineEvenPastASemicolon) {
   EXPECT_TRUE(r.config->time.virtual_time);
   EXPECT_EQ(r.config->chains.size(), 1u);
   EXPECT_EQ(error_of("bus=0 chips=L6470 # ok\n; colour=red", 3), "unknown key 'colour' (chain keys: chips, bus, cs, "
-                                                                 "path, gpiochip, speed, mode, bufsiz, cs_pin, "
+                                                                 "path, gpiochip, speed, mode, bufsiz, cs/sck/mosi/miso_pin, "
                                                                  "busy/flag/sw/stck/stby_rst/dir_pin, spi, axis.K; board-wide: "
                                                                  "time, scale, idle, log, socket, trace, numbering, "
                                                                  "check, check.allow, call_time, loop_time, limit, apb_clock)");
@@ -543,7 +543,7 @@ TEST(BoardConfigCheck, MistakesGetOneLineWithASuggestion) {
             "SPI_MODE,FRAME_LENGTH)");
   EXPECT_EQ(error_of("chips=L6470 sanitizer=error"),
             "l6470emu: config T, clause 1: unknown key 'sanitizer': did you mean check=? (chain keys: chips, bus, cs, "
-            "path, gpiochip, speed, mode, bufsiz, cs_pin, busy/flag/sw/stck/stby_rst/dir_pin, spi, axis.K; board-wide: time, "
+            "path, gpiochip, speed, mode, bufsiz, cs/sck/mosi/miso_pin, busy/flag/sw/stck/stby_rst/dir_pin, spi, axis.K; board-wide: time, "
             "scale, idle, log, socket, trace, numbering, check, check.allow, call_time, loop_time, limit, apb_clock)");
   EXPECT_EQ(error_of("chips=L6470 check=warn; check=error"),
             "l6470emu: config T, clause 2: check= is given twice: clause 1 says 'warn', clause 2 says 'error' (a "
