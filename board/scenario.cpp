@@ -46,7 +46,7 @@ ScenarioChip chip_of(const json& j) { return ScenarioChip{unhex(j.at("chain")), 
 }  // namespace
 
 std::string_view to_string(ScenarioAction::Kind k) {
-  constexpr std::string_view n[] = {"sw", "stby_rst", "fault", "load", "block", "supply", "serial"};
+  constexpr std::string_view n[] = {"sw", "stby_rst", "fault", "load", "block", "supply", "serial", "dir"};
   return n[static_cast<unsigned>(k)];
 }
 std::string_view to_string(ScenarioTrigger::Kind k) {

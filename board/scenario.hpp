@@ -54,6 +54,7 @@ struct ScenarioAction {
     block,     ///< a hard stop at `position` (1/128 step) on the side the rotor is moving to
     supply,    ///< the motor supply becomes `supply_mV`; UVLO follows the L6470's thresholds
     serial,    ///< `text` arrives at the program's Serial input (a firmware sketch's); no chip
+    dir,       ///< DIR (an L6474's) driven to `level` (high = forward: the way STCK then steps)
   };
   Kind kind = Kind::sw;
   ScenarioChip chip;

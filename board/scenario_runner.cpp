@@ -77,6 +77,7 @@ std::string describe(const ScenarioAction& a) {
   switch (a.kind) {
     case ScenarioAction::Kind::sw: return a.level ? "SW opened" : "SW closed";
     case ScenarioAction::Kind::stby_rst: return a.level ? "STBY_RST high" : "STBY_RST low";
+    case ScenarioAction::Kind::dir: return a.level ? "DIR high (forward)" : "DIR low (reverse)";
     case ScenarioAction::Kind::fault:
       if (a.fault == TraceFault::THERMAL) return "THERMAL " + std::string(thermal_name(a.value));
       if (a.fault == TraceFault::ADCIN) return "ADCIN " + std::to_string(a.value);
@@ -153,6 +154,8 @@ void ScenarioRunner::check_step_against_board(std::size_t i, std::vector<std::pa
     const ScenarioAction& a = *st.action;
     s.target_chip = resolve(a.chip, w);
     const Chip& chip = board_.chain(s.target_chip.chain).chip(s.target_chip.chip);
+    if (a.kind == ScenarioAction::Kind::dir && !variant_has_pin(chip.variant(), Pin::DIR))
+      bad(s.target_chip.label + " (" + std::string(chip.variant().name) + ") has no DIR pin for dir: (an L6474 has)");
     if ((a.kind == ScenarioAction::Kind::load || a.kind == ScenarioAction::Kind::block) && !chip.axis())
       bad(s.target_chip.label + " has no axis (axis.K= in the board description) for " +
           std::string(to_string(a.kind)));
@@ -415,6 +418,9 @@ void ScenarioRunner::apply(const ScenarioAction& a, const Resolved& r, const std
       return;
     case ScenarioAction::Kind::stby_rst:
       board_.drive_pin(r.chain, r.chip, Pin::STBY_RST, a.level);
+      return;
+    case ScenarioAction::Kind::dir:
+      board_.drive_pin(r.chain, r.chip, Pin::DIR, a.level);
       return;
     case ScenarioAction::Kind::fault:
       board_.inject_fault(r.chain, r.chip, a.fault, a.value);

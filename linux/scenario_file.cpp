@@ -231,7 +231,7 @@ class Reader {
 
   ScenarioAction action(const YAML::Node& m, const ScenarioChip& dflt) {
     if (!m.IsMap()) fail(m, "do", "expects a map such as {sw: close}");
-    const std::vector<std::string> kinds{"sw", "stby_rst", "fault", "thermal", "adcin", "load", "block", "supply_mV", "serial"};
+    const std::vector<std::string> kinds{"sw", "stby_rst", "dir", "fault", "thermal", "adcin", "load", "block", "supply_mV", "serial"};
     std::vector<std::string> keys = kinds;
     keys.insert(keys.end(), {"clear", "bit", "chip", "chain"});
     check_keys(m, "do:", keys);
@@ -239,7 +239,7 @@ class Reader {
     a.chip = chip_of(m, dflt);
     int n = 0;
     for (const auto& k : kinds) n += m[k] ? 1 : 0;
-    if (n != 1) fail(m, "do", "names exactly one action: sw, stby_rst, fault, thermal, adcin, load, block, supply_mV or serial");
+    if (n != 1) fail(m, "do", "names exactly one action: sw, stby_rst, dir, fault, thermal, adcin, load, block, supply_mV or serial");
     if (const YAML::Node v = m["serial"]) {
       // Text typed into the program's Serial: no chip takes it.
       for (const char* k : {"chip", "chain"})
@@ -257,6 +257,9 @@ class Reader {
     } else if (const YAML::Node v = m["stby_rst"]) {
       a.kind = ScenarioAction::Kind::stby_rst;
       a.level = choice(v, "stby_rst", {"low", "high"}) == "high";
+    } else if (const YAML::Node v = m["dir"]) {
+      a.kind = ScenarioAction::Kind::dir;
+      a.level = choice(v, "dir", {"low", "high"}) == "high";
     } else if (const YAML::Node v = m["fault"]) {
       a.kind = ScenarioAction::Kind::fault;
       const std::string f =

@@ -55,6 +55,7 @@ std::string action_text(const ScenarioAction& a) {
   switch (a.kind) {
     case ScenarioAction::Kind::sw: o << "sw: " << (a.level ? "open" : "close"); break;
     case ScenarioAction::Kind::stby_rst: o << "stby_rst: " << (a.level ? "high" : "low"); break;
+    case ScenarioAction::Kind::dir: o << "dir: " << (a.level ? "high" : "low"); break;
     case ScenarioAction::Kind::fault:
       if (a.fault == TraceFault::THERMAL)
         o << "thermal: " << thermal_name(a.value);

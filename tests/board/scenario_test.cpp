@@ -530,3 +530,46 @@ TEST(ScenarioExchange, AScenarioReadsBackAsItWasWritten) {
 
 }  // namespace
 }  // namespace l6470emu::test
+
+namespace l6470emu::test {
+namespace {
+
+TEST(ScenarioRunner, ADirStepTurnsTheWayAnL6474StepsAndIsRefusedForAChipWithoutTheDirPin) {
+  VirtualBoard v("chips=L6474; time=virtual");
+  send(v.board, {0xB8});  // Enable: the bridges on, STCK moves the motor
+  Scenario s;
+  ScenarioAction reverse;
+  reverse.kind = ScenarioAction::Kind::dir;
+  reverse.level = false;
+  s.steps.push_back(at_time(ticks_from_ms(1), reverse, "s.yaml:1"));
+  s.steps.push_back(expect_at(at(ticks_from_ms(3)), reg("ABS_POS", -10), "s.yaml:2"));  // signed, as ABS_POS reads
+  ScenarioRunner runner(v.board, s);
+  auto pulses = [&](int n, Tick from) {
+    for (int k = 0; k < n; ++k) {
+      runner.advance_to(from + 8 * k);
+      v.board.drive_pin(0, 0, Pin::STCK, true);
+      runner.advance_to(from + 8 * k + 4);
+      v.board.drive_pin(0, 0, Pin::STCK, false);
+    }
+  };
+  v.board.drive_pin(0, 0, Pin::DIR, true);
+  pulses(10, ticks_from_us(10));   // forward: +10
+  pulses(20, ticks_from_ms(2));    // after the step: -20
+  runner.advance_to(ticks_from_ms(4));
+  runner.finish();
+  for (const ScenarioFailure& f : runner.failures())
+    ADD_FAILURE() << f.where << ": " << f.what << ": expected " << f.expected << ", seen " << f.seen;
+  EXPECT_EQ(runner.judged(), 1u);
+  EXPECT_NE(runner.log().at(0).find("DIR low (reverse)"), std::string::npos) << runner.log().at(0);
+
+  VirtualBoard l6470("chips=L6470; time=virtual");
+  try {
+    ScenarioRunner refused(l6470.board, s);
+    ADD_FAILURE() << "a dir: step for an L6470 was taken";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("(L6470) has no DIR pin for dir: (an L6474 has)"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace l6470emu::test

@@ -90,7 +90,7 @@ TEST(ScenarioFile, AMisspelledKeyIsNamedWithItsLineAndTheNearMiss) {
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {sw: shut}\n"),
             "l6470emu: scenario s.yaml:3: key 'sw': 'shut' is not one of close, open");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {falt: ocd}\n"),
-            "l6470emu: scenario s.yaml:3: key 'falt': unknown (did you mean fault?) in do:; known: sw, stby_rst, fault, "
+            "l6470emu: scenario s.yaml:3: key 'falt': unknown (did you mean fault?) in do:; known: sw, stby_rst, dir, fault, "
             "thermal, adcin, load, block, supply_mV, serial, clear, bit, chip, chain");
   EXPECT_EQ(error_of("steps:\n  - at: 1.0000001s\n    do: {sw: close}\n"),
             "l6470emu: scenario s.yaml:2: key 'at': expects a duration (250ns, 1us, 10ms, 2.5s, 1min: whole ticks of "
@@ -144,7 +144,7 @@ TEST(ScenarioFile, AMisspelledOneShotFaultIsNamedWithTheNearMiss) {
             "l6470emu: scenario s.yaml:3: key 'fault': 'lost_frme' is not one of ocd, uvlo, uvlo_adc, stall_a, stall_b, "
             "reset, miso_flip, lost_frame (did you mean lost_frame?)");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bti: 3}\n"),
-            "l6470emu: scenario s.yaml:3: key 'bti': unknown (did you mean bit?) in do:; known: sw, stby_rst, fault, "
+            "l6470emu: scenario s.yaml:3: key 'bti': unknown (did you mean bit?) in do:; known: sw, stby_rst, dir, fault, "
             "thermal, adcin, load, block, supply_mV, serial, clear, bit, chip, chain");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {fault: miso_flip, bit: 8}\n"),
             "l6470emu: scenario s.yaml:3: key 'bit': 8 is out of range (0..7)");
@@ -181,7 +181,7 @@ TEST(ScenarioFile, SerialTextThatIsEmptyOrAimedAtAChipIsNamed) {
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: [1, 2]}\n"),
             "l6470emu: scenario s.yaml:3: key 'serial': expects a single value");
   EXPECT_EQ(error_of("steps:\n  - at: 1s\n    do: {serial: x, sw: close}\n"),
-            "l6470emu: scenario s.yaml:3: key 'do': names exactly one action: sw, stby_rst, fault, thermal, adcin, load, "
+            "l6470emu: scenario s.yaml:3: key 'do': names exactly one action: sw, stby_rst, dir, fault, thermal, adcin, load, "
             "block, supply_mV or serial");
   EXPECT_EQ(error_of("steps:\n  - at: end\n    do: {serial: x}\n"),
             "l6470emu: scenario s.yaml:3: key 'do': nothing can be done at the end; use expect:");

@@ -41,6 +41,8 @@ steps:
     do: {stby_rst: low}
   - on: {busy: rise}
     do: {stby_rst: high}
+  - at: 1s
+    do: {dir: low}
   - on: {command: GoUntil, count: 2}
     chain: spidev0.0
     do: {load: {inertia_g_mm2: 5, friction_uNm: 7, force_uNm: -20000}}
@@ -88,8 +90,8 @@ steps:
   - at: end
     expect: {sanitizer: clean}
 )");
-  ASSERT_EQ(original.steps.size(), 28u);
-  EXPECT_EQ(original.steps[15].action->text, "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash");
+  ASSERT_EQ(original.steps.size(), 29u);
+  EXPECT_EQ(original.steps[16].action->text, "G 100\r\n\ttab \"quoted\" back\\slash: colon # hash");
   const std::string written = scenario_yaml(original, "made by a test\nsecond line");
   EXPECT_EQ(written.rfind("# made by a test\n# second line\n", 0), 0u) << written;
   expect_same_steps(original, read(written));
