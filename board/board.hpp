@@ -196,14 +196,16 @@ class Board {
 
   // ---- pulse trains (board_pulses.cpp): a timer's output on an input pin ----------------
 
-  /// Drives input pin `pin` of chip `chip` with `train` from now on (a PWM timer on STCK): the
-  /// pin goes low now and then follows the train edge by edge, each edge at its own tick,
+  /// Drives input pin `pin` of chip `chip` with `train` (a PWM timer on STCK): the pin follows
+  /// the train edge by edge, each edge at its own tick,
   /// until the train's count is spent (the pin stays low) or stop_pulse_train. A train on STCK
   /// costs nothing per pulse while the chain is not recorded and the chip has no axis: the
   /// pulses up to a tick reach the chip at once (Chip::stck_pulses) when the chain is brought
   /// there; a recorded chain, a chip with an axis and any other pin get every edge at its tick
   /// (recorded as any input change). Pulses that fall inside an SPI transfer reach the chip at
-  /// the transfer's end. Replaces a train already on the pin. False (nothing done) for a bad
+  /// the transfer's end. A train already on the pin keeps its pulses that rise before
+  /// `train.start` and makes no later one (a timer's new period from its update event on); without
+  /// one the pin goes low now. False (nothing done) for a bad
   /// index, an output pin, a train that makes no pulse (PulseTrain::valid) or one starting
   /// before the board's time.
   bool drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, const PulseTrain& train);

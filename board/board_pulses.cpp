@@ -94,8 +94,25 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
   if (chip >= c.chain.size() || !variant_has_pin(c.chain.peek_chip(chip).variant(), pin)) return false;
   catch_up(c);
   if (train.start < c.chain.now()) return false;
-  stop_pulse_train(chain, chip, pin, false);
-  set_input(chain, chip, pin, false);
+  // A train already on the pin keeps the pulses that rise before the new one starts (a timer
+  // whose new period takes effect at its update event), and no later one.
+  bool replaced = false;
+  for (auto it = c.trains.begin(); it != c.trains.end();) {
+    if (it->chip != chip || it->pin != pin) {
+      ++it;
+      continue;
+    }
+    replaced = true;
+    const std::uint64_t keep = train.start ? it->train.rises_through(train.start - 1) : 0;
+    if (keep == 0 || (it->rises == keep && it->falls == keep)) {
+      c.add_train_rises(*it);
+      it = c.trains.erase(it);
+      continue;
+    }
+    it->train.count = keep;
+    ++it;
+  }
+  if (!replaced) set_input(chain, chip, pin, false);
   c.trains.push_back(ChainState::Train{chip, pin, train, 0, 0});
   catch_up(c);  // a train starting now has its first edge now
   emit_changes(c, c.chain.now());
@@ -105,16 +122,10 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
 bool Board::stop_pulse_train(std::size_t chain, std::size_t chip, Pin pin, bool level) {
   if (chain >= chains_.size()) return false;
   ChainState& c = *chains_[chain];
-  using Train = ChainState::Train;
-  auto found = [&] {
-    return std::find_if(c.trains.begin(), c.trains.end(), [&](const Train& t) { return t.chip == chip && t.pin == pin; });
-  };
-  if (found() == c.trains.end()) return false;
+  auto on_pin = [&](const ChainState::Train& t) { return t.chip == chip && t.pin == pin; };
+  if (std::none_of(c.trains.begin(), c.trains.end(), on_pin)) return false;
   catch_up(c);
-  if (const auto it = found(); it != c.trains.end()) {
-    c.add_train_rises(*it);
-    c.trains.erase(it);
-  }
+  std::erase_if(c.trains, [&](const ChainState::Train& t) { return on_pin(t) && (c.add_train_rises(t), true); });
   set_input(chain, chip, pin, level);
   emit_changes(c, c.chain.now());
   return true;
