@@ -204,10 +204,10 @@ class Board {
   /// there; a recorded chain, a chip with an axis and any other pin get every edge at its tick
   /// (recorded as any input change). Pulses that fall inside an SPI transfer reach the chip at
   /// the transfer's end. A train already on the pin keeps its pulses that rise before
-  /// `train.start` and makes no later one (a timer's new period from its update event on); without
+  /// the new train's first and makes no later one (a timer's new period from its update event on); without
   /// one the pin goes low now. False (nothing done) for a bad
-  /// index, an output pin, a train that makes no pulse (PulseTrain::valid) or one starting
-  /// before the board's time.
+  /// index, an output pin, a train that makes no pulse (PulseTrain::valid) or whose first pulse
+  /// rises before the board's time.
   bool drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, const PulseTrain& train);
   /// Ends the train on the pin now: the edges up to now applied, then the pin driven to
   /// `level`. False when no train drives the pin.

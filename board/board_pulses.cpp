@@ -21,7 +21,8 @@ std::uint64_t PulseTrain::edges_through(Tick tick, std::uint64_t offset_counts) 
   const auto span = static_cast<unsigned __int128>(tick - start + 1) * clock_hz;
   const auto limit = (span + kTicksPerSecond - 1) / kTicksPerSecond;
   if (limit <= offset_counts) return 0;
-  const unsigned __int128 n = (limit - 1 - offset_counts) / period_counts + 1;
+  unsigned __int128 n = (limit - 1 - offset_counts) / period_counts + 1;
+  n = n > first ? n - first : 0;  // the periods before the first pulse made have none
   if (count && n > count) return count;
   return n > ~std::uint64_t{0} ? ~std::uint64_t{0} : static_cast<std::uint64_t>(n);
 }
@@ -93,7 +94,7 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
   ChainState& c = *chains_[chain];
   if (chip >= c.chain.size() || !variant_has_pin(c.chain.peek_chip(chip).variant(), pin)) return false;
   catch_up(c);
-  if (train.start < c.chain.now()) return false;
+  if (train.rise_tick(0) < c.chain.now()) return false;
   // A train already on the pin keeps the pulses that rise before the new one starts (a timer
   // whose new period takes effect at its update event), and no later one.
   bool replaced = false;
@@ -103,7 +104,8 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
       continue;
     }
     replaced = true;
-    const std::uint64_t keep = train.start ? it->train.rises_through(train.start - 1) : 0;
+    const Tick from = train.rise_tick(0);
+    const std::uint64_t keep = from ? it->train.rises_through(from - 1) : 0;
     if (keep == 0 || (it->rises == keep && it->falls == keep)) {
       c.add_train_rises(*it);
       it = c.trains.erase(it);

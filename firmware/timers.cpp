@@ -182,6 +182,8 @@ void FirmwareTimers::drive_output(Timer& t, bool on) {
     train.period_counts = ~std::uint64_t{0} / 2;
     train.high_counts = train.period_counts - 1;
   }
+  // An output enabled while the counter runs makes its first pulse at the next counter reset.
+  if (rt_.now() > t.origin) train.first = train.rises_through(rt_.now() - 1);
   train.count = t.pulse_count;  // tone's duration: so many pulses from the start
   rt_.drive_pulse_train(t.output, &train);
 }
