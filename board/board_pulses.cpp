@@ -76,7 +76,7 @@ void Board::run_trains(ChainState& c, Tick target) {
     }
     if (falls > t.falls) chip.stck_pulses(whole);
     if (rises > falls && rises > t.rises) chip.set_stck_pin(true);  // a pulse high at `target`
-    train_counts_.bulk_pulses += rises - t.rises;
+    train_counts_.bulk_pulses += rises > t.rises ? rises - t.rises : 0;
     t.rises = rises;
     t.falls = falls;
     if (c.wired) c.wire[t.chip][static_cast<unsigned>(t.pin)] = rises > falls;
@@ -98,6 +98,7 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
   // A train already on the pin keeps the pulses that rise before the new one starts (a timer
   // whose new period takes effect at its update event), and no later one.
   bool replaced = false;
+  std::uint64_t made_rises = 0, made_falls = 0;  // edges the old train made from the new one's start on
   for (auto it = c.trains.begin(); it != c.trains.end();) {
     if (it->chip != chip || it->pin != pin) {
       ++it;
@@ -106,6 +107,11 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
     replaced = true;
     const Tick from = train.rise_tick(0);
     const std::uint64_t keep = from ? it->train.rises_through(from - 1) : 0;
+    // A new train starting now takes over the edges the old one made now (its own).
+    made_rises += it->rises > keep ? it->rises - keep : 0;
+    made_falls += it->falls > keep ? it->falls - keep : 0;
+    it->rises = std::min(it->rises, keep);
+    it->falls = std::min(it->falls, keep);
     if (keep == 0 || (it->rises == keep && it->falls == keep)) {
       c.add_train_rises(*it);
       it = c.trains.erase(it);
@@ -115,7 +121,10 @@ bool Board::drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, cons
     ++it;
   }
   if (!replaced) set_input(chain, chip, pin, false);
-  c.trains.push_back(ChainState::Train{chip, pin, train, 0, 0});
+  // Edges at the board's time already made by the train it replaces are not made twice.
+  const Tick now = c.chain.now();
+  c.trains.push_back(ChainState::Train{chip, pin, train, std::min(train.rises_through(now), made_rises),
+                                       std::min(train.falls_through(now), made_falls)});
   catch_up(c);  // a train starting now has its first edge now
   emit_changes(c, c.chain.now());
   return true;

@@ -50,10 +50,27 @@ void FirmwareTimers::set_prescaler(int timer, std::uint32_t division) {
 }
 std::uint32_t FirmwareTimers::prescaler(int timer) const { return at(timer).prescaler; }
 
+void FirmwareTimers::set_preload(int timer, bool on) { at(timer).preload = on; }
+bool FirmwareTimers::preload(int timer) const { return at(timer).preload; }
+
 void FirmwareTimers::set_period(int timer, std::uint64_t counts) {
   Timer& t = at(timer);
   t.next_period = std::max<std::uint64_t>(counts, 1);
   if (!t.running) t.period = t.next_period;
+  if (t.running && !t.preload) apply_now(t);
+}
+
+void FirmwareTimers::apply_now(Timer& t) {
+  if (!t.pending_change()) return;
+  const std::uint64_t count = counter(static_cast<int>(&t - timers_.data()));
+  if (count >= t.next_period) return;  // the counter is past it already: from the next update on
+  // The period under way restarts its origin at its own start, with the new values.
+  t.origin = tick_at(t, t.updates * t.period);
+  t.updates = 0;
+  t.compares = t.next_compare > 0 && count >= t.next_compare ? 1 : 0;  // a match already passed
+  t.period = t.next_period;
+  t.compare = t.next_compare;
+  drive_output(t, true);
 }
 std::uint64_t FirmwareTimers::period(int timer) const { return at(timer).next_period; }
 
@@ -61,6 +78,7 @@ void FirmwareTimers::set_compare(int timer, std::uint64_t counts) {
   Timer& t = at(timer);
   t.next_compare = counts;
   if (!t.running) t.compare = counts;
+  if (t.running && !t.preload) apply_now(t);
 }
 std::uint64_t FirmwareTimers::compare(int timer) const { return at(timer).next_compare; }
 

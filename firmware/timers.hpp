@@ -20,9 +20,10 @@ class FirmwareRuntime;
 /// clock_hz / prescaler; a period is `period` counts (ARR + 1), the PWM output (mode 1) is high
 /// while the counter is below `compare` (CCR): pulses rise at every counter reset and fall at
 /// the compare match, so the output pin sees one pulse per period unless compare is 0 (low) or
-/// at least the period (high). A change of period or compare while the timer runs takes effect
-/// at its next update event, as with the preload (ARPE, OCxPE) the vendor libraries and the HAL's
-/// PWM set up; a stopped timer takes it at once.
+/// at least the period (high). With the preload on (ARPE, OCxPE: STM32duino's default, the HAL's
+/// AutoReloadPreload) a change of period or compare while the timer runs takes effect at its
+/// next update event; with it off, at once for the period under way (when the counter has
+/// not passed the new value yet; else at the next update). A stopped timer takes it at once.
 class FirmwareTimers {
  public:
   explicit FirmwareTimers(FirmwareRuntime& runtime) : rt_(runtime) {}
@@ -44,6 +45,9 @@ class FirmwareTimers {
   /// The compare value (CCR), counts: the PWM output is high while the counter is below it.
   void set_compare(int timer, std::uint64_t counts);
   std::uint64_t compare(int timer) const;
+  /// Whether a new period or compare waits for the next update (true, the default).
+  void set_preload(int timer, bool on);
+  bool preload(int timer) const;
   /// The pin (a runtime pin key) the PWM output drives; -1: none. Takes effect at once.
   void set_output(int timer, int key);
   int output(int timer) const;
@@ -82,6 +86,7 @@ class FirmwareTimers {
     std::uint64_t pulse_count = 0;
     int update_irq = -1, compare_irq = -1;
     bool running = false;
+    bool preload = true;
     Tick origin = 0;              // the tick the counter was last 0 from a start or an update taking a change
     std::uint64_t updates = 0;    // update events since origin already handled
     std::uint64_t compares = 0;   // compare matches since origin already handled
@@ -95,6 +100,8 @@ class FirmwareTimers {
   Tick next_compare(const Timer& t) const;
   /// Puts the output's pulse train on the board from the origin (or takes it off).
   void drive_output(Timer& t, bool on);
+  /// Without the preload: the period and compare just written, for the period under way.
+  void apply_now(Timer& t);
 
   FirmwareRuntime& rt_;
   std::vector<Timer> timers_;

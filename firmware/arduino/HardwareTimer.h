@@ -181,8 +181,8 @@ class HardwareTimer {
   void setMode(uint32_t channel, TimerModes_t mode, uint32_t pin, ChannelInputFilter_t filter = FILTER_NONE);
   TimerModes_t getMode(uint32_t channel);
 
-  /* Whether a new overflow waits for the next update (true, the default) or applies at once
-   * (here: at the next update either way; false is noted once in the log). */
+  /* Whether a new overflow or compare waits for the next update (true, the default) or applies
+   * to the period under way. */
   void setPreloadEnable(bool value);
 
   /* Channel `channel`'s compare value (CCR) in ticks, or a duty cycle in the other formats. */

@@ -252,8 +252,8 @@ TimerModes_t HardwareTimer::getMode(uint32_t channel) {
 }
 
 void HardwareTimer::setPreloadEnable(bool value) {
-  FirmwareRuntime& r = call();
-  if (!value) r.log("HardwareTimer::setPreloadEnable(false): a new overflow still waits for the next update here");
+  call();
+  if (timer_ >= 0) runtime().timers().set_preload(timer_, value);
 }
 
 uint32_t HardwareTimer::getCaptureCompare(uint32_t channel, TimerCompareFormat_t format) {

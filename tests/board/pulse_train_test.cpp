@@ -99,6 +99,19 @@ TEST(PulseTrainOnTheBoard, AStoppedTrainMovesNoMoreAndACountedTrainEndsByItself)
   EXPECT_FALSE(v.board.stop_pulse_train(0, 1, Pin::STCK)) << "it ended by itself";
 }
 
+TEST(PulseTrainOnTheBoard, ATrainReplacedAtOneOfItsRisingEdgesMakesThatPulseOnce) {
+  VirtualBoard v("chips=L6474; time=virtual");
+  v.enable();
+  const Tick t0 = v.board.time().now();
+  ASSERT_TRUE(v.board.drive_pulse_train(0, 0, Pin::STCK, train_of(t0, kTicksPerSecond, 100, 50)));
+  v.board.advance_to(t0 + 300);  // pulses at 0, 100, 200, 300: the last one high
+  ASSERT_TRUE(v.board.drive_pulse_train(0, 0, Pin::STCK, train_of(t0 + 300, kTicksPerSecond, 40, 20)));
+  v.board.advance_to(t0 + 300 + 40 * 9 + 5);  // the new train's pulses at 300, 340, ..., 660
+  EXPECT_EQ(v.position(), 3 + 10);
+  EXPECT_EQ(v.board.pulse_train_rises(0, 0, Pin::STCK), 13u);
+  EXPECT_EQ(v.board.pulse_train_counts().bulk_pulses, 13u);
+}
+
 TEST(PulseTrainOnTheBoard, ABadTrainIsRefused) {
   VirtualBoard v("chips=L6474; time=virtual");
   EXPECT_FALSE(v.board.drive_pulse_train(0, 0, Pin::STCK, train_of(0, kTicksPerSecond, 4, 4)));

@@ -93,6 +93,25 @@ TEST(FirmwareTimers, ANewPeriodSetInTheUpdateInterruptTakesEffectAtTheNextUpdate
   EXPECT_EQ(updates, (std::vector<Tick>{ticks_from_us(400), ticks_from_us(800), ticks_from_us(1100), ticks_from_us(1300)}));
   EXPECT_EQ(r.position(), 5) << "pulses rise at 0, 400, 800, 1100 and 1300 us";
   EXPECT_EQ(r.rt.board().pulse_train_rises(0, 0, Pin::STCK), 5u);
+  EXPECT_EQ(r.rt.board().pulse_train_counts().bulk_pulses, 5u);
+}
+
+TEST(FirmwareTimers, WithoutThePreloadANewPeriodShortensThePeriodUnderWay) {
+  Rig r(kL6474);
+  r.enable();
+  const int t = r.timer(400, r.pin("PB10"));
+  r.rt.timers().set_preload(t, false);
+  std::vector<Tick> updates;
+  r.rt.timers().set_update_irq(t, r.rt.add_irq([&] {
+    updates.push_back(r.rt.now());
+    r.rt.timers().set_period(t, 100);
+    r.rt.timers().set_compare(t, 50);
+  }));
+  r.rt.timers().start(t);
+  r.rt.sleep_until(ticks_from_us(700) + 1);
+  // The period written in the update at 400 us is the one under way: updates at 500, 600, 700.
+  EXPECT_EQ(updates, (std::vector<Tick>{ticks_from_us(400), ticks_from_us(500), ticks_from_us(600), ticks_from_us(700)}));
+  EXPECT_EQ(r.position(), 5) << "pulses rise at 0, 400, 500, 600 and 700 us";
 }
 
 TEST(FirmwareTimers, AStoppedTimerMovesNoMoreAndItsPinIsLow) {
