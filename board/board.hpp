@@ -201,8 +201,8 @@ class Board {
   /// until the train's count is spent (the pin stays low) or stop_pulse_train. A train on STCK
   /// costs nothing per pulse while the chain is not recorded and the chip has no axis: the
   /// pulses up to a tick reach the chip at once (Chip::stck_pulses) when the chain is brought
-  /// there; a recorded chain, a chip with an axis and any other pin get every edge at its tick
-  /// (recorded as any input change). Pulses that fall inside an SPI transfer reach the chip at
+  /// there; a recorded chain, a chip with an axis or with its SYNC clock on BUSY\SYNC, and any
+  /// other pin get every edge at its tick (recorded as any input change). Pulses that fall inside an SPI transfer reach the chip at
   /// the transfer's end. A train already on the pin keeps its pulses that rise before
   /// the new train's first and makes no later one (a timer's new period from its update event on); without
   /// one the pin goes low now. False (nothing done) for a bad

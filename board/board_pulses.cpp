@@ -3,7 +3,6 @@
 // by one. The timers that make trains are the fronts' (firmware/timers.cpp).
 #include <algorithm>
 
-#include "board/board_chain.hpp"
 #include "board/board_internal.hpp"
 
 namespace l6470emu {
@@ -36,8 +35,11 @@ Tick Board::ChainState::Train::next_edge() const {
 
 void Board::run_trains(ChainState& c, Tick target) {
   using Train = ChainState::Train;
+  // Every edge at its tick where something must see each one: a recording, an axis, the SYNC
+  // clock a step-clock chip puts out on BUSY\SYNC, a pin other than STCK.
   auto one_by_one = [&](const Train& t) {
-    return c.recorder || t.pin != Pin::STCK || c.chain.chip(t.chip).has_axis();
+    const Chip& chip = c.chain.chip(t.chip);
+    return c.recorder || t.pin != Pin::STCK || chip.has_axis() || chip.sync_clock_on();
   };
   auto apply_edge = [&](Train& t, bool level) {
     if (c.wired) c.wire[t.chip][static_cast<unsigned>(t.pin)] = level;

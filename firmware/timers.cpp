@@ -40,15 +40,10 @@ std::uint64_t FirmwareTimers::clock(int timer) const { return at(timer).clock_hz
 
 void FirmwareTimers::set_prescaler(int timer, std::uint32_t division) {
   Timer& t = at(timer);
-  if (division == 0) division = 1;
-  if (division == t.prescaler) return;
-  // The prescaler is preloaded too; in counts of the input clock the period and compare change.
-  const bool was = t.running;
-  if (was) stop(timer);
-  t.prescaler = division;
-  if (was) start(timer);
+  t.next_prescaler = std::max<std::uint32_t>(division, 1);  // always buffered, as PSC is
+  if (!t.running) t.prescaler = t.next_prescaler;
 }
-std::uint32_t FirmwareTimers::prescaler(int timer) const { return at(timer).prescaler; }
+std::uint32_t FirmwareTimers::prescaler(int timer) const { return at(timer).next_prescaler; }
 
 void FirmwareTimers::set_preload(int timer, bool on) { at(timer).preload = on; }
 bool FirmwareTimers::preload(int timer) const { return at(timer).preload; }
@@ -61,7 +56,7 @@ void FirmwareTimers::set_period(int timer, std::uint64_t counts) {
 }
 
 void FirmwareTimers::apply_now(Timer& t) {
-  if (!t.pending_change()) return;
+  if (t.next_period == t.period && t.next_compare == t.compare) return;
   const std::uint64_t count = counter(static_cast<int>(&t - timers_.data()));
   if (count >= t.next_period) return;  // the counter is past it already: from the next update on
   // The period under way restarts its origin at its own start, with the new values.
@@ -100,6 +95,7 @@ void FirmwareTimers::start(int timer) {
   Timer& t = at(timer);
   if (t.running) return;
   t.running = true;
+  t.prescaler = t.next_prescaler;
   t.period = t.next_period;
   t.compare = t.next_compare;
   t.origin = rt_.now();
@@ -112,6 +108,7 @@ void FirmwareTimers::stop(int timer) {
   if (!t.running) return;
   drive_output(t, false);
   t.running = false;
+  t.prescaler = t.next_prescaler;
   t.period = t.next_period;
   t.compare = t.next_compare;
 }
@@ -171,6 +168,7 @@ void FirmwareTimers::fire_through(Tick now) {
         // The preloaded period and compare take effect: the counter restarts from this update.
         t.origin = u;
         t.updates = t.compares = 0;
+        t.prescaler = t.next_prescaler;
         t.period = t.next_period;
         t.compare = t.next_compare;
         drive_output(t, true);

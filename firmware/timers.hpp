@@ -33,10 +33,11 @@ class FirmwareTimers {
   int add(std::string name);
   /// The timer called `name`, or -1.
   int find(const std::string& name) const;
-  /// The counter's input clock, Hz (> 0).
+  /// The counter's input clock, Hz (> 0); a running timer restarts from 0 on a new one.
   void set_clock(int timer, std::uint64_t hz);
   std::uint64_t clock(int timer) const;
-  /// The prescaler's division (PSC + 1, >= 1).
+  /// The prescaler's division (PSC + 1, >= 1): always buffered, in force from the next update
+  /// (at once while stopped).
   void set_prescaler(int timer, std::uint32_t division);
   std::uint32_t prescaler(int timer) const;
   /// Counts per period (ARR + 1, >= 1).
@@ -79,7 +80,7 @@ class FirmwareTimers {
   struct Timer {
     std::string name;
     std::uint64_t clock_hz = 4'000'000;
-    std::uint32_t prescaler = 1;
+    std::uint32_t prescaler = 1, next_prescaler = 1;  // in force; from the next update on
     std::uint64_t period = 65536, compare = 0;                // in force
     std::uint64_t next_period = 65536, next_compare = 0;      // from the next update on
     int output = -1;
@@ -90,7 +91,9 @@ class FirmwareTimers {
     Tick origin = 0;              // the tick the counter was last 0 from a start or an update taking a change
     std::uint64_t updates = 0;    // update events since origin already handled
     std::uint64_t compares = 0;   // compare matches since origin already handled
-    bool pending_change() const { return next_period != period || next_compare != compare; }
+    bool pending_change() const {
+      return next_period != period || next_compare != compare || next_prescaler != prescaler;
+    }
   };
   Timer& at(int timer);
   const Timer& at(int timer) const;
