@@ -4,7 +4,6 @@
 #include "firmware/timers.hpp"
 
 #include <algorithm>
-#include <stdexcept>
 
 #include "firmware/runtime.hpp"
 
@@ -54,6 +53,7 @@ void FirmwareTimers::set_period(int timer, std::uint64_t counts) {
   if (!t.running) t.period = t.next_period;
   if (t.running && !t.preload) apply_now(t);
 }
+std::uint64_t FirmwareTimers::period(int timer) const { return at(timer).next_period; }
 
 void FirmwareTimers::apply_now(Timer& t) {
   if (t.next_period == t.period && t.next_compare == t.compare) return;
@@ -67,7 +67,6 @@ void FirmwareTimers::apply_now(Timer& t) {
   t.compare = t.next_compare;
   drive_output(t, true);
 }
-std::uint64_t FirmwareTimers::period(int timer) const { return at(timer).next_period; }
 
 void FirmwareTimers::set_compare(int timer, std::uint64_t counts) {
   Timer& t = at(timer);

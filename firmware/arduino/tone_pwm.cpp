@@ -42,13 +42,14 @@ void run_timer(FirmwareRuntime& r, int id, uint64_t clock_hz, uint32_t prescaler
   t.start(id);
 }
 
-/// The name of the timer behind an Uno's PWM pin (nullptr: the pin has no PWM).
-const char* uno_pwm_timer(uint8_t pin) {
+/// How an Uno's pin makes its PWM: Timer0's fast PWM (pins 5, 6), Timer1's and Timer2's
+/// phase-correct one (3, 9, 10, 11), or none.
+enum class UnoPwm { none, fast, phase_correct };
+UnoPwm uno_pwm(uint8_t pin) {
   switch (pin) {
-    case 5: case 6: return "Timer0";
-    case 9: case 10: return "Timer1";
-    case 3: case 11: return "Timer2";
-    default: return nullptr;
+    case 5: case 6: return UnoPwm::fast;
+    case 3: case 9: case 10: case 11: return UnoPwm::phase_correct;
+    default: return UnoPwm::none;
   }
 }
 
@@ -83,8 +84,8 @@ void analogWrite(uint8_t pin, int val) {
     r.write_pin(key, level);
   };
   const auto tp = key >= 128 ? l6470emu::default_timer_pin(static_cast<unsigned>(key - 128)) : std::nullopt;
-  const char* uno_timer = nucleo ? nullptr : uno_pwm_timer(pin);
-  if ((nucleo && !tp) || (!nucleo && !uno_timer)) return steady(val >= (full + 1) / 2);  // no PWM on the pin
+  const UnoPwm uno = nucleo ? UnoPwm::none : uno_pwm(pin);
+  if ((nucleo && !tp) || (!nucleo && uno == UnoPwm::none)) return steady(val >= (full + 1) / 2);  // no PWM on the pin
   if (val <= 0) return steady(false);
   if (val >= full) return steady(true);
   const int id = timer_named(r, name);
@@ -98,7 +99,7 @@ void analogWrite(uint8_t pin, int val) {
   }
   // An Uno's timers count 16 MHz / 64 = 250 kHz: Timer0 in fast PWM (256 counts, high for
   // OCR + 1: 976.5625 Hz), Timer1 and Timer2 phase-correct (510 counts, high for 2 × OCR: 490.196 Hz).
-  if (uno_timer[5] == '0')
+  if (uno == UnoPwm::fast)
     run_timer(r, id, 250'000, 1, 256, static_cast<uint64_t>(val) + 1, key);
   else
     run_timer(r, id, 250'000, 1, 510, 2 * static_cast<uint64_t>(val), key);

@@ -3,7 +3,7 @@
 // callback that counts steps and runs at its exact tick (its getCount(), two calls of 1 us after
 // the update, reads 84 counts of 42 MHz; micros() 1000 us apart); pauseChannel and a new setPWM
 // at 2 kHz from inside the callback (a ramp), pause after 100 updates; ABS_POS moves by exactly
-// the pulses made.
+// the pulses made. Then analogWrite's 1 kHz PWM on the same pin.
 #include <SPI.h>
 
 const SPISettings kL6474(4000000, MSBFIRST, SPI_MODE3);
@@ -73,6 +73,12 @@ void setup() {
   // pauses the timer: that one's pulse has risen with the counter's reset before the callback
   // runs. 11 + 90 pulses.
   check(abs_pos() == 101, "ABS_POS moved by exactly the 101 pulses made");
+
+  // analogWrite on a NUCLEO: a PWM at analogWriteFrequency (1 kHz) from the pin's timer.
+  analogWrite(D9, 128);
+  delay(100);
+  analogWrite(D9, 0);
+  check(abs_pos() == 101 + 101, "analogWrite(D9, 128) for 100 ms: pulses at 0, 1, ..., 100 ms");
   Serial.println(failures ? "FAIL" : "PASS");
   exit(failures ? 1 : 0);
 }
