@@ -189,7 +189,16 @@ HAL_StatusTypeDef base_start(TIM_HandleTypeDef* htim, bool on, bool with_it) {
 // ---------------------------------------------------------------- stm32_hal.h's hooks
 
 bool l6470emu_tim_gpio_af(unsigned port_pin, std::uint32_t alternate) {
-  std::erase_if(g_pins, [&](const l6470emu::TimerPin& p) { return p.port_pin == port_pin; });
+  // The pin leaves the timer it was given to (its output stops driving it), if any.
+  for (auto it = g_pins.begin(); it != g_pins.end();) {
+    if (it->port_pin != port_pin) {
+      ++it;
+      continue;
+    }
+    const unsigned timer = it->timer;
+    it = g_pins.erase(it);
+    if (g_tim[timer].timer >= 0) apply(timer);
+  }
   for (unsigned timer = 1; timer <= 11; ++timer)
     if (const auto p = l6470emu::timer_pin(port_pin, timer, alternate)) {
       g_pins.push_back(*p);
