@@ -155,7 +155,7 @@ SpiDevice& Board::begin_transfer(std::size_t chain, const WireSettings& wire) {
   c.prediction_valid = false;
   // The use starts when the bus is free: now, or when the use before it on this bus ends.
   const Tick start = std::max(time_.now(), bus_free_[c.config.bus]);
-  if (start > c.chain.now()) advance_chain(c, start);
+  bring_to(c, start);
   record_outputs(c);
   c.touched = true;
   // One controller per bus: a chip-select still held low on another device of the bus is released first.
@@ -270,7 +270,7 @@ Tick Board::clock_bytes(std::span<const std::size_t> chains, std::span<const std
     if (!c.chain.selected()) continue;
     c.prediction_valid = false;
     c.touched = true;
-    if (start > c.chain.now()) advance_chain(c, start);
+    bring_to(c, start);
     record_outputs(c);
     ChainBus& bus = *c.bus;
     bus.set_device(spi_of(c));
@@ -385,8 +385,10 @@ void Board::emit_changes(ChainState& c, Tick tick) {
 
 void Board::catch_up(std::size_t chain) { catch_up(state(chain)); }
 
-void Board::catch_up(ChainState& c) {
-  const Tick target = time_.now();
+void Board::catch_up(ChainState& c) { bring_to(c, time_.now()); }
+
+void Board::bring_to(ChainState& c, Tick target) {
+  if (!c.trains.empty()) return run_trains(c, target);  // board_pulses.cpp
   if (target > c.chain.now()) advance_chain(c, target);
 }
 
@@ -493,7 +495,7 @@ bool Board::advance_to(Tick tick) {
   if (!time_.is_virtual()) return false;
   const Tick target = time_.set_now(tick);
   for (auto& c : chains_) {
-    if (c->chain.now() < target) advance_chain(*c, target);
+    bring_to(*c, target);
     emit_changes(*c, c->chain.now());
   }
   return true;

@@ -21,6 +21,7 @@
 #include "board/coverage_collector.hpp"
 #include "board/sanitizer.hpp"
 #include "board/pins.hpp"
+#include "board/pulse_train.hpp"
 #include "daisychain/chain.hpp"
 #include "daisychain/pin_level_bus.hpp"
 #include "daisychain/chip_numbering.hpp"
@@ -213,6 +214,35 @@ class Board {
   /// gpio line event read, an interrupt run): a read too, and an edge the program waited on.
   void note_output_edge(std::size_t chain, std::size_t chip, Pin pin, bool rising);
 
+  // ---- pulse trains (board_pulses.cpp): a timer's output on an input pin ----------------
+
+  /// Drives input pin `pin` of chip `chip` with `train` (a PWM timer on STCK): the pin follows
+  /// the train edge by edge, each edge at its own tick,
+  /// until the train's count is spent (the pin stays low) or stop_pulse_train. A train on STCK
+  /// costs nothing per pulse while the chain is not recorded and the chip has no axis: the
+  /// pulses up to a tick reach the chip at once (Chip::stck_pulses) when the chain is brought
+  /// there; a recorded chain, a chip with an axis or with its SYNC clock on BUSY\SYNC, and any
+  /// other pin get every edge at its tick (recorded as any input change). Pulses that fall inside an SPI transfer reach the chip at
+  /// the transfer's end. A train already on the pin keeps its pulses that rise before
+  /// the new train's first and makes no later one (a timer's new period from its update event on); without
+  /// one the pin goes low now. False (nothing done) for a bad
+  /// index, an output pin, a train that makes no pulse (PulseTrain::valid) or whose first pulse
+  /// rises before the board's time.
+  bool drive_pulse_train(std::size_t chain, std::size_t chip, Pin pin, const PulseTrain& train);
+  /// Ends the train on the pin now: the edges up to now applied, then the pin driven to
+  /// `level`. False when no train drives the pin.
+  bool stop_pulse_train(std::size_t chain, std::size_t chip, Pin pin, bool level = false);
+  /// The rising edges the pin's train has applied up to now (0 without a train).
+  std::uint64_t pulse_train_rises(std::size_t chain, std::size_t chip, Pin pin);
+  /// How the board's trains reached the chips since it was made: pulses applied in bulk, and
+  /// edges applied one at a time (for tests and benchmarks: a long train is not simulated
+  /// pulse by pulse).
+  struct PulseTrainCounts {
+    std::uint64_t bulk_pulses = 0;
+    std::uint64_t single_edges = 0;
+  };
+  PulseTrainCounts pulse_train_counts() const { return train_counts_; }
+
   // ---- interface coverage -----------------------------------------------------------
 
   /// Starts collecting interface coverage (docs/coverage.md) on every chain, from now on.
@@ -315,6 +345,10 @@ class Board {
                    const std::function<void(RecordingChain&)>& recorded, const std::function<void(Chip&)>& direct,
                    const std::function<void(std::vector<std::pair<std::size_t, AxisSpec>>&, std::size_t)>& describe);
   void catch_up(ChainState& c);
+  /// Brings the chain to `target` (if later), applying its trains' edges up to it.
+  void bring_to(ChainState& c, Tick target);
+  /// bring_to with trains: edge by edge where it must, else in bulk (board_pulses.cpp).
+  void run_trains(ChainState& c, Tick target);
   void advance_chain(ChainState& c, Tick target);
   void advance_chain_to(ChainState& c, Tick target);
   Tick first_change(ChainState& c, std::size_t chip, Pin pin, bool level, Tick from, Tick to);
@@ -337,6 +371,7 @@ class Board {
   std::vector<std::vector<std::array<Tick, 2>>> output_reads_;
   std::unique_ptr<CoverageCollector> coverage_;  // while coverage is collected
   std::vector<std::unique_ptr<ChainState>> chains_;
+  PulseTrainCounts train_counts_;
 };
 
 }  // namespace l6470emu

@@ -6,6 +6,7 @@
 #include <compare>
 
 #include "board/board.hpp"
+#include "board/pulse_train.hpp"
 #include "board/trace_recorder.hpp"
 
 namespace l6470emu {
@@ -45,6 +46,23 @@ struct Board::ChainState {
   // a new watch): until then the chain advances to any earlier tick without probing.
   bool prediction_valid = false;
   Tick predicted_edge = kNever;
+  /// A pulse train driving an input pin (board_pulses.cpp), with the edges already applied.
+  struct Train {
+    std::size_t chip = 0;
+    Pin pin = Pin::STCK;
+    PulseTrain train;
+    std::uint64_t rises = 0, falls = 0;
+    /// The tick of the next edge not yet applied (kNever when the train has no more).
+    Tick next_edge() const;
+  };
+  std::vector<Train> trains;
+  /// Rising edges of trains that have ended, by chip and pin (pulse_train_rises).
+  std::vector<std::pair<std::pair<std::size_t, Pin>, std::uint64_t>> train_rises;
+  void add_train_rises(const Train& t) {
+    for (auto& [where, n] : train_rises)
+      if (where == std::pair{t.chip, t.pin}) return void(n += t.rises);
+    train_rises.push_back({{t.chip, t.pin}, t.rises});
+  }
   ChainState(const ChainConfig& c, std::vector<Chip> chips) : config(c), chain(std::move(chips)) {}
 };
 

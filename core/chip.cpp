@@ -554,6 +554,23 @@ void Chip::set_stck_pin(bool level) {
   if (axis_) axis_after_change();
 }
 
+void Chip::stck_pulses(std::uint64_t n) {
+  if (axis_) {  // the axis has its rules at every step: one pulse after the other
+    set_stck_pin(false);
+    for (std::uint64_t i = 0; i < n; ++i) {
+      set_stck_pin(true);
+      set_stck_pin(false);
+    }
+    return;
+  }
+  sync();
+  touched();
+  stck_level_ = false;
+  // Nothing a microstep changes decides whether the next edge steps: the condition holds for all n.
+  if (n && stby_level_ && motion_.activity == Activity::step_clock && (variant_->motion_engine || !motion_.hiz))
+    take_microsteps(motion_, profile_, n);
+}
+
 void Chip::set_dir_pin(bool level) {
   sync();
   touched();

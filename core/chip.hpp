@@ -137,6 +137,11 @@ class alignas(64) Chip {
   /// STCK input level; a rising edge in step-clock mode makes one microstep (on a part without
   /// a motion engine, the L6474: each rising edge while the bridges are enabled).
   void set_stck_pin(bool level);
+  /// `n` whole STCK pulses at now(), ending low: exactly set_stck_pin(true) then
+  /// set_stck_pin(false), `n` times (a pin left high is first taken low, which moves nothing).
+  /// Without an axis the cost does not grow with `n`; with one each pulse is applied in turn,
+  /// so that the axis sees every step.
+  void stck_pulses(std::uint64_t n);
   /// DIR input level (the L6474's; the other parts have no such pin and ignore it): the
   /// direction STCK steps in, high = forward. STATUS DIR shows it.
   void set_dir_pin(bool level);

@@ -217,6 +217,17 @@ void take_microstep(MotionState& s, const Profile& p) {
   s.travel += s.dir ? p.el_increment() : -static_cast<std::int64_t>(p.el_increment());
 }
 
+void take_microsteps(MotionState& s, const Profile& p, std::uint64_t n) {
+  if (n == 0) return;
+  // ABS_POS lives modulo 2^22 and EL_POS modulo 2^9: only n's residues move them.
+  const auto pos_steps = static_cast<std::int64_t>(n & kPosMask);
+  s.abs_pos = wrap22(static_cast<std::int64_t>(s.abs_pos) + (s.dir ? pos_steps : -pos_steps));
+  const std::uint64_t el = (n & 0x1FFu) * p.el_increment();
+  s.el_pos = static_cast<std::uint16_t>((s.el_pos + (s.dir ? el : 512 * 128 - el)) & 0x1FF);
+  const auto travel = static_cast<std::int64_t>(n) * p.el_increment();
+  s.travel += s.dir ? travel : -travel;
+}
+
 std::uint32_t directed_distance(std::int32_t from, std::int32_t to, bool forward) {
   const auto d = static_cast<std::uint32_t>(forward ? to - from : from - to);
   return d & static_cast<std::uint32_t>(kPosMask);

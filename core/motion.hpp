@@ -117,6 +117,9 @@ void hard_hiz(MotionState& s);
 
 /// One microstep in the current direction: ABS_POS and EL_POS move, ABS_POS wraps in 22 bits.
 void take_microstep(MotionState& s, const Profile& p);
+/// `n` microsteps in the current direction at once: exactly `n` take_microstep calls (ABS_POS
+/// wrapped in 22 bits, EL_POS in 9, the travel summed), at a cost independent of `n`.
+void take_microsteps(MotionState& s, const Profile& p, std::uint64_t n);
 
 /// GoTo's shortest path from `from` to `to` in 22-bit space: direction (true = forward) and distance.
 /// A distance of exactly 2^21 goes in reverse (the sign of the 22-bit difference).

@@ -99,6 +99,7 @@ FirmwareRuntime::FirmwareRuntime(const BoardConfig& config, FirmwareFront front,
   board_ = std::make_unique<Board>(config_, log_, *clock_);
   board_->set_edge_sink([this](const PinEdge& e) { edges_.push_back(e); });
   wire(config_);
+  timers_ = std::make_unique<FirmwareTimers>(*this);
 }
 
 FirmwareRuntime::~FirmwareRuntime() {
@@ -235,7 +236,7 @@ void FirmwareRuntime::spend(Tick ticks) {
     set_now(std::max(now_, limit_ticks_));  // the run ends at the limit itself
     stop_at_limit();
   }
-  set_now(now_ + ticks);
+  run_timers_to(now_ + ticks);
   catch_up();
   if (!polled_.empty()) poll_levels();
   if (any_pending_) deliver();
@@ -260,7 +261,9 @@ void FirmwareRuntime::sleep_until(Tick tick) {
       step = std::min(step, next_edge_);
     }
     if (!polled_.empty()) step = std::min(step, now_ + kPollTicks);
+    step = std::min(step, std::max(timers_->next_event(), now_));  // a timer event: met at its tick
     set_now(std::max(step, now_));
+    timers_->fire_through(now_);
     catch_up();
     if (!polled_.empty()) poll_levels();
     if (any_pending_) deliver();
@@ -627,12 +630,39 @@ void FirmwareRuntime::transfer(int controller, const BusSettings& settings, std:
   const Tick end = board_->clock_bytes(ctl.chains, tx, rx, settings);
   clocked_ = clocked_ || !tx.empty();
   check_rules();
-  set_now(std::max(now_, end));
+  run_timers_to(end);  // a timer event inside the bytes' bus time is met at its tick
   after_change();
   if (board_watches_) dirty();
   process_edges();
   if (now_ >= limit_ticks_) stop_at_limit();
   if (any_pending_) deliver();
+}
+
+// ---------------------------------------------------------------- timers (firmware/timers.cpp)
+
+bool FirmwareRuntime::drive_pulse_train(int key, const PulseTrain* train) {
+  Line* l = line(key);
+  if (!l || l->inputs.empty()) return false;
+  for (const ChipRef& r : l->inputs) {
+    if (train)
+      board_->drive_pulse_train(r.chain, r.chip, r.pin, *train);
+    else
+      board_->stop_pulse_train(r.chain, r.chip, r.pin, false);
+  }
+  l->applied = -1;  // the pin's next drive by the program reaches the board whatever it was
+  dirty();
+  process_edges();
+  return true;
+}
+
+void FirmwareRuntime::run_timers_to(Tick tick) {
+  for (Tick at = timers_->next_event(); at <= tick; at = timers_->next_event()) {
+    set_now(std::max(at, now_));
+    timers_->fire_through(now_);
+    catch_up();
+    if (any_pending_) deliver();  // the handler runs at its event's tick
+  }
+  set_now(std::max(tick, now_));
 }
 
 // ---------------------------------------------------------------- the run

@@ -20,6 +20,7 @@
 #include "board/run_report.hpp"
 #include "board/scenario.hpp"
 #include "firmware/arduino_board.hpp"
+#include "firmware/timers.hpp"
 
 namespace l6470emu {
 
@@ -129,6 +130,15 @@ class FirmwareRuntime {
   bool interrupts_enabled() const { return irqs_on_; }
   /// Whether an interrupt handler is running (interrupts do not nest).
   bool in_interrupt() const { return in_irq_; }
+
+  // ---- timers (firmware/timers.cpp) ---------------------------------------------------------
+
+  /// The microcontroller's timers: their events wake delays and calls at their exact ticks.
+  FirmwareTimers& timers() { return *timers_; }
+  /// A timer's output on pin `key`: every chip input the description wires to the pin follows
+  /// `train` (Board::drive_pulse_train); nullptr stops it, the pin low again. False when
+  /// nothing is wired to the pin as a chip input.
+  bool drive_pulse_train(int key, const PulseTrain* train);
 
   // ---- SPI ----------------------------------------------------------------------------------
 
@@ -268,6 +278,10 @@ class FirmwareRuntime {
   bool clocked_ = false;
   std::string serial_in_;      // Serial input arrived: read up to serial_at_
   std::size_t serial_at_ = 0;
+  std::unique_ptr<FirmwareTimers> timers_;
+  /// Moves the time to `tick` through the timer events before it, each met at its own tick
+  /// (interrupts delivered there); then to `tick` itself.
+  void run_timers_to(Tick tick);
 };
 
 /// millis() at `tick`: milliseconds since the start in 32 bits, wrapping at 2^32 (after 49.7

@@ -125,12 +125,17 @@ extern "C" {
 void pinMode(uint8_t pin, uint8_t mode);
 void digitalWrite(uint8_t pin, uint8_t val);
 int digitalRead(uint8_t pin);
-/* No analog world: analogRead reads 0, analogWrite drives its pin high from 128 up. */
+/* No analog world: analogRead reads 0. analogWrite is a PWM from a timer (docs/firmware.md,
+ * "Timers"): on an Uno 490 Hz on pins 3, 9, 10, 11 and 977 Hz on 5 and 6, other pins high from
+ * 128 up; on a NUCLEO-F401RE analogWriteFrequency (1 kHz by default) on the pins with a timer.
+ * tone() is a 50 % square wave of exactly `frequency` Hz, `frequency` × `duration` / 1000
+ * pulses when a duration is given. */
 int analogRead(uint8_t pin);
 void analogReference(uint8_t mode);
 void analogWrite(uint8_t pin, int val);
 void analogReadResolution(int bits);
 void analogWriteResolution(int bits);
+void analogWriteFrequency(uint32_t frequency);
 
 unsigned long millis(void);
 unsigned long micros(void);
@@ -161,6 +166,9 @@ void loop(void);
 
 #include "WString.h"
 #include "HardwareSerial.h"
+#ifdef ARDUINO_NUCLEO_F401RE
+#include "HardwareTimer.h" /* as STM32duino's Arduino.h: its timers and the pin map */
+#endif
 
 /* C++: the helpers the Arduino core gives sketches as templates and overloads. */
 template <class T, class L>

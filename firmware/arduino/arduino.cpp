@@ -73,15 +73,6 @@ int analogRead(uint8_t) {
 
 void analogReference(uint8_t) { runtime().call(); }
 void analogReadResolution(int) { runtime().call(); }
-void analogWriteResolution(int) { runtime().call(); }
-
-void analogWrite(uint8_t pin, int val) {
-  FirmwareRuntime& r = runtime();
-  r.call();
-  const int key = r.arduino_pin(pin);
-  r.set_pin_mode(key, l6470emu::McuPinMode::output);
-  r.write_pin(key, val >= 128);
-}
 
 unsigned long millis(void) {
   FirmwareRuntime& r = runtime();
@@ -211,13 +202,6 @@ void yield(void) { runtime().call(); }
 
 unsigned long pulseIn(uint8_t pin, uint8_t state) { return pulseIn(pin, state, 1000000UL); }
 
-void tone(uint8_t pin, unsigned int, unsigned long) {
-  FirmwareRuntime& r = runtime();
-  r.call();
-  r.log("tone() on pin " + std::to_string(pin) + ": no waveform is modelled (a step clock on STCK needs digitalWrite pulses)");
-}
-
-void noTone(uint8_t) { runtime().call(); }
 
 uint16_t makeWord(uint16_t w) { return w; }
 uint16_t makeWord(uint8_t h, uint8_t l) { return static_cast<uint16_t>(h << 8 | l); }

@@ -3,6 +3,7 @@
 // controllers with the settings of their Init, HAL_Delay and HAL_GetTick in virtual time.
 // The model first: stm32_hal.h's macros (RESET, SET, ERROR, SPI1, ...) must not reach its headers.
 #include "firmware/runtime.hpp"
+#include "firmware/stm32/hal_internal.hpp"
 
 #include <algorithm>
 #include <array>
@@ -287,7 +288,9 @@ void HAL_GPIO_Init(GPIO_TypeDef* GPIOx, GPIO_InitTypeDef* init) {
     const bool input = m == l6470emu::McuPinMode::input;
     if (input && init->Pull == GPIO_PULLUP) m = l6470emu::McuPinMode::input_pullup;
     if (input && init->Pull == GPIO_PULLDOWN) m = l6470emu::McuPinMode::input_pulldown;
-    if ((mode == GPIO_MODE_AF_PP || mode == GPIO_MODE_AF_OD) && r.pin_wired(k))
+    const bool af = mode == GPIO_MODE_AF_PP || mode == GPIO_MODE_AF_OD;
+    const bool timer_output = l6470emu_tim_gpio_af(GPIOx->l6470emu_port * 16 + pin, af ? init->Alternate : ~0u);
+    if (af && !timer_output && r.pin_wired(k))
       r.log("HAL_GPIO_Init: pin " + l6470emu::to_string(FirmwareRuntime::pin_of(k)) +
             " given to a peripheral (alternate function) but the board wires it to a chip: a hardware chip "
             "select is not modelled; drive CS with HAL_GPIO_WritePin");
@@ -388,6 +391,7 @@ void HAL_NVIC_SetPriority(IRQn_Type, uint32_t, uint32_t) { call(); }
 
 void HAL_NVIC_EnableIRQ(IRQn_Type IRQn) {
   FirmwareRuntime& r = call();
+  if (l6470emu_tim_nvic(IRQn, true)) return r.spend(0);  // a timer's vector (hal_tim.cpp)
   const int v = vector_of_irqn(IRQn);
   if (v < 0) return;
   g.enabled[static_cast<std::size_t>(v)] = true;
@@ -398,6 +402,7 @@ void HAL_NVIC_EnableIRQ(IRQn_Type IRQn) {
 
 void HAL_NVIC_DisableIRQ(IRQn_Type IRQn) {
   FirmwareRuntime& r = call();
+  if (l6470emu_tim_nvic(IRQn, false)) return;
   const int v = vector_of_irqn(IRQn);
   if (v < 0) return;
   g.enabled[static_cast<std::size_t>(v)] = false;

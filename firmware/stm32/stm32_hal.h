@@ -2,8 +2,9 @@
  * front, docs/firmware.md): GPIO with EXTI interrupts, blocking (and completing-at-once _IT/_DMA)
  * SPI honouring CLKPolarity, CLKPhase, FirstBit, DataSize and BaudRatePrescaler, HAL_Delay and
  * HAL_GetTick in virtual time, NVIC enables, PRIMASK, and the clock set-up a CubeMX main() calls
- * (accepted, no effect). One header for every family: stm32f4xx_hal.h and the others include
- * it. No registers (GPIOA->ODR, SPI1->DR), UART, timers, ADC or DMA streams are modelled. */
+ * (accepted, no effect), timers with PWM outputs and their callbacks (stm32_hal_tim.h). One
+ * header for every family: stm32f4xx_hal.h and the others include it. No registers
+ * (GPIOA->ODR, SPI1->DR), UART, ADC or DMA streams are modelled. */
 #ifndef L6470EMU_STM32_HAL_H
 #define L6470EMU_STM32_HAL_H
 
@@ -187,6 +188,14 @@ typedef enum {
   EXTI3_IRQn = 9,
   EXTI4_IRQn = 10,
   EXTI9_5_IRQn = 23,
+  TIM1_BRK_TIM9_IRQn = 24,
+  TIM1_UP_TIM10_IRQn = 25,
+  TIM1_TRG_COM_TIM11_IRQn = 26,
+  TIM1_CC_IRQn = 27,
+  TIM2_IRQn = 28,
+  TIM3_IRQn = 29,
+  TIM4_IRQn = 30,
+  TIM5_IRQn = 50,
   SPI1_IRQn = 35,
   SPI2_IRQn = 36,
   EXTI15_10_IRQn = 40,
@@ -653,6 +662,9 @@ void HAL_SPI_TxRxCpltCallback(SPI_HandleTypeDef* hspi);
 void HAL_SPI_ErrorCallback(SPI_HandleTypeDef* hspi);
 HAL_SPI_StateTypeDef HAL_SPI_GetState(SPI_HandleTypeDef* hspi);
 uint32_t HAL_SPI_GetError(SPI_HandleTypeDef* hspi);
+
+/* ---- TIM ----------------------------------------------------------------------------------- */
+#include "stm32_hal_tim.h"
 
 #ifdef __cplusplus
 }
