@@ -157,6 +157,26 @@ TEST(FirmwareBitBang, ModeZeroShapedEdgesReadWhatTheControllerReadsInModeZeroAnd
   for (int k = 0; k < 3; ++k) EXPECT_EQ(banged[k], unsigned(high[k] << 8 | low[k])) << "chip " << k;
 }
 
+TEST(FirmwareBitBang, AModeThreeLoopThatReadsMisoBeforeTheClockFallsReadsEachBitOneEdgeLate) {
+  BitBang b("chips=L6470 cs_pin=D4 sck_pin=D5 mosi_pin=D6 miso_pin=D7 check=warn");
+  b.frame({0x38});  // GetParam(CONFIG): 0x2E 0x88
+  auto early_frame = [&] {
+    std::uint8_t in = 0;
+    b.write(b.cs, false);
+    for (int bit = 7; bit >= 0; --bit) {
+      in = static_cast<std::uint8_t>(in << 1 | b.read(b.miso));  // before the falling edge moves it
+      b.write(b.sck, false);
+      b.write(b.mosi, false);
+      b.write(b.sck, true);
+    }
+    b.write(b.cs, true);
+    return in;
+  };
+  EXPECT_EQ(early_frame() & 0x7F, 0x2E >> 1) << "bits 7..1 of 0x2E, after the latch the last frame left";
+  EXPECT_EQ(early_frame(), 0x88 >> 1) << "0x2E's bit 0, then bits 7..1 of 0x88";
+  EXPECT_TRUE(b.broken.empty()) << b.rules().front() << ": " << b.broken.front().what;
+}
+
 TEST(FirmwareBitBang, TwoChainsSharingTheClockAndDataPinsAnswerOnlyWhenTheirChipSelectIsLow) {
   BitBang b("bus=0 cs=0 chips=L6470 cs_pin=D4 sck_pin=D5 mosi_pin=D6 miso_pin=D7 check=warn; "
             "bus=0 cs=1 chips=L6480 cs_pin=D8 sck_pin=D5 mosi_pin=D6 miso_pin=D7");
