@@ -381,9 +381,11 @@ void FirmwareRuntime::apply_drive(Line& l) {
 
 void FirmwareRuntime::unclocked_frame(std::size_t chain) {
   // One such frame is every start's (a chip select set to output drives low until it is driven
-  // high). Pins the description does not map driven inside it, or a second one before any
-  // byte, are a bus the board cannot hear: bit-banged on pins it does not know.
-  const bool unmapped_inside = unmapped_writes_ != unmapped_at_select_[chain];
+  // high). Pins the description does not map clocked inside it (a byte's eight rising edges
+  // on one pin are at least 15 level changes; an LED set up meanwhile is one or two), or a
+  // second one before any byte, are a bus the board cannot hear: bit-banged on pins it does not know.
+  constexpr std::uint64_t kChangesOfAByte = 15;
+  const bool unmapped_inside = unmapped_writes_ - unmapped_at_select_[chain] >= kChangesOfAByte;
   if (!unmapped_inside && (++unclocked_frames_[chain] < 2 || board_->chain(chain).frames() != 0)) return;
   std::string pins;
   for (const int key : unmapped_driven_) pins += (pins.empty() ? "" : ", ") + to_string(pin_of(key));

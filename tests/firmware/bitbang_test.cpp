@@ -208,6 +208,22 @@ TEST(FirmwareBitBang, PinsTheDescriptionDoesNotMapAreNamedInOneLineAndAsSpiPins)
   EXPECT_FALSE(b.rt.clocked_bytes()) << "nothing reached the chips";
 }
 
+TEST(FirmwareBitBang, AnLedSwitchedOnWhileThePowerUpFrameIsOpenIsNoBusOnUnmappedPins) {
+  // pinMode(CS, OUTPUT) drives CS low until it is written high; a sketch that sets up its LED
+  // in between makes one clockless frame around one unmapped write: no bit-banged bus.
+  FirmwareRuntime rt(config_of("chips=L6470 cs_pin=D10 check=warn"), FirmwareFront::arduino, [](std::string_view) {});
+  std::vector<Violation> broken;
+  rt.board().sanitizer().set_broken_sink([&](const Violation& v) { broken.push_back(v); });
+  rt.set_pin_mode(10, McuPinMode::output);
+  rt.call();
+  rt.set_pin_mode(13, McuPinMode::output);
+  rt.call();
+  rt.write_pin(13, true);
+  rt.call();
+  rt.write_pin(10, true);
+  for (const Violation& v : broken) ADD_FAILURE() << rule_info(v.rule).name << ": " << v.what;
+}
+
 TEST(FirmwareBitBang, ClockEdgesWithNoChipSelectLowAreNamedOnce) {
   BitBang b(kThreeChips);
   for (int i = 0; i < 3; ++i) b.clock_bits(0xD0);  // CS never falls
