@@ -208,6 +208,19 @@ TEST(FirmwareBitBang, PinsTheDescriptionDoesNotMapAreNamedInOneLineAndAsSpiPins)
   EXPECT_FALSE(b.rt.clocked_bytes()) << "nothing reached the chips";
 }
 
+TEST(FirmwareBitBang, TheLineNamesThePinsSwitchedInsideTheFrameNotEveryPinTheProgramSetUp) {
+  BitBang b("chips=L6470 cs_pin=D4 check=warn");
+  for (int pin = 20; pin < 40; ++pin) {  // a firmware's enables, heaters, fans and LEDs
+    b.rt.set_pin_mode(pin, McuPinMode::output);
+    b.write(pin, true);
+  }
+  b.frame({0x38});
+  EXPECT_EQ(b.log_lines_with("spidev0.0: a chip-select frame with no clock edge: nothing reached the chips; the program "
+                             "drives pins 5, 6 the board description does not map"),
+            1u)
+      << (b.log.empty() ? "" : b.log.front());
+}
+
 TEST(FirmwareBitBang, AnLedSwitchedOnWhileThePowerUpFrameIsOpenIsNoBusOnUnmappedPins) {
   // pinMode(CS, OUTPUT) drives CS low until it is written high; a sketch that sets up its LED
   // in between makes one clockless frame around one unmapped write: no bit-banged bus.
