@@ -28,6 +28,7 @@ struct FirmwareRuntime::Line {
   std::vector<ChipRef> inputs;    // chip SW/STCK/STBY_RST it drives
   std::vector<std::size_t> sck_chains, mosi_chains, miso_chains;  // SPI at the pins: the chains it is CK, SDI or SDO of
   std::uint64_t unselected_rising = 0;  // a CK line: rising edges while none of its chains was selected
+  std::uint64_t unmapped_change = 0;    // a line the description does not map: unmapped_writes_ at its last change (0 none)
   int applied = -1;               // what it last drove onto the board: -1 unknown, 0 low, 1 high, 2 released
   unsigned edges = 0;
   std::function<void(bool)> on_edge;
@@ -294,9 +295,7 @@ McuPinMode FirmwareRuntime::pin_mode(int key) const {
 void FirmwareRuntime::write_pin(int key, bool level) {
   Line& l = make_line(key);
   if (l.latch != level && !wired(l)) {
-    ++unmapped_writes_;
-    if (unmapped_driven_.size() < 16 && std::find(unmapped_driven_.begin(), unmapped_driven_.end(), key) == unmapped_driven_.end())
-      unmapped_driven_.push_back(key);
+    l.unmapped_change = ++unmapped_writes_;
   }
   l.latch = level;
   apply_drive(l);
@@ -384,12 +383,25 @@ void FirmwareRuntime::apply_drive(Line& l) {
 
 void FirmwareRuntime::unclocked_frame(std::size_t chain) {
   // One such frame is every start's (a chip select set to output drives low until it is driven
-  // high). Pins the description does not map driven inside it, or a second one before any
-  // byte, are a bus the board cannot hear: bit-banged on pins it does not know.
-  const bool unmapped_inside = unmapped_writes_ != unmapped_at_select_[chain];
+  // high). Pins the description does not map clocked inside it (a byte's eight rising edges
+  // on one pin are at least 15 level changes; an LED set up meanwhile is one or two), or a
+  // second one before any byte, are a bus the board cannot hear: bit-banged on pins it does not know.
+  constexpr std::uint64_t kChangesOfAByte = 15;
+  const bool unmapped_inside = unmapped_writes_ - unmapped_at_select_[chain] >= kChangesOfAByte;
   if (!unmapped_inside && (++unclocked_frames_[chain] < 2 || board_->chain(chain).frames() != 0)) return;
+  // The pins switched inside the frame (the bus), else every one ever switched; eight at most.
+  std::vector<int> keys;
+  for (const bool inside : {true, false}) {
+    const std::uint64_t since = inside ? unmapped_at_select_[chain] : 0;
+    for (const auto& l : lines_)
+      if (!wired(*l) && l->unmapped_change > since) keys.push_back(l->key);
+    if (!keys.empty()) break;
+  }
+  std::sort(keys.begin(), keys.end());
+  constexpr std::size_t kNamed = 8;
   std::string pins;
-  for (const int key : unmapped_driven_) pins += (pins.empty() ? "" : ", ") + to_string(pin_of(key));
+  for (std::size_t i = 0; i < std::min(keys.size(), kNamed); ++i) pins += (pins.empty() ? "" : ", ") + to_string(pin_of(keys[i]));
+  if (keys.size() > kNamed) pins += " and " + std::to_string(keys.size() - kNamed) + " more";
   const std::string what =
       "a chip-select frame with no clock edge: nothing reached the chips" +
       (pins.empty() ? std::string()

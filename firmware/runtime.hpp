@@ -267,7 +267,6 @@ class FirmwareRuntime {
   bool finished_ = false;
   std::vector<Controller> controllers_;
   std::vector<std::string> reported_;
-  std::vector<int> unmapped_driven_;  // pins the program drove that the description does not map (the first 16)
   std::uint64_t unmapped_writes_ = 0;             // level changes of such pins so far
   std::vector<std::uint64_t> unmapped_at_select_;  // per chain: unmapped_writes_ at its last CS falling edge
   std::vector<std::uint64_t> unclocked_frames_;    // per chain: CS frames with no clock edge
