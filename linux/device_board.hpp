@@ -1,5 +1,6 @@
 // The emulated board's device nodes, as a transport serves them: a spidev node per chain and a
-// gpiochip per chain carrying its chips' pins, in front of the OS-free Board (board/board.hpp),
+// gpiochip per chain carrying its chips' pins (and, on a chain with sck_pin=, the CS, SCK, MOSI
+// and MISO lines a bit-banging host drives: device_board_spi_pins.cpp), in front of the OS-free Board (board/board.hpp),
 // and the open files / line requests of the host programs, with the kernel's semantics
 // (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
 // Every open file or line request is a handle backed by a SOCK_SEQPACKET socketpair: the
@@ -98,7 +99,9 @@ class DeviceBoard {
   void closed(std::uint64_t handle);
   /// ioctl other than SPI_IOC_MESSAGE on `handle`. `arg` holds the _IOC_SIZE(cmd) argument bytes
   /// (copied in for _IOC_WRITE, copied out for _IOC_READ by the caller). A line request fills
-  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno.
+  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno. A set of line
+  /// values that drives an SPI line returns kSpiLineSetTicks of board time later (a wait in
+  /// virtual time, a spin on the wall clock), the board unlocked meanwhile.
   long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
   /// SPI_IOC_MESSAGE(n): `tx` holds the tx data of the transfers with a tx_buf, concatenated;
   /// `rx` (spidev_rx_bytes long) receives the rx data. Returns the total length or -errno.
@@ -280,7 +283,9 @@ class DeviceBoard {
 
   // gpio ioctls (device_board_gpio.cpp)
   long gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
+  /// A line request's ioctl; `lasts_to`: the tick the call returns at (0: at once).
   long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, Tick& lasts_to);
+  /// ioctl() under the lock; `lasts_to` as line_ioctl's, waited for once the lock is released.
   long locked_ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created,
                     Tick& lasts_to);
   void fill_v2_info(GpioDev& g, unsigned offset, void* info);
