@@ -44,11 +44,13 @@ DeviceBoard::DeviceBoard(const BoardConfig& config, DiagnosticLog& log, HostCloc
       const std::size_t n = board_.chip_count(ci);
       g->layout.chips = n;
       for (std::size_t k = 0; k < n; ++k) g->layout.dir = g->layout.dir || board_.chain(ci).peek_chip(k).variant().pins.dir;
+      g->layout.spi = cc.pins.sck.has_value();  // SPI at the pins: CS, SCK, MOSI, MISO lines after the chips'
       g->lines.resize(g->layout.count());
       for (unsigned off = 0; off < g->lines.size(); ++off) {
         LineDev& l = g->lines[off];
         l.name = g->layout.name(off);
         l.flags = GPIO_V2_LINE_FLAG_INPUT;
+        l.out_value = g->layout.spi_line(off) == SpiLine::cs;  // CS idles high (deselected)
       }
       cd->gpio = static_cast<int>(gpios_.size());
       nodes_.push_back({DeviceNode::Type::gpiochip, "/dev/" + g->name, g->name, kGpiochipMajor, *cc.gpiochip, 0});
@@ -311,7 +313,18 @@ long DeviceBoard::spi_write(std::uint64_t handle, std::span<const std::uint8_t> 
 }
 
 long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created) {
-  std::lock_guard lock(m_);
+  Tick lasts_to = 0;
+  long r = 0;
+  {
+    std::lock_guard lock(m_);
+    r = locked_ioctl(handle, cmd, arg, created, lasts_to);
+  }
+  if (lasts_to != 0) wait_for(lasts_to);  // a set of SPI lines takes its time (kSpiLineSetTicks)
+  return r;
+}
+
+long DeviceBoard::locked_ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created,
+                               Tick& lasts_to) {
   Handle* h = find_any(handle);
   if (!h) return -EBADF;
   if (h->kind == HandleKind::spidev) {
@@ -331,12 +344,13 @@ long DeviceBoard::ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::
     return r;
   }
   if (h->kind == HandleKind::gpiochip) return gpiochip_ioctl(*h, cmd, arg, created);
-  return line_ioctl(*h, cmd, arg);
+  return line_ioctl(*h, cmd, arg, lasts_to);
 }
 
 // ---------------------------------------------------------------- pin edges as line events
 
 bool DeviceBoard::physical_level(GpioDev& g, unsigned offset) {
+  if (g.layout.spi_line(offset)) return spi_line_level(g, offset);
   const LineDev& l = g.lines[offset];
   const Pin p = g.layout.pin_of(offset);
   // The host drives a chip output: it reads its own value.
@@ -345,6 +359,7 @@ bool DeviceBoard::physical_level(GpioDev& g, unsigned offset) {
 }
 
 void DeviceBoard::set_chip_input(GpioDev& g, unsigned offset, bool level) {
+  if (const auto line = g.layout.spi_line(offset)) return set_spi_line(g, *line, level, /*at_request=*/false);
   LineDev& l = g.lines[offset];
   const Pin p = g.layout.pin_of(offset);
   if (pin_is_chip_output(p)) {
@@ -357,7 +372,9 @@ void DeviceBoard::set_chip_input(GpioDev& g, unsigned offset, bool level) {
 }
 
 void DeviceBoard::watch_line(GpioDev& g, unsigned offset, bool watched) {
-  // Edge detection (which needs an input line) starts from the level the line has now.
+  // Edge detection (which needs an input line) starts from the level the line has now. (Never
+  // asked of an SPI line: a request for its edges is refused.)
+  if (g.layout.spi_line(offset)) return;
   board_.watch_pin(g.chain, g.layout.chip_of(offset), g.layout.pin_of(offset), watched);
 }
 

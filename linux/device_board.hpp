@@ -1,5 +1,6 @@
 // The emulated board's device nodes, as a transport serves them: a spidev node per chain and a
-// gpiochip per chain carrying its chips' pins, in front of the OS-free Board (board/board.hpp),
+// gpiochip per chain carrying its chips' pins (and, on a chain with sck_pin=, the CS, SCK, MOSI
+// and MISO lines a bit-banging host drives: device_board_spi_pins.cpp), in front of the OS-free Board (board/board.hpp),
 // and the open files / line requests of the host programs, with the kernel's semantics
 // (drivers/spi/spidev.c, drivers/gpio/gpiolib-cdev.c).
 // Every open file or line request is a handle backed by a SOCK_SEQPACKET socketpair: the
@@ -98,7 +99,9 @@ class DeviceBoard {
   void closed(std::uint64_t handle);
   /// ioctl other than SPI_IOC_MESSAGE on `handle`. `arg` holds the _IOC_SIZE(cmd) argument bytes
   /// (copied in for _IOC_WRITE, copied out for _IOC_READ by the caller). A line request fills
-  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno.
+  /// `created` (and the fd field of the argument struct). Returns >= 0 or -errno. A set of line
+  /// values that drives an SPI line returns kSpiLineSetTicks of board time later (a wait in
+  /// virtual time, a spin on the wall clock), the board unlocked meanwhile.
   long ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
   /// SPI_IOC_MESSAGE(n): `tx` holds the tx data of the transfers with a tx_buf, concatenated;
   /// `rx` (spidev_rx_bytes long) receives the rx data. Returns the total length or -errno.
@@ -125,6 +128,12 @@ class DeviceBoard {
                 const std::function<bool()>& caller_alive = {});
   long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx, std::string* check_report = nullptr,
                  const std::function<bool()>& caller_alive = {});
+
+  /// What a line-values set (GPIOHANDLE_SET_LINE_VALUES_IOCTL, GPIO_V2_LINE_SET_VALUES_IOCTL) that
+  /// drives a CS, SCK or MOSI line costs in board time: the call returns 1 µs after the edges,
+  /// about what the kernel's gpio character device takes on a Raspberry Pi, so that a bit-banged
+  /// frame keeps t_setCS and t_disCS in virtual time too. Other gpio calls cost no board time.
+  static constexpr Tick kSpiLineSetTicks = 1 * kTicksPerMicrosecond;
 
   /// Bus time of one slice of a long message whose caller may die (10 ms).
   static constexpr Tick kBusSliceTicks = 10 * 1000 * kTicksPerMicrosecond;
@@ -274,7 +283,11 @@ class DeviceBoard {
 
   // gpio ioctls (device_board_gpio.cpp)
   long gpiochip_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created);
-  long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg);
+  /// A line request's ioctl; `lasts_to`: the tick the call returns at (0: at once).
+  long line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, Tick& lasts_to);
+  /// ioctl() under the lock; `lasts_to` as line_ioctl's, waited for once the lock is released.
+  long locked_ioctl(std::uint64_t handle, unsigned long cmd, std::span<std::uint8_t> arg, NewFile* created,
+                    Tick& lasts_to);
   void fill_v2_info(GpioDev& g, unsigned offset, void* info);
   long request_lines(Handle& chip, HandleKind kind, const std::vector<unsigned>& offsets,
                      const std::vector<std::uint64_t>& flags, const std::vector<int>& values, const char* consumer,
@@ -282,6 +295,19 @@ class DeviceBoard {
   long reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
                          const std::vector<std::uint32_t>& debounce);
   bool logical_value(Handle& h, unsigned index);
+  /// -EOPNOTSUPP (said in the log) when `flags` ask edge events of an SPI line, else 0.
+  long refuse_spi_line_edges(GpioDev& g, const std::vector<unsigned>& offsets, const std::vector<std::uint64_t>& flags);
+  /// A request's (or reconfiguration's) output values (`values`: -1 none, else 0/1 logical).
+  void set_requested_values(GpioDev& g, const std::vector<unsigned>& offsets, const std::vector<int>& values);
+  /// Sets the values of lines `indices` of request `h` (physical levels in `levels`, one per
+  /// index), in offset order; returns the tick the call lasts to (0: it drove no SPI line).
+  Tick apply_values(Handle& h, const std::vector<unsigned>& indices, const std::vector<bool>& levels);
+
+  // SPI at the pins (device_board_spi_pins.cpp): the host drives CS, SCK, MOSI (or MISO,
+  // which the chips ignore); `at_request`: set by a line request's default output value.
+  void set_spi_line(GpioDev& g, SpiLine line, bool level, bool at_request);
+  /// The level an SPI line reads (before active-low).
+  bool spi_line_level(GpioDev& g, unsigned offset);
 
   DiagnosticLog& log_;
   Board board_;

@@ -215,6 +215,7 @@ long DeviceBoard::request_lines(Handle& chip, HandleKind kind, const std::vector
     for (std::size_t j = 0; j < i; ++j)
       if (offsets[j] == offsets[i]) return -EBUSY;
   }
+  if (const long r = refuse_spi_line_edges(g, offsets, flags)) return r;
   if (!created) return -EINVAL;
   std::unique_ptr<Handle> h;
   NewFile f = make_handle(kind, chip.dev, /*cloexec=*/true, h);  // anon_inode_getfile(O_RDONLY | O_CLOEXEC)
@@ -234,13 +235,12 @@ long DeviceBoard::request_lines(Handle& chip, HandleKind kind, const std::vector
       fl |= l.flags & (GPIO_V2_LINE_FLAG_INPUT | GPIO_V2_LINE_FLAG_OUTPUT);
     l.flags = fl;
     l.debounce_us = debounce[i];
-    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && values[i] >= 0)
-      set_chip_input(g, offsets[i], (values[i] != 0) != ((fl & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
-    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && pin_is_chip_output(g.layout.pin_of(offsets[i])))
+    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && !g.layout.spi_line(offsets[i]) && pin_is_chip_output(g.layout.pin_of(offsets[i])))
       log_.line(g.name + ": line " + l.name + " requested as an output by \"" + r.consumer +
                 "\", but the chip drives it (the host reads back its own value)");
     edges = edges || (fl & kV2EdgeFlags);
   }
+  set_requested_values(g, offsets, values);
   for (unsigned off : offsets)
     if (g.lines[off].flags & kV2EdgeFlags) watch_line(g, off, true);
   board_.report_changes(g.chain);  // outputs set at request time may have edges for others
@@ -258,6 +258,7 @@ long DeviceBoard::request_lines(Handle& chip, HandleKind kind, const std::vector
 long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>& flags, const std::vector<int>& values,
                                     const std::vector<std::uint32_t>& debounce) {
   GpioDev& g = *gpios_[h.dev];
+  if (const long r = refuse_spi_line_edges(g, h.offsets, flags)) return r;
   bool edges = false;
   for (std::size_t i = 0; i < h.offsets.size(); ++i) {
     LineDev& l = g.lines[h.offsets[i]];
@@ -266,8 +267,10 @@ long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>&
       fl |= l.flags & (GPIO_V2_LINE_FLAG_INPUT | GPIO_V2_LINE_FLAG_OUTPUT);
     l.flags = fl;
     l.debounce_us = debounce[i];
-    if ((fl & GPIO_V2_LINE_FLAG_OUTPUT) && values[i] >= 0)
-      set_chip_input(g, h.offsets[i], (values[i] != 0) != ((fl & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
+  }
+  set_requested_values(g, h.offsets, values);
+  for (std::size_t i = 0; i < h.offsets.size(); ++i) {
+    const std::uint64_t fl = g.lines[h.offsets[i]].flags;
     watch_line(g, h.offsets[i], (fl & kV2EdgeFlags) != 0);  // a watch starts from the level now
     edges = edges || (fl & kV2EdgeFlags);
   }
@@ -282,14 +285,64 @@ long DeviceBoard::reconfigure_lines(Handle& h, const std::vector<std::uint64_t>&
   return 0;
 }
 
+long DeviceBoard::refuse_spi_line_edges(GpioDev& g, const std::vector<unsigned>& offsets,
+                                        const std::vector<std::uint64_t>& flags) {
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+    if (g.layout.spi_line(offsets[i]) && (flags[i] & kV2EdgeFlags)) {
+      log_.line(g.name + ": edge events on " + g.lines[offsets[i]].name +
+                " are not emulated (the SPI lines are read and set only): the request is refused (EOPNOTSUPP)");
+      return -EOPNOTSUPP;
+    }
+  return 0;
+}
+
+void DeviceBoard::set_requested_values(GpioDev& g, const std::vector<unsigned>& offsets, const std::vector<int>& values) {
+  // A request's output values, in offset order as a set of values is (apply_values).
+  std::vector<unsigned> order(offsets.size());
+  for (unsigned i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) { return offsets[a] < offsets[b]; });
+  for (const unsigned i : order) {
+    const unsigned off = offsets[i];
+    const std::uint64_t fl = g.lines[off].flags;
+    if (!(fl & GPIO_V2_LINE_FLAG_OUTPUT) || values[i] < 0) continue;
+    const bool level = (values[i] != 0) != ((fl & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
+    if (const auto line = g.layout.spi_line(off))
+      set_spi_line(g, *line, level, /*at_request=*/true);
+    else
+      set_chip_input(g, off, level);
+  }
+}
+
+Tick DeviceBoard::apply_values(Handle& h, const std::vector<unsigned>& indices, const std::vector<bool>& levels) {
+  // One call's values reach the board one line at a time, in offset order (CS, SCK, MOSI): a
+  // rising SCK set together with MOSI samples the MOSI from before the call, as a data line
+  // changing at a clock edge breaks the chip's hold time. Data goes out a call before its clock.
+  GpioDev& g = *gpios_[h.dev];
+  std::vector<unsigned> order(indices.size());
+  for (unsigned k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](unsigned a, unsigned b) { return h.offsets[indices[a]] < h.offsets[indices[b]]; });
+  bool spi = false;
+  for (const unsigned k : order) {
+    const unsigned off = h.offsets[indices[k]];
+    const auto line = g.layout.spi_line(off);
+    spi = spi || (line && *line != SpiLine::miso);
+    set_chip_input(g, off, levels[k]);
+  }
+  board_.report_changes(g.chain);
+  wake_pump();
+  return spi ? time().now() + kSpiLineSetTicks : 0;
+}
+
 bool DeviceBoard::logical_value(Handle& h, unsigned index) {
   GpioDev& g = *gpios_[h.dev];
   const unsigned off = h.offsets[index];
-  board_.note_output_read(g.chain, g.layout.chip_of(off), g.layout.pin_of(off));  // the host looks (BUSY, FLAG)
+  if (!g.layout.spi_line(off))
+    board_.note_output_read(g.chain, g.layout.chip_of(off), g.layout.pin_of(off));  // the host looks (BUSY, FLAG)
   return physical_level(g, off) != ((g.lines[off].flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
 }
 
-long DeviceBoard::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg) {
+long DeviceBoard::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_t> arg, Tick& lasts_to) {
   GpioDev& g = *gpios_[h.dev];
   board_.catch_up(g.chain);
   const unsigned n = static_cast<unsigned>(h.offsets.size());
@@ -305,12 +358,14 @@ long DeviceBoard::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_
     if (cmd == GPIOHANDLE_SET_LINE_VALUES_IOCTL) {
       if (!(g.lines[h.offsets[0]].flags & GPIO_V2_LINE_FLAG_OUTPUT)) return -EPERM;
       const auto d = load<gpiohandle_data>(arg);
+      std::vector<unsigned> indices(n);
+      std::vector<bool> levels(n);
       for (unsigned i = 0; i < n; ++i) {
         const LineDev& l = g.lines[h.offsets[i]];
-        set_chip_input(g, h.offsets[i], (d.values[i] != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
+        indices[i] = i;
+        levels[i] = (d.values[i] != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0);
       }
-      board_.report_changes(g.chain);
-      wake_pump();
+      lasts_to = apply_values(h, indices, levels);
       return 0;
     }
     if (cmd == GPIOHANDLE_SET_CONFIG_IOCTL) {
@@ -343,13 +398,15 @@ long DeviceBoard::line_ioctl(Handle& h, unsigned long cmd, std::span<std::uint8_
       if (lv.mask == 0) return -EINVAL;
       for (unsigned i = 0; i < n; ++i)
         if ((lv.mask >> i) & 1u && !(g.lines[h.offsets[i]].flags & GPIO_V2_LINE_FLAG_OUTPUT)) return -EPERM;
+      std::vector<unsigned> indices;
+      std::vector<bool> levels;
       for (unsigned i = 0; i < n; ++i) {
         if (!((lv.mask >> i) & 1u)) continue;
         const LineDev& l = g.lines[h.offsets[i]];
-        set_chip_input(g, h.offsets[i], (((lv.bits >> i) & 1u) != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
+        indices.push_back(i);
+        levels.push_back((((lv.bits >> i) & 1u) != 0) != ((l.flags & GPIO_V2_LINE_FLAG_ACTIVE_LOW) != 0));
       }
-      board_.report_changes(g.chain);
-      wake_pump();
+      lasts_to = apply_values(h, indices, levels);
       return 0;
     }
     case GPIO_V2_LINE_SET_CONFIG_IOCTL: {

@@ -32,8 +32,13 @@ struct DeviceBoard::GpioDev {
   std::string name;   // "gpiochip0"
   std::string label;  // "l6470emu spidev0.0"
   std::size_t chain = 0;
-  GpioLines layout;  // which line is which chip's which pin
+  GpioLines layout;  // which line is which chip's which pin (and the SPI lines)
   std::vector<LineDev> lines;
+  // SPI lines (device_board_spi_pins.cpp)
+  std::uint64_t unselected_rising = 0;  // rising SCK edges while CS was high
+  bool cs_low_from_request = false;     // CS went low when its line was requested as an output low
+  bool clockless_said = false;          // the log said a frame with no clock edge
+  bool miso_driven_said = false;        // the log said the host drives MISO
 };
 
 /// An open file or line request.
