@@ -6,12 +6,20 @@
 
 #include <dirent.h>
 #include <fcntl.h>
+#include <linux/netlink.h>
+#include <linux/rtnetlink.h>
+#include <linux/sock_diag.h>
+#include <linux/unix_diag.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "linux/preload/real.hpp"
 
@@ -50,19 +58,75 @@ bool is_child_of(const char* pid, const std::string& self) {
   return std::sscanf(close_paren + 1, " %c %ld", &state, &ppid) == 2 && std::to_string(ppid) == self;
 }
 
-// Whether process `pid`'s descriptors include `target` ("pipe:[123]").
-bool holds(const char* pid, const std::string& target) {
+// Whether process `pid`'s descriptors include one of `targets` ("pipe:[123]").
+bool holds(const char* pid, const std::vector<std::string>& targets) {
   const std::string dir = std::string("/proc/") + pid + "/fd";
   DIR* d = real::opendir(dir.c_str());
   if (!d) return false;
   bool found = false;
   while (const dirent* e = real::readdir(d))
-    if (is_number(e->d_name) && link_of(dir + "/" + e->d_name) == target) {
-      found = true;
-      break;
+    if (is_number(e->d_name)) {
+      const std::string link = link_of(dir + "/" + e->d_name);
+      if (std::find(targets.begin(), targets.end(), link) != targets.end()) {
+        found = true;
+        break;
+      }
     }
   real::closedir(d);
   return found;
+}
+
+// Whether no other process holds any of `targets`, and this one has no child.
+bool held_by_this_process_alone(const std::vector<std::string>& targets) {
+  const std::string self = std::to_string(getpid());
+  DIR* d = real::opendir("/proc");
+  if (!d) return false;
+  bool alone = true;
+  while (const dirent* e = real::readdir(d))
+    if (is_number(e->d_name) && self != e->d_name && (holds(e->d_name, targets) || is_child_of(e->d_name, self))) {
+      alone = false;
+      break;
+    }
+  real::closedir(d);
+  return alone;
+}
+
+// The inode of the peer of AF_UNIX socket `inode`, as sock_diag says it (0: none, or unknown).
+unsigned long unix_peer(unsigned long inode) {
+  const int s = socket(AF_NETLINK, SOCK_DGRAM | SOCK_CLOEXEC, NETLINK_SOCK_DIAG);
+  if (s < 0) return 0;
+  struct {
+    nlmsghdr header;
+    unix_diag_req request;
+  } ask{};
+  ask.header.nlmsg_len = sizeof ask;
+  ask.header.nlmsg_type = SOCK_DIAG_BY_FAMILY;
+  ask.header.nlmsg_flags = NLM_F_REQUEST;
+  ask.request.sdiag_family = AF_UNIX;
+  ask.request.udiag_states = ~0u;
+  ask.request.udiag_ino = static_cast<unsigned>(inode);
+  ask.request.udiag_show = UDIAG_SHOW_PEER;
+  ask.request.udiag_cookie[0] = ask.request.udiag_cookie[1] = ~0u;  // INET_DIAG_NOCOOKIE: any
+  sockaddr_nl kernel{};
+  kernel.nl_family = AF_NETLINK;
+  unsigned long peer = 0;
+  alignas(nlmsghdr) char reply[8192];
+  if (sendto(s, &ask, sizeof ask, 0, reinterpret_cast<sockaddr*>(&kernel), sizeof kernel) == sizeof ask) {
+    const ssize_t n = real::recv(s, reply, sizeof reply, 0);
+    const auto* h = reinterpret_cast<const nlmsghdr*>(reply);
+    if (n > 0 && NLMSG_OK(h, static_cast<unsigned>(n)) && h->nlmsg_type == SOCK_DIAG_BY_FAMILY) {
+      const auto* m = static_cast<const unix_diag_msg*>(NLMSG_DATA(h));
+      int len = static_cast<int>(h->nlmsg_len - NLMSG_LENGTH(sizeof *m));
+      for (auto* a = reinterpret_cast<const rtattr*>(m + 1); RTA_OK(a, len); a = RTA_NEXT(a, len))
+        if (a->rta_type == UNIX_DIAG_PEER && RTA_PAYLOAD(a) >= sizeof(std::uint32_t)) {
+          std::uint32_t p = 0;
+          std::memcpy(&p, RTA_DATA(a), sizeof p);
+          peer = p;
+        }
+    }
+  }
+  real::close(s);
+  return peer;
 }
 
 }  // namespace
@@ -70,17 +134,15 @@ bool holds(const char* pid, const std::string& target) {
 bool pipe_held_by_this_process_alone(int fd) {
   const std::string target = link_of("/proc/self/fd/" + std::to_string(fd));
   if (target.rfind("pipe:[", 0) != 0) return false;
-  const std::string self = std::to_string(getpid());
-  DIR* d = real::opendir("/proc");
-  if (!d) return false;
-  bool alone = true;
-  while (const dirent* e = real::readdir(d))
-    if (is_number(e->d_name) && self != e->d_name && (holds(e->d_name, target) || is_child_of(e->d_name, self))) {
-      alone = false;
-      break;
-    }
-  real::closedir(d);
-  return alone;
+  return held_by_this_process_alone({target});
+}
+
+bool socket_pair_held_by_this_process_alone(int fd) {
+  const std::string target = link_of("/proc/self/fd/" + std::to_string(fd));
+  if (target.rfind("socket:[", 0) != 0) return false;
+  const unsigned long peer = unix_peer(std::strtoul(target.c_str() + 8, nullptr, 10));
+  if (peer == 0) return false;
+  return held_by_this_process_alone({target, "socket:[" + std::to_string(peer) + "]"});
 }
 
 }  // namespace l6470emu::preload

@@ -95,7 +95,9 @@ bool epoll_members(int fd, std::vector<int>& members) {
 // Whether descriptor `fd` becomes ready only through this process: an emulated gpio line, a
 // virtual timerfd, or an epoll set of such descriptors.
 bool inside_fd(int fd, int depth = 0) {
-  if (is_emulated_line(fd) || is_virtual_timerfd(fd) || pipe_held_by_this_process_alone(fd)) return true;
+  if (is_emulated_line(fd) || is_virtual_timerfd(fd) || pipe_held_by_this_process_alone(fd) ||
+      socket_pair_held_by_this_process_alone(fd))
+    return true;
   std::vector<int> members;
   if (depth > 3 || !epoll_members(fd, members)) return false;
   for (const int m : members)
@@ -217,6 +219,7 @@ std::string VirtualHostTime::describe_fd(int fd) const {
     return n + " (" + node + ")";
   }
   if (pipe_held_by_this_process_alone(fd)) return n + " (a pipe no other process holds)";
+  if (socket_pair_held_by_this_process_alone(fd)) return n + " (a socket pair no other process holds)";
   if (const pid_t child = pidfd_child(fd); child > 0) return n + " (child " + std::to_string(child) + ")";
   bool armed = false;
   if (is_virtual_timerfd(fd, &armed)) return n + (armed ? " (a timerfd)" : " (a timerfd that is not armed)");

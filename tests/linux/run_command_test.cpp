@@ -320,15 +320,19 @@ std::size_t occurrences(const std::string& text, const std::string& part) {
   return n;
 }
 
-TEST_F(RunCommand, AReadOfItsOwnPipeThatNoThreadOrProcessCanWriteIsADeadlockNamingTheCall) {
+TEST_F(RunCommand, AReadOfItsOwnPipeOrSocketPairThatNoThreadOrProcessCanWriteIsADeadlockNamingTheCall) {
   for (const auto& [mode, call, times] : std::vector<std::tuple<std::string, std::string, std::size_t>>{
            {"pipe-read", "read() on fd ", 1},
            {"pipe-readv", "readv() on fd ", 1},
+           {"socketpair-recv", "recv() on fd ", 1},
            {"pipe-read-threads", "read() on fd ", 2}}) {  // two readers, and the main thread joining one
     const RunResult r = run_client(mode);
     EXPECT_EQ(r.status, kRunDeadlocked) << mode << "\n" << r.err;
     EXPECT_EQ(occurrences(r.err, call), times) << mode << "\n" << r.err;
-    EXPECT_NE(r.err.find(" (a pipe no other process holds), no timeout\n"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(mode.starts_with("socket") ? " (a socket pair no other process holds), no timeout\n"
+                                                    : " (a pipe no other process holds), no timeout\n"),
+              std::string::npos)
+        << r.err;
   }
   // Python's os.read the same way.
   const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
@@ -337,11 +341,17 @@ TEST_F(RunCommand, AReadOfItsOwnPipeThatNoThreadOrProcessCanWriteIsADeadlockNami
   EXPECT_NE(r.err.find("read() on fd "), std::string::npos) << r.err;
 }
 
-TEST_F(RunCommand, AReadOfItsOwnPipeThatAThreadAProcessOrASignalWillEndIsNoDeadlock) {
+TEST_F(RunCommand, AReadOfItsOwnPipeOrSocketPairThatAThreadAProcessOrASignalWillEndIsNoDeadlock) {
   // Another thread writes after 100 ms of virtual time: the read waits exactly that long.
   RunResult r = run_client("pipe-read-thread", {"--timeout", "5s"});
   EXPECT_EQ(r.status, kRunPassed) << r.err;
   EXPECT_EQ(r.out, "mode pipe-read-thread\nread returned 1 (errno 0)\nat 100 ms\ndone\n") << r.err;
+  r = run_client("socketpair-recv-thread", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode socketpair-recv-thread\nrecv returned 1 (errno 0) at 100 ms\ndone\n") << r.err;
+  r = run_client("socketpair-recv-child", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode socketpair-recv-child\nrecv returned 1 (errno 0) at 0 ms\ndone\n") << r.err;
   // A child writes in real time: neither a deadlock nor a jump to the time limit meanwhile.
   r = run_client("pipe-read-child", {"--timeout", "5s"});
   EXPECT_EQ(r.status, kRunPassed) << r.err;

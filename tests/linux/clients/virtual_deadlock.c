@@ -19,6 +19,7 @@
 #include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <sys/select.h>
+#include <sys/socket.h>
 #include <sys/syscall.h>
 #include <sys/uio.h>
 #include <sys/timerfd.h>
@@ -153,6 +154,22 @@ static void* computing_holder(void* arg) {
   return NULL;
 }
 
+static int socket_fds[2];
+
+/* Sleeps 100 ms of virtual time, then sends one byte on the socket pair. */
+static void* late_sender(void* arg) {
+  (void)arg;
+  usleep(100000);
+  send(socket_fds[1], "s", 1, 0);
+  return NULL;
+}
+
+static void recv_own_socket(void) {
+  char c = 0;
+  const ssize_t n = recv(socket_fds[0], &c, 1, 0);
+  printf("recv returned %zd (errno %d) at %ld ms\n", n, n < 0 ? errno : 0, now_ms());
+}
+
 static void read_own_pipe(void) {
   char c = 0;
   const ssize_t n = read(pipe_fds[0], &c, 1);
@@ -213,6 +230,9 @@ int main(int argc, char** argv) {
     char c;
     struct iovec v = {&c, 1};
     readv(pipe_fds[0], &v, 1);
+  } else if (strcmp(mode, "socketpair-recv") == 0) {
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds); /* nobody else holds it */
+    recv_own_socket();
   } else if (strcmp(mode, "pipe-read-threads") == 0) {
     /* Two threads read the same pipe; the main thread joins the first. */
     pipe(pipe_fds);
@@ -291,6 +311,23 @@ int main(int argc, char** argv) {
     read_own_pipe();
     printf("at %ld ms\n", now_ms());
     pthread_join(t, NULL);
+  } else if (strcmp(mode, "socketpair-recv-thread") == 0) {
+    /* Its own socket pair, sent on by another thread after a virtual sleep. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    pthread_t t;
+    pthread_create(&t, NULL, late_sender, NULL);
+    recv_own_socket();
+    pthread_join(t, NULL);
+  } else if (strcmp(mode, "socketpair-recv-child") == 0) {
+    /* Its own socket pair, sent on by a child in real time. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    if (fork() == 0) {
+      real_sleep_ms(300);
+      send(socket_fds[1], "c", 1, 0);
+      _exit(0);
+    }
+    recv_own_socket();
+    wait(NULL);
   } else if (strcmp(mode, "pipe-read-child") == 0) {
     /* Its own pipe, written by a child in real time. */
     pipe(pipe_fds);
