@@ -418,6 +418,38 @@ TEST_F(RunCommand, AParentWaitingForAChildThatReadsAPipeOnlyTheParentCouldWriteI
   EXPECT_EQ(r.out, "mode child-fed\nread returned 1 (errno 0)\nchild exited 0\ndone\n") << r.err;
 }
 
+TEST_F(RunCommand, APythonParentWaitingForACatWhoseInputItNeverClosesIsADeadlockAndCommunicateIsNot) {
+  // Popen.wait() with the child's stdin still open: the parent waits for cat, cat for its input.
+  RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+                    python("import subprocess\n"
+                           "subprocess.Popen(['cat'], stdin=subprocess.PIPE, stdout=subprocess.PIPE).wait()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" (cat): thread "), std::string::npos) << r.err;
+  // communicate() feeds it and closes its input; a child that takes real time is waited for.
+  r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+          python("import subprocess\n"
+                 "out, _ = subprocess.Popen(['cat'], stdin=subprocess.PIPE, stdout=subprocess.PIPE).communicate(b'fed')\n"
+                 "print(out.decode())\n"
+                 "r = subprocess.run(['sh', '-c', 'sleep 0.2; echo slow'], capture_output=True)\n"
+                 "print(r.stdout.decode().strip(), r.returncode)\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "fed\nslow 0\n") << r.err;
+}
+
+TEST_F(RunCommand, APythonAbbaDeadlockOfTwoLocksIsADeadlockNamingEachThreadsWait) {
+  const RunResult r = run({"--chain", "chips=L6470", "--wall-timeout", "30"},
+                          python("import threading\n"
+                                 "a, b = threading.Lock(), threading.Lock()\n"
+                                 "ea, eb = threading.Event(), threading.Event()\n"
+                                 "def one():\n    with a:\n        ea.set(); eb.wait()\n        with b: pass\n"
+                                 "def two():\n    with b:\n        eb.set(); ea.wait()\n        with a: pass\n"
+                                 "t1 = threading.Thread(target=one); t2 = threading.Thread(target=two)\n"
+                                 "t1.start(); t2.start(); t1.join()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_EQ(occurrences(r.err, "sem_wait() on the object at 0x"), 3u) << r.err;  // (CPython's locks are semaphores)
+}
+
 TEST_F(RunCommand, AShellPipelineWhoseWriterEndsWhileItsReaderWaitsIsNoDeadlock) {
   // The writer's last close races the reader's look at who holds the pipe: end of file, never a
   // deadlock. Several times, for the race's sake.
