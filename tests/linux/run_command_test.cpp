@@ -281,6 +281,19 @@ TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClo
   }
 }
 
+TEST_F(RunCommand, InVirtualTimeACallTheLibraryDoesNotCoverIsEndedByTheGuardWhichSaysWhatEachThreadWasBlockedIn) {
+  // sigwait() is no covered call: the thread counts as running, virtual time cannot judge it.
+  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
+                          python("import signal\nsignal.sigwait([signal.SIGUSR1])\n"));
+  EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+  EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(the kernel's view, from /proc"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" (python3) thread "), std::string::npos) << r.err;
+#if defined(__x86_64__)
+  EXPECT_NE(r.err.find(": rt_sigtimedwait()"), std::string::npos) << r.err;
+#endif
+}
+
 TEST_F(RunCommand, InVirtualTimeAPauseOrAPollOfItsOwnPipeNothingCanEndIsADeadlockNamingTheCall) {
   for (const auto& [program, call] : std::vector<std::pair<std::string, std::string>>{
            {"import signal\nsignal.pause()\n", "pause()"},
