@@ -118,6 +118,8 @@ int lock_program_mutex(VirtualHostTime& vt, pthread_mutex_t* m) {
   return lock_in_virtual_time(vt, m);
 }
 
+void mutex_waiters_after_fork_child() { g_mutex_waiters.store(0, std::memory_order_relaxed); }
+
 void program_mutex_unlocked(pthread_mutex_t* m) {
   // No fence between the unlock and this load: a waiter that registered just now and is not
   // seen here is not lost for virtual time (its trylock, `ready`, runs before any jump), only

@@ -408,6 +408,7 @@ void VirtualHostTime::after_fork_parent() {
 }
 
 void VirtualHostTime::after_fork_child() {
+  mutex_waiters_after_fork_child();
   timerfd_table_after_fork();
   thread_table_after_fork();
   scheduler_.after_fork_child();

@@ -182,6 +182,8 @@ void timerfd_table_after_snapshot();
 int lock_program_mutex(VirtualHostTime& vt, pthread_mutex_t* m);
 /// intercept_mutex.cpp: a program's mutex `m` was unlocked: its first covered waiter tries again.
 void program_mutex_unlocked(pthread_mutex_t* m);
+/// intercept_mutex.cpp: fork()'s child has one thread, which waits on no mutex.
+void mutex_waiters_after_fork_child();
 /// intercept_poll.cpp: whether descriptor `fd` is an emulated gpio line with edge events.
 bool is_emulated_line(int fd);
 
