@@ -26,6 +26,9 @@ std::string format_process_waits(const ProcessWaits& waits) {
     switch (d.kind) {
       case WaitDependency::Kind::child: out += "child " + std::to_string(d.pid) + "\n"; break;
       case WaitDependency::Kind::pipe: out += "pipe " + std::to_string(d.inode) + " " + std::to_string(d.fd) + "\n"; break;
+      case WaitDependency::Kind::socket:
+        out += "socket " + std::to_string(d.inode) + " " + std::to_string(d.peer) + " " + std::to_string(d.fd) + "\n";
+        break;
       case WaitDependency::Kind::other: out += "other\n"; break;
     }
   }
@@ -61,6 +64,13 @@ std::optional<ProcessWaits> parse_process_waits(std::string_view text) {
       line.remove_prefix(5);
       d.kind = WaitDependency::Kind::pipe;
       if (!take_number(line, d.inode) || !take_number(line, d.fd) || !line.empty() || d.fd < 0) return std::nullopt;
+      w.dependencies.push_back(d);
+    } else if (line.starts_with("socket ")) {
+      line.remove_prefix(7);
+      d.kind = WaitDependency::Kind::socket;
+      if (!take_number(line, d.inode) || !take_number(line, d.peer) || !take_number(line, d.fd) || !line.empty() ||
+          d.fd < 0)
+        return std::nullopt;
       w.dependencies.push_back(d);
     } else {
       return std::nullopt;

@@ -23,11 +23,13 @@ struct WaitDependency {
   enum class Kind : unsigned char {
     child,  ///< a child process (`pid`) a thread waits for (waitpid and its kin)
     pipe,   ///< a pipe (`inode`) other processes hold, waited on through descriptor `fd`
+    socket, ///< a connected AF_UNIX socket (`inode`, its peer `peer`) other processes hold
     other,  ///< anything else (a socket, a process-shared semaphore, a FIFO): never a deadlock
   };
   Kind kind = Kind::other;
   pid_t pid = 0;
   unsigned long inode = 0;
+  unsigned long peer = 0;
   int fd = -1;
   bool operator==(const WaitDependency&) const = default;
 };
@@ -39,8 +41,8 @@ struct ProcessWaits {
   bool operator==(const ProcessWaits&) const = default;
 };
 
-/// The file's text: one line per dependency ("child 123", "pipe 4567 5", "other"), then one
-/// "| "-prefixed line per thread.
+/// The file's text: one line per dependency ("child 123", "pipe 4567 5", "socket 4568 4569 6",
+/// "other"), then one "| "-prefixed line per thread.
 std::string format_process_waits(const ProcessWaits& waits);
 /// The file's text back; nullopt when a line is not one format_process_waits writes.
 std::optional<ProcessWaits> parse_process_waits(std::string_view text);

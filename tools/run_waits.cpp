@@ -16,6 +16,7 @@
 #include <set>
 
 #include "linux/process_waits.hpp"
+#include "linux/unix_socket_diag.hpp"
 
 namespace l6470emu {
 namespace {
@@ -82,9 +83,9 @@ std::set<pid_t> live_descendants(const std::map<pid_t, ProcessInfo>& all, pid_t 
   return out;
 }
 
-// The processes holding pipe `inode` (their /proc/PID/fd links), as lsof finds them.
-std::set<pid_t> pipe_holders(const std::map<pid_t, ProcessInfo>& all, unsigned long inode) {
-  const std::string target = "pipe:[" + std::to_string(inode) + "]";
+// The processes holding `target` ("pipe:[123]", "socket:[124]": their /proc/PID/fd links), as
+// lsof finds them.
+std::set<pid_t> holders(const std::map<pid_t, ProcessInfo>& all, const std::string& target) {
   std::set<pid_t> out;
   for (const auto& [pid, info] : all) {
     const std::string dir = "/proc/" + std::to_string(pid) + "/fd";
@@ -175,8 +176,21 @@ CrossProcessDeadlock RunWaits::look() const {
           break;
         case WaitDependency::Kind::pipe: {
           if (!pipe_would_block(p, d.fd, d.inode)) return {};
-          for (const pid_t holder : pipe_holders(all, d.inode))
+          for (const pid_t holder : holders(all, "pipe:[" + std::to_string(d.inode) + "]"))
             if (!run.count(holder)) return {};  // another process (or this one, run) may write it
+          break;
+        }
+        case WaitDependency::Kind::socket: {
+          // Still connected to the same peer, nothing queued, and both ends held only by the run
+          // (the peer held by someone: else its reader gets end of file).
+          const UnixSocketInfo info = unix_socket_info(d.inode);
+          if (!info.known || info.peer != d.peer || info.receive_queue != 0) return {};
+          const std::set<pid_t> own = holders(all, "socket:[" + std::to_string(d.inode) + "]");
+          const std::set<pid_t> peer = holders(all, "socket:[" + std::to_string(d.peer) + "]");
+          if (!own.count(p) || peer.empty()) return {};
+          for (const std::set<pid_t>* side : {&own, &peer})
+            for (const pid_t holder : *side)
+              if (!run.count(holder)) return {};
           break;
         }
       }

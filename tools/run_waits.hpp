@@ -2,8 +2,9 @@
 // preload publishes, while every thread of it waits and only another process could end a wait,
 // what it waits on (linux/process_waits.hpp) in a directory run makes. When every live process of
 // the run has done so, and each one's waits depend only on the others (a child that waits too, a
-// pipe only they hold, empty and with writers left), nothing can ever end any of them: a parent
-// in waitpid() of a child that reads a pipe only the parent could write. Linux only (/proc).
+// pipe or a Unix socket pair only they hold, empty and with writers left), nothing can ever end
+// any of them: a parent in waitpid() of a child that reads a pipe only the parent could write.
+// Linux only (/proc, sock_diag).
 #pragma once
 
 #include <sys/types.h>
@@ -38,8 +39,9 @@ class RunWaits {
 
   /// Looks once: whether every live descendant of this process (zombies aside) published its
   /// waits and each depends only on the others: a child among them, a pipe that only they hold
-  /// and that is neither readable nor without writers as its waiter sees it; anything else (a
-  /// socket, a process-shared object, a process that published nothing) is no deadlock.
+  /// and that is neither readable nor without writers as its waiter sees it, a Unix socket pair
+  /// both of whose ends only they hold, with nothing queued; anything else (another socket, a
+  /// process-shared object, a process that published nothing) is no deadlock.
   CrossProcessDeadlock look() const;
   /// The thread lines each process has published now, by pid (for the wall-clock guard's words).
   std::map<pid_t, std::vector<std::string>> said() const;

@@ -6,11 +6,6 @@
 
 #include <dirent.h>
 #include <fcntl.h>
-#include <linux/netlink.h>
-#include <linux/rtnetlink.h>
-#include <linux/sock_diag.h>
-#include <linux/unix_diag.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,6 +17,7 @@
 #include <vector>
 
 #include "linux/preload/real.hpp"
+#include "linux/unix_socket_diag.hpp"
 
 namespace l6470emu::preload {
 
@@ -91,44 +87,6 @@ bool held_by_this_process_alone(const std::vector<std::string>& targets) {
   return alone;
 }
 
-// The inode of the peer of AF_UNIX socket `inode`, as sock_diag says it (0: none, or unknown).
-unsigned long unix_peer(unsigned long inode) {
-  const int s = socket(AF_NETLINK, SOCK_DGRAM | SOCK_CLOEXEC, NETLINK_SOCK_DIAG);
-  if (s < 0) return 0;
-  struct {
-    nlmsghdr header;
-    unix_diag_req request;
-  } ask{};
-  ask.header.nlmsg_len = sizeof ask;
-  ask.header.nlmsg_type = SOCK_DIAG_BY_FAMILY;
-  ask.header.nlmsg_flags = NLM_F_REQUEST;
-  ask.request.sdiag_family = AF_UNIX;
-  ask.request.udiag_states = ~0u;
-  ask.request.udiag_ino = static_cast<unsigned>(inode);
-  ask.request.udiag_show = UDIAG_SHOW_PEER;
-  ask.request.udiag_cookie[0] = ask.request.udiag_cookie[1] = ~0u;  // INET_DIAG_NOCOOKIE: any
-  sockaddr_nl kernel{};
-  kernel.nl_family = AF_NETLINK;
-  unsigned long peer = 0;
-  alignas(nlmsghdr) char reply[8192];
-  if (sendto(s, &ask, sizeof ask, 0, reinterpret_cast<sockaddr*>(&kernel), sizeof kernel) == sizeof ask) {
-    const ssize_t n = real::recv(s, reply, sizeof reply, 0);
-    const auto* h = reinterpret_cast<const nlmsghdr*>(reply);
-    if (n > 0 && NLMSG_OK(h, static_cast<unsigned>(n)) && h->nlmsg_type == SOCK_DIAG_BY_FAMILY) {
-      const auto* m = static_cast<const unix_diag_msg*>(NLMSG_DATA(h));
-      int len = static_cast<int>(h->nlmsg_len - NLMSG_LENGTH(sizeof *m));
-      for (auto* a = reinterpret_cast<const rtattr*>(m + 1); RTA_OK(a, len); a = RTA_NEXT(a, len))
-        if (a->rta_type == UNIX_DIAG_PEER && RTA_PAYLOAD(a) >= sizeof(std::uint32_t)) {
-          std::uint32_t p = 0;
-          std::memcpy(&p, RTA_DATA(a), sizeof p);
-          peer = p;
-        }
-    }
-  }
-  real::close(s);
-  return peer;
-}
-
 }  // namespace
 
 bool pipe_held_by_this_process_alone(int fd) {
@@ -140,7 +98,7 @@ bool pipe_held_by_this_process_alone(int fd) {
 bool socket_pair_held_by_this_process_alone(int fd) {
   const std::string target = link_of("/proc/self/fd/" + std::to_string(fd));
   if (target.rfind("socket:[", 0) != 0) return false;
-  const unsigned long peer = unix_peer(std::strtoul(target.c_str() + 8, nullptr, 10));
+  const unsigned long peer = unix_socket_info(std::strtoul(target.c_str() + 8, nullptr, 10)).peer;
   if (peer == 0) return false;
   return held_by_this_process_alone({target, "socket:[" + std::to_string(peer) + "]"});
 }

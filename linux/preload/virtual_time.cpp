@@ -23,6 +23,7 @@
 #include "linux/log.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/process_waits.hpp"
+#include "linux/unix_socket_diag.hpp"
 
 namespace l6470emu::preload {
 
@@ -128,6 +129,14 @@ WaitDependency dependency_of(int fd) {
     d.kind = WaitDependency::Kind::pipe;
     d.inode = std::strtoul(link.c_str() + 6, nullptr, 10);
     d.fd = fd;
+  } else if (link.rfind("socket:[", 0) == 0) {
+    const unsigned long inode = std::strtoul(link.c_str() + 8, nullptr, 10);
+    if (const UnixSocketInfo info = unix_socket_info(inode); info.known && info.peer != 0) {
+      d.kind = WaitDependency::Kind::socket;
+      d.inode = inode;
+      d.peer = info.peer;
+      d.fd = fd;
+    }
   } else if (const pid_t child = pidfd_child(fd); child > 0) {
     d.kind = WaitDependency::Kind::child;
     d.pid = child;

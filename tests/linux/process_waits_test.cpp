@@ -16,11 +16,16 @@ TEST(ProcessWaits, EveryKindOfDependencyAndTheThreadLinesComeBackAsTheyWere) {
   pipe.kind = WaitDependency::Kind::pipe;
   pipe.inode = 11227923;
   pipe.fd = 8;
-  w.dependencies = {child, pipe, WaitDependency{}};
+  WaitDependency socket;
+  socket.kind = WaitDependency::Kind::socket;
+  socket.inode = 300;
+  socket.peer = 301;
+  socket.fd = 4;
+  w.dependencies = {child, pipe, socket, WaitDependency{}};
   w.threads = {"thread 12 (cat): read() on fd 8, no timeout", "thread 13 (cat): waitpid() on fd 11 (child 4242), no timeout"};
   const std::string text = format_process_waits(w);
   EXPECT_EQ(text,
-            "child 4242\npipe 11227923 8\nother\n"
+            "child 4242\npipe 11227923 8\nsocket 300 301 4\nother\n"
             "| thread 12 (cat): read() on fd 8, no timeout\n"
             "| thread 13 (cat): waitpid() on fd 11 (child 4242), no timeout\n");
   EXPECT_EQ(parse_process_waits(text), w);
@@ -42,6 +47,7 @@ TEST(ProcessWaits, AFileCutShortOrWithAnUnknownLineIsRefused) {
   EXPECT_FALSE(parse_process_waits("child 12x\n"));
   EXPECT_FALSE(parse_process_waits("pipe 5\n"));
   EXPECT_FALSE(parse_process_waits("socket 5 3\n"));
+  EXPECT_FALSE(parse_process_waits("fifo 5 3\n"));
   EXPECT_TRUE(parse_process_waits(""));  // nothing waited on: an empty list
 }
 

@@ -429,6 +429,14 @@ TEST_F(RunCommand, AParentWaitingForAChildThatReadsAPipeOnlyTheParentCouldWriteI
   r = run_client("child-fed", {"--timeout", "5s"});
   EXPECT_EQ(r.status, kRunPassed) << r.err;
   EXPECT_EQ(r.out, "mode child-fed\nread returned 1 (errno 0)\nchild exited 0\ndone\n") << r.err;
+  // A socket pair the same way.
+  r = run_client("child-socketpair-hung", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): recv() on fd "), std::string::npos) << r.err;
+  r = run_client("child-socketpair-fed", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode child-socketpair-fed\nrecv returned 1 (errno 0) at 0 ms\nchild exited 0\ndone\n") << r.err;
 }
 
 TEST_F(RunCommand, APythonParentWaitingForACatWhoseInputItNeverClosesIsADeadlockAndCommunicateIsNot) {
@@ -448,6 +456,22 @@ TEST_F(RunCommand, APythonParentWaitingForACatWhoseInputItNeverClosesIsADeadlock
                  "print(r.stdout.decode().strip(), r.returncode)\n"));
   EXPECT_EQ(r.status, kRunPassed) << r.err;
   EXPECT_EQ(r.out, "fed\nslow 0\n") << r.err;
+}
+
+TEST_F(RunCommand, APythonProcessJoiningAChildThatWaitsOnAMultiprocessingPipeNobodySendsOnIsADeadlock) {
+  const std::string start = "import multiprocessing as mp\n"
+                            "def child(conn):\n    print('child got', conn.recv(), flush=True)\n"
+                            "mp.set_start_method('fork')\n"
+                            "a, b = mp.Pipe()\np = mp.Process(target=child, args=(b,))\np.start()\n";
+  RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"}, python(start + "p.join()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): waitpid() on fd "), std::string::npos) << r.err;
+  // Sent on after a second of the parent's time: the child gets it, the join returns.
+  r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+          python(start + "time.sleep(1); a.send('hello'); p.join(); print('exit', p.exitcode)\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "child got hello\nexit 0\n") << r.err;
 }
 
 TEST_F(RunCommand, APythonAbbaDeadlockOfTwoLocksIsADeadlockNamingEachThreadsWait) {

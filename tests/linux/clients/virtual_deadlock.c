@@ -269,6 +269,15 @@ int main(int argc, char** argv) {
       _exit(0);
     }
     waitpid(child, NULL, 0);
+  } else if (strcmp(mode, "child-socketpair-hung") == 0) {
+    /* The child waits on a socket pair only the parent could send on; the parent waits for it. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      recv_own_socket();
+      _exit(0);
+    }
+    waitpid(child, NULL, 0);
   } else if (strcmp(mode, "outside-thread") == 0) {
     /* A thread in a pipe read (not covered) holds off the verdict until a child writes to the
        pipe in real time; then only the main thread's poll of the idle line is left. */
@@ -386,6 +395,19 @@ int main(int argc, char** argv) {
     }
     usleep(100000);
     write(pipe_fds[1], "z", 1);
+    int status = 0;
+    waitpid(child, &status, 0);
+    printf("child exited %d\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+  } else if (strcmp(mode, "child-socketpair-fed") == 0) {
+    /* The same, the parent sending after 100 ms of its virtual time. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      recv_own_socket();
+      _exit(0);
+    }
+    usleep(100000);
+    send(socket_fds[1], "p", 1, 0);
     int status = 0;
     waitpid(child, &status, 0);
     printf("child exited %d\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
