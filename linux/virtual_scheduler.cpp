@@ -253,6 +253,7 @@ void VirtualScheduler::wait_in(const Wait& w, const std::function<void()>& block
 }
 
 void VirtualScheduler::end_locked(Waiter& w, End how) {
+  running_again_locked();
   w.end = how;
   w.done.store(true, std::memory_order_release);
   ++running_;
@@ -313,8 +314,14 @@ void VirtualScheduler::decide_locked(bool forced) {
     if (d == kNever) {
       // Every thread waits for something outside the process, or for nothing that can come
       // (the time limit aside: it ends a run that goes on, not one that cannot).
-      if (!forced && running_ == 0) check_deadlock_locked();
-      if (limit == kNever) return;
+      const bool outside = waits_outside_locked();
+      // Looked at again after that (slow) look at who holds what: a pipe's last other holder may
+      // have closed it meanwhile, which ends its reader's wait rather than making it a deadlock.
+      if (wake_ready_locked()) return;
+      if (!forced && running_ == 0) check_deadlock_locked(outside);
+      // Another process (a child, a pipe's writer) or an armed real timer goes on in real time
+      // meanwhile: the program's time does not run on to the limit without it.
+      if (limit == kNever || outside || (hooks_.outside_wakeup && !hooks_.outside_wakeup().empty())) return;
     }
     d = std::min(d, limit);
     d = std::max(d, hooks_.now());
@@ -340,21 +347,32 @@ void VirtualScheduler::decide_locked(bool forced) {
   redecide_ = true;  // so many jumps woke nobody: the waiters take the decision up again shortly
 }
 
-void VirtualScheduler::check_deadlock_locked() {
-  if (!hooks_.deadlock || running_ > 0) return;
-  bool any = false;
+void VirtualScheduler::running_again_locked() {
+  if (!stuck_said_) return;
+  stuck_said_ = false;
+  if (hooks_.unstuck) hooks_.unstuck();
+}
+
+bool VirtualScheduler::waits_outside_locked() const {
   for (const Waiter* w : waiters_) {
     if (w->done.load(std::memory_order_relaxed)) continue;
-    any = true;
-    if (w->w->outside) return;  // another process may post or signal
+    if (w->w->outside) return true;  // another process may post or signal
     for (const pollfd& p : w->w->fds)
-      if (!hooks_.inside_fd || !hooks_.inside_fd(p.fd)) return;  // another process may write to it
+      if (!hooks_.inside_fd || !hooks_.inside_fd(p.fd)) return true;  // another process may write to it
   }
+  return false;
+}
+
+void VirtualScheduler::check_deadlock_locked(bool outside) {
+  if (!hooks_.deadlock || running_ > 0) return;
+  const bool any = std::any_of(waiters_.begin(), waiters_.end(),
+                               [](const Waiter* w) { return !w->done.load(std::memory_order_relaxed); });
   if (!any) return;
+  if (outside && !hooks_.stuck) return;
   if (hooks_.outside_wakeup) {
     const std::string why = hooks_.outside_wakeup();
     if (!why.empty()) {
-      if (!outside_logged_ && hooks_.log) {
+      if (!outside && !outside_logged_ && hooks_.log) {
         outside_logged_ = true;
         hooks_.log("virtual time: every thread waits and nothing in the process can wake them, but " + why +
                    ": waiting for its signal in real time");
@@ -362,7 +380,19 @@ void VirtualScheduler::check_deadlock_locked() {
       return;
     }
   }
-  hooks_.deadlock(deadlock_report_locked());
+  if (!outside) return hooks_.deadlock(deadlock_report_locked());
+  // Only another process can end a wait: say so, for a run to see whether every process waits
+  // on another (a deadlock across them).
+  std::vector<int> fds;
+  bool other = false;
+  for (const Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed)) continue;
+    other = other || w->w->outside;
+    for (const pollfd& p : w->w->fds)
+      if (!hooks_.inside_fd || !hooks_.inside_fd(p.fd)) fds.push_back(p.fd);
+  }
+  stuck_said_ = true;
+  hooks_.stuck(fds, other, thread_lines_locked());
 }
 
 std::string VirtualScheduler::deadlock_report_locked() const {
@@ -370,31 +400,7 @@ std::string VirtualScheduler::deadlock_report_locked() const {
   std::string r = "virtual time: deadlock at t=" + seconds_of(now) +
                   " s: every thread waits and nothing can wake any of them (no timeout, timer or line edge to come); "
                   "the run ends with exit status " + std::to_string(kDeadlockExitStatus);
-  for (const Waiter* w : waiters_) {
-    if (w->done.load(std::memory_order_relaxed)) continue;
-    const Wait& wait = *w->w;
-    const std::string name = thread_name(w->tid);
-    r += "\n  thread " + std::to_string(w->tid) + (name.empty() ? "" : " (" + name + ")") + ": " +
-         (wait.call == nullptr ? std::string("a covered wait")
-          : std::string_view(wait.call).find(' ') != std::string_view::npos ? std::string(wait.call)
-                                                                           : std::string(wait.call) + "()");
-    for (std::size_t i = 0; i < wait.fds.size(); ++i)
-      r += (i == 0 ? " on " : ", ") + (hooks_.describe_fd ? hooks_.describe_fd(wait.fds[i].fd)
-                                                           : "fd " + std::to_string(wait.fds[i].fd));
-    if (const pid_t joined = wait.joined_tid ? wait.joined_tid->load(std::memory_order_acquire) : 0; joined != 0) {
-      const std::string name_of_joined = thread_name(joined);
-      r += " of thread " + std::to_string(joined) + (name_of_joined.empty() ? "" : " (" + name_of_joined + ")");
-    } else if (wait.fds.empty() && wait.object != nullptr) {
-      char obj[32];
-      std::snprintf(obj, sizeof obj, "%p", wait.object);
-      r += std::string(" on the object at ") + obj;
-    }
-    if (wait.deadline != kNever)
-      r += ", until t=" + seconds_of(wait.deadline) + " s";  // (not reached: a jump would have come first)
-    else
-      r += wait.timeout_beyond_end ? ", its timeout past the last time the clocks can show (it never ends)"
-                                   : ", no timeout";
-  }
+  for (const std::string& line : thread_lines_locked()) r += "\n  " + line;
   if (hooks_.describe_board) {
     const std::string board = hooks_.describe_board();
     std::size_t at = 0;
@@ -406,6 +412,39 @@ std::string VirtualScheduler::deadlock_report_locked() const {
     }
   }
   return r;
+}
+
+std::vector<std::string> VirtualScheduler::thread_lines_locked() const {
+  std::vector<std::string> lines;
+  for (const Waiter* w : waiters_) {
+    if (w->done.load(std::memory_order_relaxed)) continue;
+    const Wait& wait = *w->w;
+    const std::string name = thread_name(w->tid);
+    std::string r = "thread " + std::to_string(w->tid) + (name.empty() ? "" : " (" + name + ")") + ": " +
+         (wait.call == nullptr ? std::string("a covered wait")
+          : std::string_view(wait.call).find(' ') != std::string_view::npos ? std::string(wait.call)
+                                                                           : std::string(wait.call) + "()");
+    for (std::size_t i = 0; i < wait.fds.size(); ++i)
+      r += (i == 0 ? " on " : ", ") + (hooks_.describe_fd ? hooks_.describe_fd(wait.fds[i].fd)
+                                                           : "fd " + std::to_string(wait.fds[i].fd));
+    if (const pid_t joined = wait.joined_tid ? wait.joined_tid->load(std::memory_order_acquire) : 0; joined != 0) {
+      const std::string name_of_joined = thread_name(joined);
+      r += " of thread " + std::to_string(joined) + (name_of_joined.empty() ? "" : " (" + name_of_joined + ")");
+    } else if (wait.describe) {
+      r += " " + wait.describe();
+    } else if (wait.fds.empty() && wait.object != nullptr) {
+      char obj[32];
+      std::snprintf(obj, sizeof obj, "%p", wait.object);
+      r += std::string(" on the object at ") + obj;
+    }
+    if (wait.deadline != kNever)
+      r += ", until t=" + seconds_of(wait.deadline) + " s";  // (not reached: a jump would have come first)
+    else
+      r += wait.timeout_beyond_end ? ", its timeout past the last time the clocks can show (it never ends)"
+                                   : ", no timeout";
+    lines.push_back(std::move(r));
+  }
+  return lines;
 }
 
 int VirtualScheduler::notify(const void* object, bool all) {
@@ -437,6 +476,7 @@ bool VirtualScheduler::grant(const void* object) { return notify(object, false) 
 
 void VirtualScheduler::thread_started() {
   Locked lock(m_);
+  running_again_locked();
   ++running_;
   touch();
 }
@@ -497,6 +537,7 @@ void VirtualScheduler::after_fork_child() {
   // the parent's thread, so this thread gets its own.
   waiters_.clear();
   running_ = 1;
+  stuck_said_ = false;  // (the parent's word, not this process's)
   t_wake.renew();
   t_holds_lock = false;
   m_.unlock();

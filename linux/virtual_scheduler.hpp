@@ -61,7 +61,8 @@ class VirtualScheduler {
     std::function<Tick()> next_world;
     /// The run's time limit (kNever: none): the clocks jump there when every thread waits for
     /// it alone, but only once the waits were found to be no deadlock (a thread that nothing but
-    /// the limit can wake is deadlocked, limit or not).
+    /// the limit can wake is deadlocked, limit or not), and not while a thread waits on another
+    /// process (a child, a pipe's writer) or an armed real timer, which go on in real time meanwhile.
     std::function<Tick()> time_limit;
     std::function<void(int)> fire_timer;     ///< a timer set with set_timer() expired
     std::function<std::int64_t()> real_ns;   ///< the real monotonic clock, ns (idle grace)
@@ -78,6 +79,15 @@ class VirtualScheduler {
     /// A deadlock was found (the scheduler's lock is held): `report` says what each thread waits
     /// on. Expected to end the process; if it returns, the threads simply go on waiting.
     std::function<void(const std::string& report)> deadlock;
+    /// Every thread waits, nothing in the process can wake any of them and no real timer is
+    /// armed, but another process could (the scheduler's lock is held): `outside_fds` are the
+    /// descriptors waited on that only another process can make ready, `other` says a wait
+    /// depends on another process some other way (a process-shared object, a child without a
+    /// pidfd), `threads` each thread's wait in words. A whole run can then be seen deadlocked
+    /// across its processes (linux/process_waits.hpp). Unset: nothing is said.
+    std::function<void(const std::vector<int>& outside_fds, bool other, const std::vector<std::string>& threads)> stuck;
+    /// A wait ended (or a thread started) after `stuck` was called: the process runs again.
+    std::function<void()> unstuck;
   };
 
   /// How a wait ends.
@@ -102,6 +112,9 @@ class VirtualScheduler {
     bool watches_board = false;             ///< fds include lines with edge events: the next edge is a wake-up
     const void* object = nullptr;           ///< notify(object) / grant(object) ends the wait
     const std::atomic<pid_t>* joined_tid = nullptr;  ///< pthread_join: the joined thread's id, once it runs (report)
+    /// What the wait is on, in words for the deadlock report ("on the mutex at 0x..., held by
+    /// thread 12"), instead of "on the object at 0x..."; called with the scheduler's lock held.
+    std::function<std::string()> describe;
     const sigset_t* sigmask = nullptr;      ///< signal mask while blocked (ppoll, pselect, epoll_pwait)
     bool interruptible = true;              ///< a signal handler ends the wait (else it goes on)
     /// Checked under the scheduler's lock before registering: true ends the wait at once (ready).
@@ -172,8 +185,11 @@ class VirtualScheduler {
   End block(Waiter& me);
   void leave_wait(Waiter& me);
   void decide_locked(bool forced);
-  void check_deadlock_locked();
+  void check_deadlock_locked(bool outside);
+  bool waits_outside_locked() const;
   std::string deadlock_report_locked() const;
+  std::vector<std::string> thread_lines_locked() const;
+  void running_again_locked();
   bool wake_ready_locked();
   void end_locked(Waiter& w, End how);
   void remove_locked(Waiter& w);
@@ -192,6 +208,7 @@ class VirtualScheduler {
   // A decision stopped after kMaxEmptyJumps jumps that woke nobody: a waiter takes it up again.
   bool redecide_ = false;
   bool outside_logged_ = false;
+  bool stuck_said_ = false;  // Hooks::stuck was called and no wait has ended since
 };
 
 }  // namespace l6470emu

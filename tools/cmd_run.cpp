@@ -32,6 +32,8 @@
 #include "linux/device_board.hpp"
 #include "tools/run_judgement.hpp"
 #include "tools/run_progress.hpp"
+#include "tools/run_blocked.hpp"
+#include "tools/run_waits.hpp"
 #include "tools/run_outcome.hpp"
 #include "board/run_report.hpp"
 #include "linux/scenario_file.hpp"
@@ -148,6 +150,9 @@ struct ProgramEnd {
   bool wall_guard = false;    // killed by that guard
   int stopped_by = 0;         // the signal run was stopped by and passed on to the program (0: none)
   RunProgressLine* progress = nullptr;  // the line drawn while it waits (a terminal only)
+  const RunWaits* waits = nullptr;      // the processes' published waits (a deadlock across them)
+  CrossProcessDeadlock deadlock;        // found there: run ended every process of the program
+  std::vector<std::string> blocked;     // what each thread was blocked in when the wall-clock guard ended it
   std::vector<RunReport> blocks;
 };
 
@@ -188,8 +193,10 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
 
 // Waits for the program. In wall time a limit in simulated seconds is limit / scale seconds of
 // real time, after which run kills it. In any time, the wall-clock guard (--wall-timeout) ends a
-// program that waits where virtual time cannot see it (pause(), a read on its own pipe, a lock no
-// thread releases) or simply runs too long. A SIGINT or SIGTERM to run is passed on to the
+// program that waits where virtual time cannot see it (a raw system call, sigwait(), a FIFO or
+// socket another process holds) or simply runs too long, and says what each thread was blocked in
+// (tools/run_blocked.hpp). Processes waiting on each other, each having said so (tools/run_waits.hpp),
+// are a deadlock it ends at once. A SIGINT or SIGTERM to run is passed on to the
 // program, which gets 5 s to end before SIGKILL; run then writes its reports with the program
 // marked as stopped. Once the program has ended, whatever it left running (its children and
 // their descendants, setsid() ones too: spawn_program made run their reaper) gets 2 s to end by
@@ -229,12 +236,20 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
   };
   Clock::time_point kill_at{};  // once a signal was passed on: when SIGKILL follows
   bool signalled = false;
+  // A deadlock across the processes: seen twice, kWaitsLook apart, the same both times (a wait
+  // that another process has just ended has had time to be withdrawn).
+  constexpr std::chrono::milliseconds kWaitsLook{100};
+  Clock::time_point next_look = start + kWaitsLook;
+  CrossProcessDeadlock seen;
   while (true) {
     const pid_t r = waitpid(run.pid, &run.wstatus, WNOHANG);
     if (r == run.pid || (r < 0 && errno != EINTR)) return;
     const auto now = Clock::now();
     if (limit_at && now >= *limit_at) return kill_now(run.wall_timeout);
-    if (now >= guard_at && !run.stopped_by) return kill_now(run.wall_guard);
+    if (now >= guard_at && !run.stopped_by) {
+      run.blocked = blocked_threads(run.waits ? run.waits->said() : std::map<pid_t, std::vector<std::string>>{});
+      return kill_now(run.wall_guard);
+    }
     if (const int sig = g_stop_signal.load(); sig && !run.stopped_by) {
       run.stopped_by = sig;
       kill(run.pid, sig);
@@ -246,6 +261,18 @@ void wait_for_program_itself(ProgramEnd& run, std::optional<Tick> timeout, const
       signalled = false;
     }
     if (run.progress) run.progress->update();
+    if (run.waits && now >= next_look && !run.stopped_by) {
+      next_look = now + kWaitsLook;
+      CrossProcessDeadlock found = run.waits->look();
+      if (found.found() && found == seen) {
+        for (const pid_t p : found.processes) kill(p, SIGKILL);
+        run.deadlock = std::move(found);
+        while (waitpid(run.pid, &run.wstatus, 0) < 0 && errno == EINTR) {
+        }
+        return;
+      }
+      seen = std::move(found);
+    }
     if (ended.fd >= 0) {
       pollfd p{ended.fd, POLLIN, 0};
       poll(&p, 1, 5);
@@ -284,6 +311,8 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   const std::unique_ptr<RunProgressLine> progress = RunProgressLine::on_terminal();
   if (progress) env.push_back(progress->environment_entry());
   run.progress = progress.get();
+  const std::unique_ptr<RunWaits> waits = RunWaits::make(report_path);
+  run.waits = waits.get();
   // SIGINT and SIGTERM interrupt the wait (no SA_RESTART) and are passed on to the program.
   struct sigaction stop {}, old_int {}, old_term {};
   stop.sa_handler = on_run_stop_signal;
@@ -294,6 +323,7 @@ int run_under_preload(const BoardConfig& config, const Scenario& scenario, std::
   if (started) {
     wait_for_program(run, timeout, config);
     run.progress = nullptr;
+    run.waits = nullptr;
     run.blocks = parse_run_reports(read_all(report_path));
   }
   sigaction(SIGINT, &old_int, nullptr);
@@ -575,6 +605,8 @@ std::optional<int> RunCommand::run() {
   program_exit.wall_guard = run.wall_guard;
   program_exit.wall_guard_limit = *wall_guard;
   program_exit.stopped_by = run.stopped_by;
+  program_exit.deadlock = std::move(run.deadlock.lines);
+  program_exit.blocked = std::move(run.blocked);
   program_exit.blocks = std::move(run.blocks);
   const RunJudgement verdict = judge_run(program_exit, timeout);
   const int status = verdict.status;

@@ -34,6 +34,7 @@ RunJudgement judge_run(const ProgramExit& run, std::optional<Tick> timeout) {
       cause_block = &b;
     }
   if (run.wall_timeout || run.wall_guard) cause = RunEnd::timeout;
+  if (!run.deadlock.empty()) cause = RunEnd::deadlock;
   // The processes that used the chips with a scenario bound are judged; else the program's own.
   std::vector<const RunReport*> judged;
   for (const RunReport& b : run.blocks)
@@ -58,16 +59,28 @@ RunJudgement judge_run(const ProgramExit& run, std::optional<Tick> timeout) {
     j.end_tick = std::max(j.end_tick, cause_block->tick);
     j.detail = cause_block->detail;
   }
+  if (run.wall_guard && !run.blocked.empty()) {
+    j.detail = {"what each thread was blocked in when the guard ended it (the kernel's view, from /proc, where a "
+                "process said nothing of its own waits):"};
+    for (const std::string& line : run.blocked) j.detail.push_back("  " + line);
+  }
+  if (!run.deadlock.empty()) {
+    j.detail = {"every process of the program waits on another of them, and none can end another's wait "
+                "(each said what it waits on; run ended them all):"};
+    for (const std::string& line : run.deadlock) j.detail.push_back("  " + line);
+  }
   if (run.wall_timeout && timeout) j.end_tick = std::max(j.end_tick, *timeout);  // killed: no report of its own
   j.exited = WIFEXITED(run.wstatus);
   j.code = j.exited ? WEXITSTATUS(run.wstatus) : -1;
   j.signal = WIFSIGNALED(run.wstatus) ? WTERMSIG(run.wstatus) : 0;
   if (run.wall_guard)
     j.ended = "was stopped by the wall-clock guard after " + seconds_text(run.wall_guard_limit) +
-              " of the host's time (--wall-timeout): it waited where virtual time cannot see (pause(), a read on its "
-              "own pipe, a lock no thread releases) or ran longer than that";
+              " of the host's time (--wall-timeout): it waited where virtual time cannot see (a raw system call, "
+              "sigwait(), a FIFO or socket another process holds) or ran longer than that";
   else if (cause == RunEnd::timeout)
     j.ended = "stopped at the simulated time limit " + seconds_text(timeout.value_or(j.end_tick));
+  else if (!run.deadlock.empty())
+    j.ended = "deadlocked in virtual time, its processes waiting on each other";
   else if (cause == RunEnd::deadlock)
     j.ended = "deadlocked in virtual time";
   else if (cause == RunEnd::sanitizer)

@@ -23,6 +23,12 @@ struct ProgramExit {
   bool wall_guard = false;        ///< killed by the wall-clock guard (--wall-timeout)
   Tick wall_guard_limit = 0;      ///< that guard, in ticks of host time (for the words)
   int stopped_by = 0;             ///< a signal to run passed on to the program (0: none)
+  /// Non-empty: run found every process of the program waiting on another (tools/run_waits.hpp)
+  /// and ended them; what each thread waited on, one a line.
+  std::vector<std::string> deadlock;
+  /// What each thread of the program's processes was blocked in when the wall-clock guard ended
+  /// it (tools/run_blocked.hpp), one a line.
+  std::vector<std::string> blocked;
   std::vector<RunReport> blocks;  ///< one per process that wrote one
 };
 

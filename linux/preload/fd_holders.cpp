@@ -8,12 +8,16 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "linux/preload/real.hpp"
+#include "linux/unix_socket_diag.hpp"
 
 namespace l6470emu::preload {
 
@@ -50,19 +54,37 @@ bool is_child_of(const char* pid, const std::string& self) {
   return std::sscanf(close_paren + 1, " %c %ld", &state, &ppid) == 2 && std::to_string(ppid) == self;
 }
 
-// Whether process `pid`'s descriptors include `target` ("pipe:[123]").
-bool holds(const char* pid, const std::string& target) {
+// Whether process `pid`'s descriptors include one of `targets` ("pipe:[123]").
+bool holds(const char* pid, const std::vector<std::string>& targets) {
   const std::string dir = std::string("/proc/") + pid + "/fd";
   DIR* d = real::opendir(dir.c_str());
   if (!d) return false;
   bool found = false;
   while (const dirent* e = real::readdir(d))
-    if (is_number(e->d_name) && link_of(dir + "/" + e->d_name) == target) {
-      found = true;
-      break;
+    if (is_number(e->d_name)) {
+      const std::string link = link_of(dir + "/" + e->d_name);
+      if (std::find(targets.begin(), targets.end(), link) != targets.end()) {
+        found = true;
+        break;
+      }
     }
   real::closedir(d);
   return found;
+}
+
+// Whether no other process holds any of `targets`, and this one has no child.
+bool held_by_this_process_alone(const std::vector<std::string>& targets) {
+  const std::string self = std::to_string(getpid());
+  DIR* d = real::opendir("/proc");
+  if (!d) return false;
+  bool alone = true;
+  while (const dirent* e = real::readdir(d))
+    if (is_number(e->d_name) && self != e->d_name && (holds(e->d_name, targets) || is_child_of(e->d_name, self))) {
+      alone = false;
+      break;
+    }
+  real::closedir(d);
+  return alone;
 }
 
 }  // namespace
@@ -70,17 +92,15 @@ bool holds(const char* pid, const std::string& target) {
 bool pipe_held_by_this_process_alone(int fd) {
   const std::string target = link_of("/proc/self/fd/" + std::to_string(fd));
   if (target.rfind("pipe:[", 0) != 0) return false;
-  const std::string self = std::to_string(getpid());
-  DIR* d = real::opendir("/proc");
-  if (!d) return false;
-  bool alone = true;
-  while (const dirent* e = real::readdir(d))
-    if (is_number(e->d_name) && self != e->d_name && (holds(e->d_name, target) || is_child_of(e->d_name, self))) {
-      alone = false;
-      break;
-    }
-  real::closedir(d);
-  return alone;
+  return held_by_this_process_alone({target});
+}
+
+bool socket_pair_held_by_this_process_alone(int fd) {
+  const std::string target = link_of("/proc/self/fd/" + std::to_string(fd));
+  if (target.rfind("socket:[", 0) != 0) return false;
+  const unsigned long peer = unix_socket_info(std::strtoul(target.c_str() + 8, nullptr, 10)).peer;
+  if (peer == 0) return false;
+  return held_by_this_process_alone({target, "socket:[" + std::to_string(peer) + "]"});
 }
 
 }  // namespace l6470emu::preload

@@ -1,5 +1,6 @@
 // Whether another process could still make a descriptor readable: the deadlock rule asks it of
-// every descriptor a waiter polls that the board does not own (docs/linux.md, Deadlocks).
+// every descriptor a waiter polls that the board does not own (docs/linux.md, Deadlocks): a pipe,
+// or a socket pair, that no other process holds.
 #pragma once
 
 #include <string>
@@ -15,5 +16,11 @@ std::string link_of(const std::string& path);
 /// takes a scan of every process: for a deadlock check, never on a hot path. Then nothing outside
 /// this process can make it readable.
 bool pipe_held_by_this_process_alone(int fd);
+
+/// Whether `fd` is a connected AF_UNIX socket (a socketpair() end) whose peer, and itself, no
+/// other process holds, in a process with no child: then nothing outside this process can send
+/// to it. The peer is the kernel's answer (sock_diag's UNIX_DIAG_PEER, as `ss -x` asks); false
+/// when it has none or the kernel cannot say. Reads /proc as pipe_held_by_this_process_alone.
+bool socket_pair_held_by_this_process_alone(int fd);
 
 }  // namespace l6470emu::preload

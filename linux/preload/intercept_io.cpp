@@ -1,7 +1,8 @@
 // Replaced C library functions that act on open descriptors: ioctl, read, __read_chk and
 // write. Emulated descriptors go to the backend with the kernel's argument handling
 // (user memory copied in and out, EFAULT, the VFS's own ioctls); others go to the C library
-// (but for virtual timerfds, whose reads intercept_timerfd.cpp answers).
+// (but for virtual timerfds, whose reads intercept_timerfd.cpp answers, and, in virtual time, a
+// read that would block, which first waits for data as a covered wait: descriptor_wait.hpp).
 #include <errno.h>
 #include <fcntl.h>
 #include <linux/gpio.h>
@@ -16,6 +17,7 @@
 #include <cstring>
 #include <vector>
 
+#include "linux/preload/descriptor_wait.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/user_memory.hpp"
@@ -231,10 +233,15 @@ __attribute__((visibility("default"))) int ioctl(int fd, unsigned long request, 
 __attribute__((visibility("default"))) ssize_t read(int fd, void* buf, size_t count) {
   FdEntry* e = fd_entry(fd);
   if (!e || inside()) {
-    if (!e && virtual_timerfds_exist() && !inside()) {
-      ssize_t r = 0;
-      if (as_cancellation_point([&]() __attribute__((noinline)) { return read_virtual_timerfd(fd, buf, count, &r); }))
-        return r;
+    if (VirtualHostTime* vt = e ? nullptr : virtual_time()) {
+      if (virtual_timerfds_exist()) {
+        ssize_t r = 0;
+        if (as_cancellation_point([&]() __attribute__((noinline)) { return read_virtual_timerfd(fd, buf, count, &r); }))
+          return r;
+      }
+      // A pipe, socket or terminal: its wait for data is a covered wait (descriptor_wait.hpp).
+      if (!readable_or_interrupted([&]() __attribute__((noinline)) { return covered_read_wait(*vt, fd, "read"); }))
+        return -1;
     }
     return real::read(fd, buf, count);
   }

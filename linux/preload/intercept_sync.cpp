@@ -1,6 +1,6 @@
 // pthread_create/join, condition variables and semaphores for virtual time: threads counted, waits
-// with virtual timeouts, signal/post handed to the first waiter. Not virtualised: mutexes, rwlocks,
-// objects shared with another process. Wall mode: the C library's.
+// with virtual timeouts, signal/post handed to the first waiter. Mutexes: intercept_mutex.cpp. Not
+// virtualised: rwlocks, objects shared with another process. Wall mode: the C library's.
 #include <errno.h>
 #include <pthread.h>
 #include <semaphore.h>
@@ -120,12 +120,13 @@ int cond_wait(VirtualHostTime& vt, pthread_cond_t* c, pthread_mutex_t* m, clocki
   w.after_register = [&] {
     unlock_error = pthread_mutex_unlock(m);
     unlocked = unlock_error == 0;
+    if (unlocked) program_mutex_unlocked(m);
     return unlocked;
   };
   const End end = vt.wait(w);
   if (unlock_error) return unlock_error;  // not the caller's mutex (error-checking types)
   if (unlocked) {
-    const int r = pthread_mutex_lock(m);
+    const int r = lock_program_mutex(vt, m);
     if (r != 0) return r;  // EOWNERDEAD of a robust mutex
   }
   return end == End::timed_out ? ETIMEDOUT : 0;

@@ -57,6 +57,10 @@ L6470EMU_REAL(int, fcntl, (int, int, ...))
 L6470EMU_REAL(int, ioctl, (int, unsigned long, ...))
 L6470EMU_REAL(ssize_t, read, (int, void*, size_t))
 L6470EMU_REAL(ssize_t, write, (int, const void*, size_t))
+L6470EMU_REAL(ssize_t, readv, (int, const struct iovec*, int))
+L6470EMU_REAL(ssize_t, recv, (int, void*, size_t, int))
+L6470EMU_REAL(ssize_t, recvfrom, (int, void*, size_t, int, struct sockaddr*, socklen_t*))
+L6470EMU_REAL(ssize_t, recvmsg, (int, struct msghdr*, int))
 L6470EMU_REAL(int, stat, (const char*, struct stat*))
 L6470EMU_REAL(int, lstat, (const char*, struct stat*))
 L6470EMU_REAL(int, fstat, (int, struct stat*))
@@ -102,6 +106,12 @@ L6470EMU_REAL(int, sem_trywait, (sem_t*))
 L6470EMU_REAL(int, sem_post, (sem_t*))
 L6470EMU_REAL(int, pthread_create, (pthread_t*, const pthread_attr_t*, void* (*)(void*), void*))
 L6470EMU_REAL(int, pthread_join, (pthread_t, void**))
+L6470EMU_REAL(pid_t, waitpid, (pid_t, int*, int))
+L6470EMU_REAL(pid_t, wait4, (pid_t, int*, int, struct rusage*))
+L6470EMU_REAL(int, waitid, (idtype_t, id_t, siginfo_t*, int))
+L6470EMU_REAL(int, pthread_mutex_lock, (pthread_mutex_t*))
+L6470EMU_REAL(int, pthread_mutex_trylock, (pthread_mutex_t*))
+L6470EMU_REAL(int, pthread_mutex_unlock, (pthread_mutex_t*))
 L6470EMU_REAL(int, pthread_cancel, (pthread_t))
 L6470EMU_REAL(int, timerfd_create, (int, int))
 L6470EMU_REAL(int, timerfd_settime, (int, int, const struct itimerspec*, struct itimerspec*))
@@ -135,6 +145,12 @@ ssize_t read(int fd, void* buf, size_t n) {
   if (auto f = get_read()) return f(fd, buf, n);
   return syscall(SYS_read, fd, buf, n);
 }
+ssize_t readv(int fd, const struct iovec* iov, int n) { return get_readv()(fd, iov, n); }
+ssize_t recv(int fd, void* buf, size_t n, int flags) { return get_recv()(fd, buf, n, flags); }
+ssize_t recvfrom(int fd, void* buf, size_t n, int flags, struct sockaddr* from, socklen_t* from_len) {
+  return get_recvfrom()(fd, buf, n, flags, from, from_len);
+}
+ssize_t recvmsg(int fd, struct msghdr* msg, int flags) { return get_recvmsg()(fd, msg, flags); }
 ssize_t write(int fd, const void* buf, size_t n) {
   if (auto f = get_write()) return f(fd, buf, n);
   return syscall(SYS_write, fd, buf, n);
@@ -228,6 +244,12 @@ int pthread_create(pthread_t* t, const pthread_attr_t* attr, void* (*fn)(void*),
   return get_pthread_create()(t, attr, fn, arg);
 }
 int pthread_join(pthread_t t, void** result) { return get_pthread_join()(t, result); }
+pid_t waitpid(pid_t pid, int* status, int options) { return get_waitpid()(pid, status, options); }
+pid_t wait4(pid_t pid, int* status, int options, struct rusage* usage) { return get_wait4()(pid, status, options, usage); }
+int waitid(idtype_t idtype, id_t id, siginfo_t* info, int options) { return get_waitid()(idtype, id, info, options); }
+int pthread_mutex_lock(pthread_mutex_t* m) { return get_pthread_mutex_lock()(m); }
+int pthread_mutex_trylock(pthread_mutex_t* m) { return get_pthread_mutex_trylock()(m); }
+int pthread_mutex_unlock(pthread_mutex_t* m) { return get_pthread_mutex_unlock()(m); }
 int pthread_cancel(pthread_t t) { return get_pthread_cancel()(t); }
 int timerfd_create(int clock, int flags) { return get_timerfd_create()(clock, flags); }
 int timerfd_settime(int fd, int flags, const struct itimerspec* value, struct itimerspec* old) {

@@ -10,9 +10,13 @@
 #include <stdio.h>
 #include <sys/epoll.h>
 #include <sys/select.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/time.h>
 #include <sys/types.h>
+#include <sys/uio.h>
+#include <sys/wait.h>
+#include <sys/resource.h>
 #include <time.h>
 
 struct statx;
@@ -30,6 +34,10 @@ int dup3(int fd, int fd2, int flags);
 int fcntl(int fd, int cmd, long arg);
 int ioctl(int fd, unsigned long request, void* arg);
 ssize_t read(int fd, void* buf, size_t n);
+ssize_t readv(int fd, const struct iovec* iov, int n);
+ssize_t recv(int fd, void* buf, size_t n, int flags);
+ssize_t recvfrom(int fd, void* buf, size_t n, int flags, struct sockaddr* from, socklen_t* from_len);
+ssize_t recvmsg(int fd, struct msghdr* msg, int flags);
 ssize_t write(int fd, const void* buf, size_t n);
 int stat(const char* path, struct stat* st);
 int lstat(const char* path, struct stat* st);
@@ -78,6 +86,12 @@ int sem_trywait(sem_t* s);
 int sem_post(sem_t* s);
 int pthread_create(pthread_t* t, const pthread_attr_t* attr, void* (*fn)(void*), void* arg);
 int pthread_join(pthread_t t, void** result);
+pid_t waitpid(pid_t pid, int* status, int options);
+pid_t wait4(pid_t pid, int* status, int options, struct rusage* usage);
+int waitid(idtype_t idtype, id_t id, siginfo_t* info, int options);
+int pthread_mutex_lock(pthread_mutex_t* m);
+int pthread_mutex_trylock(pthread_mutex_t* m);
+int pthread_mutex_unlock(pthread_mutex_t* m);
 int pthread_cancel(pthread_t t);
 int timerfd_create(int clock, int flags);
 int timerfd_settime(int fd, int flags, const struct itimerspec* value, struct itimerspec* old);

@@ -16,6 +16,7 @@
 #include "linux/preload/fork_server.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
+#include "linux/process_waits.hpp"
 
 namespace l6470emu::preload {
 namespace {
@@ -25,6 +26,8 @@ std::string* g_report_path = nullptr;  // never freed: read at exit
 Tick g_timeout = kNever;
 std::atomic<bool> g_reported{false};
 std::atomic<bool> g_devices{false};
+std::string* g_waits_dir = nullptr;  // never freed
+bool g_waits_published = false;      // (under the scheduler's lock)
 
 void at_exit() { end_run(RunEnd::exit, ""); }
 
@@ -44,6 +47,10 @@ void start_run(DeviceBoard& board) {
   if (!(report && *report) && !(scenario && *scenario) && !(timeout && *timeout)) return;
   g_board = &board;
   if (report && *report) g_report_path = new std::string(report);
+  if (report && *report) {
+    const std::string waits = run_waits_directory(report);
+    if (real::access(waits.c_str(), W_OK) == 0) g_waits_dir = new std::string(waits);
+  }
   if (timeout && *timeout) {
     char* end = nullptr;
     const unsigned long long t = std::strtoull(timeout, &end, 10);
@@ -119,7 +126,32 @@ void end_run(RunEnd cause, std::string_view detail) {
   real::close(fd);
 }
 
+bool run_publishes_waits() { return g_board != nullptr && g_waits_dir != nullptr; }
+
+void run_publish_waits(const std::string& text) {
+  if (!run_publishes_waits()) return;
+  const std::string pid = std::to_string(getpid());
+  const std::string file = *g_waits_dir + "/" + pid, temp = *g_waits_dir + "/." + pid;
+  const int fd = real::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (fd < 0) return;
+  const bool written = raw_write_all(fd, text.data(), text.size());
+  real::close(fd);
+  // Whole or not at all: run never reads half a file.
+  if (written && std::rename(temp.c_str(), file.c_str()) == 0)
+    g_waits_published = true;
+  else
+    std::remove(temp.c_str());
+}
+
+void run_withdraw_waits() {
+  if (!g_waits_published || !g_waits_dir) return;
+  g_waits_published = false;
+  const std::string file = *g_waits_dir + "/" + std::to_string(getpid());
+  std::remove(file.c_str());
+}
+
 void run_after_fork_child() {
+  g_waits_published = false;  // (the parent's file, not this process's)
   g_reported.store(false);
   g_devices.store(false);
   fork_server_after_fork_child();

@@ -37,6 +37,14 @@ void run_device_opened();
 /// the driver sanitizer's check=error path must call it with RunEnd::sanitizer and its finding
 /// before ending the program, so that `run` can tell them apart whatever the exit status.
 void end_run(RunEnd cause, std::string_view detail);
+/// Whether the run made a waits directory (run_waits_directory) this process publishes its waits in.
+bool run_publishes_waits();
+/// Every thread of this process waits and only another process can end a wait: `text`
+/// (format_process_waits) goes to its file in the run's waits directory, replacing what was there.
+/// Called with the scheduler's lock held: real system calls only.
+void run_publish_waits(const std::string& text);
+/// A wait ended: the file goes (nothing when none was published).
+void run_withdraw_waits();
 /// fork(): the child reports for itself (it has opened nothing yet).
 void run_after_fork_child();
 /// Whether this process exchanged SPI bytes with the board.

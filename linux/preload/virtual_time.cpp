@@ -22,6 +22,8 @@
 
 #include "linux/log.hpp"
 #include "linux/preload/real.hpp"
+#include "linux/process_waits.hpp"
+#include "linux/unix_socket_diag.hpp"
 
 namespace l6470emu::preload {
 
@@ -94,12 +96,52 @@ bool epoll_members(int fd, std::vector<int>& members) {
 // Whether descriptor `fd` becomes ready only through this process: an emulated gpio line, a
 // virtual timerfd, or an epoll set of such descriptors.
 bool inside_fd(int fd, int depth = 0) {
-  if (is_emulated_line(fd) || is_virtual_timerfd(fd) || pipe_held_by_this_process_alone(fd)) return true;
+  if (is_emulated_line(fd) || is_virtual_timerfd(fd) || pipe_held_by_this_process_alone(fd) ||
+      socket_pair_held_by_this_process_alone(fd))
+    return true;
   std::vector<int> members;
   if (depth > 3 || !epoll_members(fd, members)) return false;
   for (const int m : members)
     if (!inside_fd(m, depth + 1)) return false;
   return true;
+}
+
+// The child a pidfd refers to (/proc/self/fdinfo's "Pid:" line), or 0 when `fd` is no pidfd.
+pid_t pidfd_child(int fd) {
+  if (link_of("/proc/self/fd/" + std::to_string(fd)) != "anon_inode:[pidfd]") return 0;
+  const std::string path = "/proc/self/fdinfo/" + std::to_string(fd);
+  const int info = real::open(path.c_str(), O_RDONLY | O_CLOEXEC, 0);
+  if (info < 0) return 0;
+  char buf[1024];
+  const ssize_t n = real::read(info, buf, sizeof buf - 1);
+  real::close(info);
+  if (n <= 0) return 0;
+  buf[n] = 0;
+  const char* at = std::strstr(buf, "Pid:");
+  return at ? static_cast<pid_t>(std::atol(at + 4)) : 0;
+}
+
+// What another process could do to end a wait on `fd` (linux/process_waits.hpp).
+WaitDependency dependency_of(int fd) {
+  WaitDependency d;
+  const std::string link = link_of("/proc/self/fd/" + std::to_string(fd));
+  if (link.rfind("pipe:[", 0) == 0) {
+    d.kind = WaitDependency::Kind::pipe;
+    d.inode = std::strtoul(link.c_str() + 6, nullptr, 10);
+    d.fd = fd;
+  } else if (link.rfind("socket:[", 0) == 0) {
+    const unsigned long inode = std::strtoul(link.c_str() + 8, nullptr, 10);
+    if (const UnixSocketInfo info = unix_socket_info(inode); info.known && info.peer != 0) {
+      d.kind = WaitDependency::Kind::socket;
+      d.inode = inode;
+      d.peer = info.peer;
+      d.fd = fd;
+    }
+  } else if (const pid_t child = pidfd_child(fd); child > 0) {
+    d.kind = WaitDependency::Kind::child;
+    d.pid = child;
+  }
+  return d;
 }
 
 // Writes every line of `text` on standard error as the log writes them ("l6470emu: ...").
@@ -162,6 +204,17 @@ VirtualScheduler::Hooks VirtualHostTime::scheduler_hooks() {
   h.deadlock = [this](const std::string& report) { end_deadlocked(report); };
   // Last, so that the closures above keep their names (linux/preload/hot_path.order lists some).
   h.time_limit = [] { return run_time_limit(); };
+  // (Later still.) `run`'s view across processes: what this process waits on while only another
+  // process can end a wait.
+  h.stuck = [](const std::vector<int>& fds, bool other, const std::vector<std::string>& threads) {
+    if (!run_publishes_waits()) return;
+    ProcessWaits waits;
+    for (const int fd : fds) waits.dependencies.push_back(dependency_of(fd));
+    if (other) waits.dependencies.emplace_back();
+    waits.threads = threads;
+    run_publish_waits(format_process_waits(waits));
+  };
+  h.unstuck = [] { run_withdraw_waits(); };
   return h;
 }
 
@@ -175,6 +228,8 @@ std::string VirtualHostTime::describe_fd(int fd) const {
     return n + " (" + node + ")";
   }
   if (pipe_held_by_this_process_alone(fd)) return n + " (a pipe no other process holds)";
+  if (socket_pair_held_by_this_process_alone(fd)) return n + " (a socket pair no other process holds)";
+  if (const pid_t child = pidfd_child(fd); child > 0) return n + " (child " + std::to_string(child) + ")";
   bool armed = false;
   if (is_virtual_timerfd(fd, &armed)) return n + (armed ? " (a timerfd)" : " (a timerfd that is not armed)");
   std::vector<int> members;
@@ -362,6 +417,7 @@ void VirtualHostTime::after_fork_parent() {
 }
 
 void VirtualHostTime::after_fork_child() {
+  mutex_waiters_after_fork_child();
   timerfd_table_after_fork();
   thread_table_after_fork();
   scheduler_.after_fork_child();

@@ -177,6 +177,13 @@ void timerfd_table_before_fork();
 void timerfd_table_after_fork();
 /// intercept_timerfd.cpp: a snapshot's child owns the table (its lock was not taken for the fork).
 void timerfd_table_after_snapshot();
+/// intercept_mutex.cpp: locks a program's mutex as pthread_mutex_lock does, a covered wait when
+/// it is held (from inside the library: a condition variable's wait taking its mutex again).
+int lock_program_mutex(VirtualHostTime& vt, pthread_mutex_t* m);
+/// intercept_mutex.cpp: a program's mutex `m` was unlocked: its first covered waiter tries again.
+void program_mutex_unlocked(pthread_mutex_t* m);
+/// intercept_mutex.cpp: fork()'s child has one thread, which waits on no mutex.
+void mutex_waiters_after_fork_child();
 /// intercept_poll.cpp: whether descriptor `fd` is an emulated gpio line with edge events.
 bool is_emulated_line(int fd);
 

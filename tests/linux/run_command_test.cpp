@@ -12,6 +12,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "board/run_report.hpp"
 #include "linux/virtual_scheduler.hpp"
@@ -121,11 +122,11 @@ TEST_F(RunCommand, AReportThatCannotBeWrittenOrWouldOverwriteAnInputEndsTheRunBe
 }
 
 TEST_F(RunCommand, StoppedBySigtermItPassesTheSignalOnAndWritesTheJUnitReportWithTheProgramStopped) {
-  // A read of its own pipe blocks where virtual time cannot see: only a signal ends it.
+  // sigwait() (not a covered call) blocks where virtual time cannot see: only a signal ends it.
   const std::string marker = path("paused");
   Background b({l6470emu_program(), "run", "--chain", "chips=L6470", "--junit", path("r.xml"), "--", system_python(), "-c",
                 "import signal, spidev\ns = spidev.SpiDev(); s.open(0, 0); s.mode = 3\n[s.xfer2([b]) for b in (0xD0, 0, 0)]\n"
-                "open('" + marker + "', 'w').close()\nimport os\nr, w = os.pipe()\nos.read(r, 1)\n"});
+                "open('" + marker + "', 'w').close()\nsignal.sigwait([signal.SIGUSR1])\n"});
   for (int i = 0; i < 1000 && !fs::exists(marker); ++i) usleep(10'000);
   ASSERT_TRUE(fs::exists(marker)) << "the program never reached its pause";
   const RunResult r = b.stop(SIGTERM, 30);
@@ -258,7 +259,8 @@ TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
 
 TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClockGuard) {
   // In wall time pause() waits for a signal where nothing can see it: the guard ends it, with the
-  // simulated time limit's status and its own words. (A read on its own pipe the same way.)
+  // simulated time limit's status and its own words. (A read on its own pipe the same way: wall
+  // time has no view of the waits.)
   for (const std::string& program : {std::string("import signal\nsignal.pause()\n"),
                                      std::string("import os\nr, w = os.pipe()\nos.read(r, 1)\n")}) {
     const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
@@ -268,7 +270,28 @@ TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClo
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.err.find("of virtual time"), std::string::npos) << r.err;  // when, in board time, nobody knows
+    // And what the program was blocked in, as the kernel shows it.
+    EXPECT_NE(r.err.find("what each thread was blocked in when the guard ended it (the kernel's view, from /proc"),
+              std::string::npos)
+        << r.err;
+#if defined(__x86_64__)
+    EXPECT_NE(r.err.find(program.find("pause") != std::string::npos ? ": pause()" : ": read() of fd "), std::string::npos)
+        << r.err;
+#endif
   }
+}
+
+TEST_F(RunCommand, InVirtualTimeACallTheLibraryDoesNotCoverIsEndedByTheGuardWhichSaysWhatEachThreadWasBlockedIn) {
+  // sigwait() is no covered call: the thread counts as running, virtual time cannot judge it.
+  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
+                          python("import signal\nsignal.sigwait([signal.SIGUSR1])\n"));
+  EXPECT_EQ(r.status, kRunTimedOut) << r.err;
+  EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("(the kernel's view, from /proc"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" (python3) thread "), std::string::npos) << r.err;
+#if defined(__x86_64__)
+  EXPECT_NE(r.err.find(": rt_sigtimedwait()"), std::string::npos) << r.err;
+#endif
 }
 
 TEST_F(RunCommand, InVirtualTimeAPauseOrAPollOfItsOwnPipeNothingCanEndIsADeadlockNamingTheCall) {
@@ -288,6 +311,191 @@ TEST_F(RunCommand, InVirtualTimeAPauseOrAPollOfItsOwnPipeNothingCanEndIsADeadloc
                                     "signal.setitimer(signal.ITIMER_REAL, 0.05)\nsignal.pause()\nprint('woke')\n"));
   EXPECT_EQ(woke.status, kRunPassed) << woke.err;
   EXPECT_EQ(woke.out, "woke\n") << woke.err;
+}
+
+// A C client's mode (tests/linux/clients/virtual_deadlock.c) under run, with a wall-clock guard
+// far above what any of them takes: a deadlock must be found by virtual time, not by the guard.
+RunResult run_client(const std::string& mode, const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> args{"--chain", "bus=0 cs=0 chips=L6470", "--wall-timeout", "30"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  std::vector<std::string> argv{l6470emu_program(), "run"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  argv.push_back("--");
+  argv.push_back(client("virtual_deadlock"));
+  argv.push_back(mode);
+  return run_program(argv, {}, 60);
+}
+
+// How many times `part` occurs in `text`.
+std::size_t occurrences(const std::string& text, const std::string& part) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + part.size())) ++n;
+  return n;
+}
+
+TEST_F(RunCommand, AReadOfItsOwnPipeOrSocketPairThatNoThreadOrProcessCanWriteIsADeadlockNamingTheCall) {
+  for (const auto& [mode, call, times] : std::vector<std::tuple<std::string, std::string, std::size_t>>{
+           {"pipe-read", "read() on fd ", 1},
+           {"pipe-readv", "readv() on fd ", 1},
+           {"socketpair-recv", "recv() on fd ", 1},
+           {"pipe-read-threads", "read() on fd ", 2}}) {  // two readers, and the main thread joining one
+    const RunResult r = run_client(mode);
+    EXPECT_EQ(r.status, kRunDeadlocked) << mode << "\n" << r.err;
+    EXPECT_EQ(occurrences(r.err, call), times) << mode << "\n" << r.err;
+    EXPECT_NE(r.err.find(mode.starts_with("socket") ? " (a socket pair no other process holds), no timeout\n"
+                                                    : " (a pipe no other process holds), no timeout\n"),
+              std::string::npos)
+        << r.err;
+  }
+  // Python's os.read the same way.
+  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+                          python("import os\nr, w = os.pipe()\nos.read(r, 1)\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("read() on fd "), std::string::npos) << r.err;
+}
+
+TEST_F(RunCommand, AReadOfItsOwnPipeOrSocketPairThatAThreadAProcessOrASignalWillEndIsNoDeadlock) {
+  // Another thread writes after 100 ms of virtual time: the read waits exactly that long.
+  RunResult r = run_client("pipe-read-thread", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode pipe-read-thread\nread returned 1 (errno 0)\nat 100 ms\ndone\n") << r.err;
+  r = run_client("socketpair-recv-thread", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode socketpair-recv-thread\nrecv returned 1 (errno 0) at 100 ms\ndone\n") << r.err;
+  r = run_client("socketpair-recv-child", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode socketpair-recv-child\nrecv returned 1 (errno 0) at 0 ms\ndone\n") << r.err;
+  // A child writes in real time: neither a deadlock nor a jump to the time limit meanwhile.
+  r = run_client("pipe-read-child", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode pipe-read-child\nread returned 1 (errno 0)\ndone\n") << r.err;
+  // An armed alarm: its handler (no SA_RESTART) ends the read with EINTR, as the kernel's read.
+  r = run_client("pipe-read-alarm", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode pipe-read-alarm\nread returned -1 (errno 4)\ndone\n") << r.err;
+}
+
+TEST_F(RunCommand, AnAbbaMutexDeadlockIsADeadlockNamingEachThreadsLockAndItsHolder) {
+  RunResult r = run_client("mutex-abba");
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_EQ(occurrences(r.err, "pthread_mutex_lock() on the mutex at 0x"), 2u) << r.err;
+  EXPECT_EQ(occurrences(r.err, ", held by thread "), 2u) << r.err;
+  EXPECT_NE(r.err.find("pthread_join() of thread "), std::string::npos) << r.err;
+  // A plain mutex its owner locks again blocks for ever on a real kernel too.
+  r = run_client("mutex-self");
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("pthread_mutex_lock() on the mutex at 0x"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(", held by this thread itself, no timeout"), std::string::npos) << r.err;
+}
+
+TEST_F(RunCommand, AMutexThatAnotherThreadWillReleaseIsNoDeadlock) {
+  // Held across a 100 ms virtual sleep: the lock is taken when the sleep ends, exactly.
+  RunResult r = run_client("mutex-sleeper", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode mutex-sleeper\nlocked at 100 ms\ndone\n") << r.err;
+  // Held while the holder computes (it runs): no time passes, no verdict.
+  r = run_client("mutex-worker", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode mutex-worker\nlocked at 0 ms\ndone\n") << r.err;
+  // An error-checking mutex keeps its EDEADLK.
+  r = run_client("mutex-errorcheck");
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode mutex-errorcheck\nsecond lock EDEADLK\ndone\n") << r.err;
+}
+
+TEST_F(RunCommand, AWaitForADeadlockedChildEndsAsADeadlockNamingTheChildsCallAndASlowChildIsWaitedFor) {
+  // The child reports its own deadlock and ends; the parent's waitpid returns it, the run is a deadlock.
+  RunResult r = run_client("child-pause");
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_EQ(r.out, "mode child-pause\nchild exited 87\ndone\n") << r.err;
+  EXPECT_NE(r.err.find("pause(), no timeout"), std::string::npos) << r.err;
+  // A child that takes 300 ms of real time: the parent's waitpid waits for it, its clock stays
+  // (no jump to the time limit meanwhile).
+  r = run_client("child-slow", {"--timeout", "1s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode child-slow\nchild exited 3 at 0 ms\ndone\n") << r.err;
+}
+
+TEST_F(RunCommand, AParentWaitingForAChildThatReadsAPipeOnlyTheParentCouldWriteIsADeadlockAcrossProcesses) {
+  // Each process says what it waits on; run sees that only the other could end it.
+  RunResult r = run_client("child-hung", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("deadlocked in virtual time, its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_EQ(occurrences(r.err, "\n    process "), 2u) << r.err;
+  EXPECT_NE(r.err.find("): waitpid() on fd "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" (child "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): read() on fd "), std::string::npos) << r.err;
+  // The same two processes, the parent writing after 100 ms of its own time: no deadlock.
+  r = run_client("child-fed", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode child-fed\nread returned 1 (errno 0)\nchild exited 0\ndone\n") << r.err;
+  // A socket pair the same way.
+  r = run_client("child-socketpair-hung", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): recv() on fd "), std::string::npos) << r.err;
+  r = run_client("child-socketpair-fed", {"--timeout", "5s"});
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "mode child-socketpair-fed\nrecv returned 1 (errno 0) at 0 ms\nchild exited 0\ndone\n") << r.err;
+}
+
+TEST_F(RunCommand, APythonParentWaitingForACatWhoseInputItNeverClosesIsADeadlockAndCommunicateIsNot) {
+  // Popen.wait() with the child's stdin still open: the parent waits for cat, cat for its input.
+  RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+                    python("import subprocess\n"
+                           "subprocess.Popen(['cat'], stdin=subprocess.PIPE, stdout=subprocess.PIPE).wait()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(" (cat): thread "), std::string::npos) << r.err;
+  // communicate() feeds it and closes its input; a child that takes real time is waited for.
+  r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+          python("import subprocess\n"
+                 "out, _ = subprocess.Popen(['cat'], stdin=subprocess.PIPE, stdout=subprocess.PIPE).communicate(b'fed')\n"
+                 "print(out.decode())\n"
+                 "r = subprocess.run(['sh', '-c', 'sleep 0.2; echo slow'], capture_output=True)\n"
+                 "print(r.stdout.decode().strip(), r.returncode)\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "fed\nslow 0\n") << r.err;
+}
+
+TEST_F(RunCommand, APythonProcessJoiningAChildThatWaitsOnAMultiprocessingPipeNobodySendsOnIsADeadlock) {
+  const std::string start = "import multiprocessing as mp\n"
+                            "def child(conn):\n    print('child got', conn.recv(), flush=True)\n"
+                            "mp.set_start_method('fork')\n"
+                            "a, b = mp.Pipe()\np = mp.Process(target=child, args=(b,))\np.start()\n";
+  RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"}, python(start + "p.join()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_NE(r.err.find("its processes waiting on each other"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("): waitpid() on fd "), std::string::npos) << r.err;
+  // Sent on after a second of the parent's time: the child gets it, the join returns.
+  r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "30"},
+          python(start + "time.sleep(1); a.send('hello'); p.join(); print('exit', p.exitcode)\n"));
+  EXPECT_EQ(r.status, kRunPassed) << r.err;
+  EXPECT_EQ(r.out, "child got hello\nexit 0\n") << r.err;
+}
+
+TEST_F(RunCommand, APythonAbbaDeadlockOfTwoLocksIsADeadlockNamingEachThreadsWait) {
+  const RunResult r = run({"--chain", "chips=L6470", "--wall-timeout", "30"},
+                          python("import threading\n"
+                                 "a, b = threading.Lock(), threading.Lock()\n"
+                                 "ea, eb = threading.Event(), threading.Event()\n"
+                                 "def one():\n    with a:\n        ea.set(); eb.wait()\n        with b: pass\n"
+                                 "def two():\n    with b:\n        eb.set(); ea.wait()\n        with a: pass\n"
+                                 "t1 = threading.Thread(target=one); t2 = threading.Thread(target=two)\n"
+                                 "t1.start(); t2.start(); t1.join()\n"));
+  EXPECT_EQ(r.status, kRunDeadlocked) << r.err;
+  EXPECT_EQ(occurrences(r.err, "sem_wait() on the object at 0x"), 3u) << r.err;  // (CPython's locks are semaphores)
+}
+
+TEST_F(RunCommand, AShellPipelineWhoseWriterEndsWhileItsReaderWaitsIsNoDeadlock) {
+  // The writer's last close races the reader's look at who holds the pipe: end of file, never a
+  // deadlock. Several times, for the race's sake.
+  for (int i = 0; i < 5; ++i) {
+    const RunResult r = run({"--chain", "chips=L6470", "--wall-timeout", "30"},
+                            {"/bin/sh", "-c", "{ printf abc; head -c 20000 /dev/zero; printf def; } | cat | wc -c"});
+    EXPECT_EQ(r.out, "20006\n") << r.err;
+    EXPECT_EQ(r.err.find("deadlock"), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(RunCommand, TheWallClockGuardIsADurationAndLeavesAProgramThatEndsInTimeAlone) {

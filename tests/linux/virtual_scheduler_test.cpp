@@ -14,6 +14,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace l6470emu::test {
@@ -474,6 +475,54 @@ TEST(VirtualSchedulerDeadlock, IsNotDeclaredWhileAThreadRunsOrAWakeUpIsToCome) {
   waiter.join();
   EXPECT_TRUE(reports.empty());
   EXPECT_EQ(board.jumps, (std::vector<Tick>{500}));
+}
+
+TEST(VirtualSchedulerDeadlock, IsNotDeclaredWhenAPipesLastOtherHolderClosesItWhileItIsLookedAt) {
+  // The slow look at who holds the pipe (here: the hook) races the writer's last close: the end
+  // of file it leaves ends the read's wait instead of making it a deadlock.
+  FakeBoard board;
+  int fd[2];
+  ASSERT_EQ(pipe(fd), 0);
+  std::vector<std::string> reports;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.inside_fd = [&](int) {
+    if (fd[1] >= 0) close(std::exchange(fd[1], -1));  // the writer ends meanwhile
+    return true;                                        // and nobody else holds it now
+  };
+  h.deadlock = [&](const std::string& r) { reports.push_back(r); };
+  VirtualScheduler s(std::move(h), 0, 1);
+  const pollfd p{fd[0], POLLIN, 0};
+  VirtualScheduler::Wait w;
+  w.call = "read";
+  w.fds = std::span<const pollfd>(&p, 1);
+  EXPECT_EQ(s.wait(w), End::ready);
+  EXPECT_TRUE(reports.empty());
+  close(fd[0]);
+}
+
+TEST(VirtualSchedulerDeadlock, AWaitOnlyAnotherProcessCanEndIsSaidOnceWithWhatItWaitsOnAndUnsaidWhenItEnds) {
+  FakeBoard board;
+  WakePipe pipe;
+  std::vector<std::vector<int>> said;
+  std::vector<std::string> lines;
+  int unsaid = 0;
+  VirtualScheduler::Hooks h = board.hooks();
+  h.inside_fd = [](int) { return false; };
+  h.time_limit = [] { return Tick{4'000'000}; };  // a run's limit: not jumped to while another process may act
+  h.stuck = [&](const std::vector<int>& fds, bool other, const std::vector<std::string>& threads) {
+    said.push_back(fds);
+    EXPECT_FALSE(other);
+    lines = threads;
+  };
+  h.unstuck = [&] { ++unsaid; };
+  const std::vector<std::string> reports = both_wait_on(board, h, pipe);
+  EXPECT_TRUE(reports.empty());
+  ASSERT_FALSE(said.empty());
+  EXPECT_EQ(said.back(), (std::vector<int>{pipe.fd[0], pipe.fd[0]}));  // both threads' waits
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_NE(lines[0].find(": read() on fd "), std::string::npos) << lines[0];
+  EXPECT_NE(lines[1].find(": poll() on fd "), std::string::npos) << lines[1];
+  EXPECT_EQ(unsaid, static_cast<int>(said.size()));  // withdrawn as soon as a wait ended
 }
 
 }  // namespace

@@ -19,7 +19,9 @@
 #include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <sys/select.h>
+#include <sys/socket.h>
 #include <sys/syscall.h>
+#include <sys/uio.h>
 #include <sys/timerfd.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -81,7 +83,7 @@ static int pipe_fds[2];
 static void* pipe_reader(void* arg) {
   (void)arg;
   char c = 0;
-  /* Blocked outside the covered calls: counts as running, so no deadlock while it is here. */
+  /* Waits on a pipe a child holds: another process may write it, so no deadlock while it is here. */
   const ssize_t n = read(pipe_fds[0], &c, 1);
   printf("pipe reader got %zd byte '%c'\n", n, c);
   fflush(stdout);
@@ -90,9 +92,94 @@ static void* pipe_reader(void* arg) {
 
 static void on_alarm(int sig) { (void)sig; }
 
+/* Virtual time since the program's start, ms. */
+static long start_ms = -1;
+static long now_ms(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  const long ms = ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+  if (start_ms < 0) start_ms = ms;
+  return ms - start_ms;
+}
+
+/* Sleeps 100 ms of virtual time, then writes one byte to the pipe. */
+static void* late_writer(void* arg) {
+  (void)arg;
+  usleep(100000);
+  write(pipe_fds[1], "y", 1);
+  return NULL;
+}
+
+static pthread_mutex_t mutex_a = PTHREAD_MUTEX_INITIALIZER, mutex_b = PTHREAD_MUTEX_INITIALIZER;
+static sem_t a_taken, b_taken;
+
+/* Takes A, waits until the other thread has B, then wants B. */
+static void* abba_first(void* arg) {
+  (void)arg;
+  pthread_mutex_lock(&mutex_a);
+  sem_post(&a_taken);
+  sem_wait(&b_taken);
+  pthread_mutex_lock(&mutex_b);
+  return NULL;
+}
+
+/* Takes B, waits until the other thread has A, then wants A. */
+static void* abba_second(void* arg) {
+  (void)arg;
+  pthread_mutex_lock(&mutex_b);
+  sem_post(&b_taken);
+  sem_wait(&a_taken);
+  pthread_mutex_lock(&mutex_a);
+  return NULL;
+}
+
+/* Holds A across 100 ms of virtual sleep. */
+static void* sleeping_holder(void* arg) {
+  (void)arg;
+  pthread_mutex_lock(&mutex_a);
+  sem_post(&a_taken);
+  usleep(100000);
+  pthread_mutex_unlock(&mutex_a);
+  return NULL;
+}
+
+/* Holds A while it computes (no covered call: it counts as running). */
+static volatile unsigned long sink;
+static void* computing_holder(void* arg) {
+  (void)arg;
+  pthread_mutex_lock(&mutex_a);
+  sem_post(&a_taken);
+  for (unsigned long i = 0; i < 200000000ul; ++i) sink += i;
+  pthread_mutex_unlock(&mutex_a);
+  return NULL;
+}
+
+static int socket_fds[2];
+
+/* Sleeps 100 ms of virtual time, then sends one byte on the socket pair. */
+static void* late_sender(void* arg) {
+  (void)arg;
+  usleep(100000);
+  send(socket_fds[1], "s", 1, 0);
+  return NULL;
+}
+
+static void recv_own_socket(void) {
+  char c = 0;
+  const ssize_t n = recv(socket_fds[0], &c, 1, 0);
+  printf("recv returned %zd (errno %d) at %ld ms\n", n, n < 0 ? errno : 0, now_ms());
+}
+
+static void read_own_pipe(void) {
+  char c = 0;
+  const ssize_t n = read(pipe_fds[0], &c, 1);
+  printf("read returned %zd (errno %d)\n", n, n < 0 ? errno : 0);
+}
+
 int main(int argc, char** argv) {
   const char* mode = argc > 1 ? argv[1] : "read";
   setvbuf(stdout, NULL, _IOLBF, 0);
+  now_ms();
   line_fd = busy_request();
   printf("mode %s\n", mode);
 
@@ -135,6 +222,62 @@ int main(int argc, char** argv) {
     int tfd = timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC); /* never armed */
     uint64_t n;
     read(tfd, &n, sizeof n);
+  } else if (strcmp(mode, "pipe-read") == 0) {
+    pipe(pipe_fds); /* nobody else holds it, and nobody writes it */
+    read_own_pipe();
+  } else if (strcmp(mode, "pipe-readv") == 0) {
+    pipe(pipe_fds);
+    char c;
+    struct iovec v = {&c, 1};
+    readv(pipe_fds[0], &v, 1);
+  } else if (strcmp(mode, "socketpair-recv") == 0) {
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds); /* nobody else holds it */
+    recv_own_socket();
+  } else if (strcmp(mode, "pipe-read-threads") == 0) {
+    /* Two threads read the same pipe; the main thread joins the first. */
+    pipe(pipe_fds);
+    pthread_t t1, t2;
+    pthread_create(&t1, NULL, pipe_reader, NULL);
+    pthread_create(&t2, NULL, pipe_reader, NULL);
+    pthread_join(t1, NULL);
+  } else if (strcmp(mode, "mutex-abba") == 0) {
+    sem_init(&a_taken, 0, 0);
+    sem_init(&b_taken, 0, 0);
+    pthread_t t1, t2;
+    pthread_create(&t1, NULL, abba_first, NULL);
+    pthread_create(&t2, NULL, abba_second, NULL);
+    pthread_join(t1, NULL);
+  } else if (strcmp(mode, "mutex-self") == 0) {
+    pthread_mutex_lock(&mutex_a);
+    pthread_mutex_lock(&mutex_a); /* a plain mutex locked twice by its owner */
+  } else if (strcmp(mode, "child-pause") == 0) {
+    /* A child that waits for a signal nothing sends: it is deadlocked itself, and says so. */
+    const pid_t child = fork();
+    if (child == 0) {
+      pause();
+      _exit(0);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    printf("child exited %d\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+  } else if (strcmp(mode, "child-hung") == 0) {
+    /* The child reads a pipe only the parent could write; the parent waits for the child. */
+    pipe(pipe_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      read_own_pipe();
+      _exit(0);
+    }
+    waitpid(child, NULL, 0);
+  } else if (strcmp(mode, "child-socketpair-hung") == 0) {
+    /* The child waits on a socket pair only the parent could send on; the parent waits for it. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      recv_own_socket();
+      _exit(0);
+    }
+    waitpid(child, NULL, 0);
   } else if (strcmp(mode, "outside-thread") == 0) {
     /* A thread in a pipe read (not covered) holds off the verdict until a child writes to the
        pipe in real time; then only the main thread's poll of the idle line is left. */
@@ -169,6 +312,105 @@ int main(int argc, char** argv) {
     const int n = poll(p, 2, -1);
     printf("poll returned %d, pipe readable %d\n", n, (p[1].revents & POLLIN) != 0);
     wait(NULL);
+  } else if (strcmp(mode, "pipe-read-thread") == 0) {
+    /* Its own pipe, written by another thread after a virtual sleep: the read waits for it. */
+    pipe(pipe_fds);
+    pthread_t t;
+    pthread_create(&t, NULL, late_writer, NULL);
+    read_own_pipe();
+    printf("at %ld ms\n", now_ms());
+    pthread_join(t, NULL);
+  } else if (strcmp(mode, "socketpair-recv-thread") == 0) {
+    /* Its own socket pair, sent on by another thread after a virtual sleep. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    pthread_t t;
+    pthread_create(&t, NULL, late_sender, NULL);
+    recv_own_socket();
+    pthread_join(t, NULL);
+  } else if (strcmp(mode, "socketpair-recv-child") == 0) {
+    /* Its own socket pair, sent on by a child in real time. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    if (fork() == 0) {
+      real_sleep_ms(300);
+      send(socket_fds[1], "c", 1, 0);
+      _exit(0);
+    }
+    recv_own_socket();
+    wait(NULL);
+  } else if (strcmp(mode, "pipe-read-child") == 0) {
+    /* Its own pipe, written by a child in real time. */
+    pipe(pipe_fds);
+    if (fork() == 0) {
+      real_sleep_ms(300);
+      write(pipe_fds[1], "x", 1);
+      _exit(0);
+    }
+    read_own_pipe();
+    wait(NULL);
+  } else if (strcmp(mode, "pipe-read-alarm") == 0) {
+    /* A read of its own pipe that a real timer's signal ends (a handler without SA_RESTART). */
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_alarm;
+    sigaction(SIGALRM, &sa, NULL);
+    pipe(pipe_fds);
+    alarm(1);
+    read_own_pipe();
+  } else if (strcmp(mode, "mutex-sleeper") == 0 || strcmp(mode, "mutex-worker") == 0) {
+    /* A mutex held by a thread that will release it: after its sleep, or after its work. */
+    sem_init(&a_taken, 0, 0);
+    pthread_t t;
+    pthread_create(&t, NULL, strcmp(mode, "mutex-sleeper") == 0 ? sleeping_holder : computing_holder, NULL);
+    sem_wait(&a_taken);
+    pthread_mutex_lock(&mutex_a);
+    printf("locked at %ld ms\n", now_ms());
+    pthread_mutex_unlock(&mutex_a);
+    pthread_join(t, NULL);
+  } else if (strcmp(mode, "mutex-errorcheck") == 0) {
+    /* An error-checking mutex its owner locks again: EDEADLK, as the C library says. */
+    pthread_mutexattr_t attr;
+    pthread_mutexattr_init(&attr);
+    pthread_mutexattr_settype(&attr, PTHREAD_MUTEX_ERRORCHECK);
+    pthread_mutex_t m;
+    pthread_mutex_init(&m, &attr);
+    pthread_mutex_lock(&m);
+    printf("second lock %s\n", pthread_mutex_lock(&m) == EDEADLK ? "EDEADLK" : "other");
+  } else if (strcmp(mode, "child-slow") == 0) {
+    /* A child that takes 300 ms of real time, then exits 3: the parent waits for it. */
+    const pid_t child = fork();
+    if (child == 0) {
+      real_sleep_ms(300);
+      _exit(3);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    printf("child exited %d at %ld ms\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1, now_ms());
+  } else if (strcmp(mode, "child-fed") == 0) {
+    /* The child reads a pipe the parent writes after 100 ms of its virtual time, then waits for it. */
+    pipe(pipe_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      read_own_pipe();
+      _exit(0);
+    }
+    usleep(100000);
+    write(pipe_fds[1], "z", 1);
+    int status = 0;
+    waitpid(child, &status, 0);
+    printf("child exited %d\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+  } else if (strcmp(mode, "child-socketpair-fed") == 0) {
+    /* The same, the parent sending after 100 ms of its virtual time. */
+    socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, socket_fds);
+    const pid_t child = fork();
+    if (child == 0) {
+      recv_own_socket();
+      _exit(0);
+    }
+    usleep(100000);
+    send(socket_fds[1], "p", 1, 0);
+    int status = 0;
+    waitpid(child, &status, 0);
+    printf("child exited %d\n", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
   } else if (strcmp(mode, "shared-sem") == 0) {
     /* A process-shared semaphore: another process may post it (here, in real time). */
     sem_t* s = mmap(NULL, sizeof(sem_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);

@@ -5,10 +5,11 @@ chosen by the first argument; prints key=value lines for the test.
   run-sleep SPD        Run forward at SPD (2^-28 step/tick), sleep 1 s, read ABS_POS and SPEED
   sleep-around-moves   12 Moves, each followed by a 5 s sleep: 60 s of the program's time
   threads              thread A waits on BUSY edge events while thread B moves, sleeps and polls STATUS
-  idle                 a thread blocked reading a pipe while the main thread sleeps 5 s
+  idle                 a thread blocked in a raw read system call while the main thread sleeps 5 s
   fork                 a forked child sleeps 10 s on its own copy of the clock; the parent waits for it
   subprocess           a Python child started with subprocess between two GetStatus of the parent
 """
+import ctypes
 import os
 import sys
 import threading
@@ -27,7 +28,10 @@ t_start = time.monotonic_ns()  # the board's tick 0: nothing waited before this 
 if scenario == "idle":
     r, w = os.pipe()
     got = []
-    reader = threading.Thread(target=lambda: got.append(os.read(r, 1)))  # blocked outside any covered wait
+    buf = ctypes.create_string_buffer(1)
+    # A raw read system call (0 on x86-64, 63 on arm64): blocked outside any covered wait.
+    sys_read = 63 if os.uname().machine == "aarch64" else 0
+    reader = threading.Thread(target=lambda: got.append(buf.raw if ctypes.CDLL(None).syscall(sys_read, r, buf, 1) == 1 else b""))
     reader.start()
     t0 = time.monotonic_ns()
     time.sleep(5)

@@ -1,0 +1,149 @@
+// What a run's threads are blocked in, from /proc (tools/run_blocked.hpp).
+#include "tools/run_blocked.hpp"
+
+#include <dirent.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <optional>
+#include <set>
+
+
+namespace l6470emu {
+namespace {
+
+bool is_number(const char* s) {
+  if (!*s) return false;
+  for (; *s; ++s)
+    if (*s < '0' || *s > '9') return false;
+  return true;
+}
+
+std::string read_text(const std::string& path) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return {};
+  char buf[512];
+  const ssize_t n = read(fd, buf, sizeof buf - 1);
+  close(fd);
+  if (n <= 0) return {};
+  std::string s(buf, static_cast<std::size_t>(n));
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\0')) s.pop_back();
+  return s;
+}
+
+std::vector<std::string> numbered_entries(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (const dirent* e = readdir(d))
+      if (is_number(e->d_name)) out.emplace_back(e->d_name);
+    closedir(d);
+  }
+  return out;
+}
+
+// A process's parent and whether it is a zombie (/proc/PID/stat), nullopt when it is gone.
+struct Stat {
+  pid_t parent = 0;
+  bool zombie = false;
+  std::string name;
+};
+std::optional<Stat> stat_of(const std::string& pid) {
+  const std::string stat = read_text("/proc/" + pid + "/stat");
+  const std::size_t open_paren = stat.find('('), close_paren = stat.rfind(')');
+  if (open_paren == std::string::npos || close_paren == std::string::npos || close_paren < open_paren) return std::nullopt;
+  Stat s;
+  s.name = stat.substr(open_paren + 1, close_paren - open_paren - 1);
+  char state = 0;
+  long parent = 0;
+  if (std::sscanf(stat.c_str() + close_paren + 1, " %c %ld", &state, &parent) != 2) return std::nullopt;
+  s.parent = static_cast<pid_t>(parent);
+  s.zombie = state == 'Z' || state == 'X';
+  return s;
+}
+
+// System calls whose first argument is a descriptor.
+bool takes_fd(long n) {
+  switch (n) {
+    case 0: case 19: case 45: case 47: case 232: case 281: case 441: return true;  // read readv recvfrom recvmsg epoll_wait/pwait/pwait2
+    default: return false;
+  }
+}
+
+}  // namespace
+
+std::string blocking_syscall_name(long number) {
+#if defined(__x86_64__)
+  static const std::map<long, const char*> names = {
+      {0, "read"},        {1, "write"},          {7, "poll"},          {19, "readv"},         {23, "select"},
+      {34, "pause"},      {35, "nanosleep"},     {43, "accept"},       {42, "connect"},       {45, "recvfrom"},
+      {47, "recvmsg"},    {61, "wait4"},         {128, "rt_sigtimedwait"}, {130, "rt_sigsuspend"}, {202, "futex"},
+      {230, "clock_nanosleep"}, {232, "epoll_wait"}, {247, "waitid"},  {257, "openat"},       {270, "pselect6"},
+      {271, "ppoll"},     {281, "epoll_pwait"},  {288, "accept4"},     {441, "epoll_pwait2"}, {2, "open"},
+  };
+  if (const auto it = names.find(number); it != names.end()) return it->second;
+#endif
+  return "system call " + std::to_string(number);
+}
+
+std::vector<std::string> blocked_threads(const std::map<pid_t, std::vector<std::string>>& said) {
+  // The live descendants of this process.
+  std::map<pid_t, Stat> all;
+  for (const std::string& p : numbered_entries("/proc"))
+    if (const auto s = stat_of(p)) all[static_cast<pid_t>(std::atol(p.c_str()))] = *s;
+  std::set<pid_t> run;
+  for (const auto& [pid, s] : all) {
+    if (s.zombie) continue;
+    for (pid_t p = s.parent, hops = 0; p > 0 && hops < 4096; ++hops) {
+      if (p == getpid()) {
+        run.insert(pid);
+        break;
+      }
+      const auto it = all.find(p);
+      if (it == all.end()) break;
+      p = it->second.parent;
+    }
+  }
+  std::vector<std::string> lines;
+  for (const pid_t pid : run) {
+    const std::string proc = "/proc/" + std::to_string(pid);
+    const std::string who = "process " + std::to_string(pid) + " (" + all.at(pid).name + ")";
+    if (const auto it = said.find(pid); it != said.end() && !it->second.empty()) {
+      for (const std::string& t : it->second) lines.push_back(who + ": " + t);
+      continue;
+    }
+    for (const std::string& tid : numbered_entries(proc + "/task")) {
+      const std::string task = proc + "/task/" + tid;
+      const std::string syscall = read_text(task + "/syscall"), wchan = read_text(task + "/wchan");
+      std::string what;
+      if (syscall.empty()) {
+        what = "unknown (its /proc entry cannot be read)";
+      } else if (syscall == "running") {
+        what = "running";
+      } else {
+        char* end = nullptr;
+        const long n = std::strtol(syscall.c_str(), &end, 10);
+        if (n < 0) {
+          what = "not in a system call (computing)";
+        } else {
+          what = blocking_syscall_name(n) + "()";
+          if (takes_fd(n)) {
+            const long fd = std::strtol(end, nullptr, 16);  // the arguments are in hex
+            char link[128] = {};
+            const std::string fd_path = proc + "/fd/" + std::to_string(fd);
+            const ssize_t k = readlink(fd_path.c_str(), link, sizeof link - 1);
+            what += " of fd " + std::to_string(fd) + (k > 0 ? " (" + std::string(link, static_cast<std::size_t>(k)) + ")" : "");
+          }
+        }
+        if (!wchan.empty() && wchan != "0") what += " (kernel: " + wchan + ")";
+      }
+      lines.push_back(who + " thread " + tid + ": " + what);
+    }
+  }
+  return lines;
+}
+
+}  // namespace l6470emu
