@@ -15,7 +15,9 @@ constexpr const char* kKnown[] = {
     "L6470EMU_CHAIN", "L6470EMU_CONFIG", "L6470EMU_SOCKET", "L6470EMU_LOG",         "L6470EMU_TRACE",
     "L6470EMU_SHM",   "L6470EMU_CHECK",  "L6470EMU_CHECK_ALLOW", kCoverageEnv,
     // set by `l6470emu run` for the program it runs (board/run_report.hpp)
-    kRunReportEnv, kRunScenarioEnv, kRunTimeoutEnv,
+    kRunReportEnv, kRunScenarioEnv, kRunTimeoutEnv, kRunProgressEnv,
+    // set by `l6470emu campaign` for the run that forks its reruns (linux/fork_plan.hpp, kForkPlanEnv)
+    "L6470EMU_FORK_PLAN",
     // read by the l6470emu program, the Python package, the benchmarks and the test suite, not
     // by the preload: known all the same
     "L6470EMU_PYTHON", "L6470EMU_PYTHONPATH", "L6470EMU_PRELOAD", "L6470EMU_PROGRAM", "L6470EMU_SOURCE_DIR",

@@ -5,6 +5,9 @@
 
 #include <string>
 
+#include "board/environment_names.hpp"
+#include "board/run_report.hpp"
+#include "linux/fork_plan.hpp"
 #include "run_program.hpp"
 
 namespace l6470emu::test {
@@ -38,6 +41,14 @@ TEST_F(Typos, AMistypedVariableIsNamedWithTheOneMeantEvenWhenItLeavesNothingConf
   const RunResult t = run_program({"/bin/true"}, {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", "chips=L6470"},
                                                   {"L6470EMU_LOG", "stderr"}, {"L6470EMU_SHM", "off"}});
   EXPECT_EQ(t.err.find("unknown environment variable"), std::string::npos) << t.err;
+}
+
+TEST_F(Typos, TheVariablesRunAndCampaignSetForTheirProgramsAreKnown) {
+  for (const char* name : {kRunProgressEnv, kRunReportEnv, kRunScenarioEnv, kRunTimeoutEnv, kForkPlanEnv}) {
+    bool known = false;
+    for (const char* const* k = known_environment_variables(); *k; ++k) known = known || std::string(*k) == name;
+    EXPECT_TRUE(known) << name << " is set by run or campaign but the preload would call it unknown";
+  }
 }
 
 TEST_F(Typos, OpeningANodeTheBoardLacksSaysWhichNodesItHasOncePerPath) {
