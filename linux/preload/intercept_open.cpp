@@ -17,6 +17,7 @@
 #include "linux/preload/node_path.hpp"
 #include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
+#include "linux/preload/pwm_sysfs.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
 #include "linux/preload/virtual_time.hpp"
@@ -66,6 +67,7 @@ bool try_open(int dirfd, const char* path, int flags, int& fd) {
     if (walk == NodeWalk::not_ours) {
       note_missing_node(path);  // a /dev/spidev or gpiochip path the board lacks: said once
       if (std::strncmp(path, "/sys/", 5) != 0) return false;
+      if (open_pwm_file(path, flags, fd)) return true;
       const VirtualPath v = lookup_virtual(path, true);
       if (v.type == VirtualPath::Type::file) {
         fd = open_virtual_file(v, flags);
@@ -111,11 +113,13 @@ mode_t mode_arg(int flags, va_list ap) {
 void forget_fd(int fd) {
   if (FdEntry* e = fd_take(fd)) fd_release(e);
   forget_virtual_timerfd(fd);
+  forget_pwm_fd(fd);
 }
 
 // A descriptor the C library just handed out must not look emulated (stale entry).
 int fresh(int fd) {
   if (fd >= 0 && fd_entry(fd) && !in_vfork_child()) forget_fd(fd);
+  if (fd >= 0 && pwm_fds_exist() && !in_vfork_child()) forget_pwm_fd(fd);
   return fd;
 }
 
@@ -127,6 +131,7 @@ int dup_entry(int from, int to) {
     fd_store(to, e);
   } else {
     fresh(to);
+    dup_pwm_fd(from, to);
   }
   return to;
 }
@@ -232,6 +237,7 @@ __attribute__((visibility("default"))) int close(int fd) {
   FdEntry* e = fd_entry(fd) && !in_vfork_child() ? fd_take(fd) : nullptr;
   const int r = real::close(fd);
   forget_virtual_timerfd(fd);
+  if (!in_vfork_child()) forget_pwm_fd(fd);
   if (e) {
     const int saved = errno;
     fd_release(e);
