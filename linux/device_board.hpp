@@ -206,7 +206,8 @@ class DeviceBoard {
   /// text or a state pwm_apply refuses (pwm_state.hpp), -ENOENT for a channel not exported.
   /// An enabled channel drives a pulse train on the chip's STCK (Board::drive_pulse_train) with
   /// a 1 GHz count clock: period and duty are exact in nanoseconds, each edge at the board tick
-  /// (250 ns) at or before it, without drift. Enabling starts a period (the pin rises) now; a
+  /// (250 ns) at or before it, without drift. Enabling starts a period (the pin rises) now (on
+  /// the wall clock a microsecond on: the board's time moves while the call runs); a
   /// change while enabled takes effect at the pin's next rising edge (the next period, as a
   /// kernel PWM's); disabling or unexporting drives STCK low now, the pulses that rose up to now
   /// (one rising now included) counted.

@@ -45,11 +45,19 @@ void DeviceBoard::apply_pwm(std::size_t chain, std::size_t chip, PwmChannel& ch,
     t.clock_hz = kPwmClockHz;
     t.period_counts = next.period_ns;
     t.high_counts = high;
-    t.start = now;
-    // Running: the new period and duty from the pin's next rising edge on.
-    if (ch.train_on && ch.settings.enabled) t.start = ch.train.rise_tick(ch.train.rises_through(now));
     if (!ch.train_on) set_stck_level(chain, chip, false);
-    if (board_.drive_pulse_train(chain, chip, Pin::STCK, t)) {
+    bool started = false;
+    // On the wall clock the board's time moves on while this runs: a start in the past is
+    // refused, so the train starts a microsecond on (and is tried again with the time then).
+    const Tick lead = board_.time().is_virtual() ? 0 : kTicksPerMicrosecond;
+    for (int attempt = 0; attempt < 4 && !started; ++attempt) {
+      const Tick at = attempt == 0 ? now : board_.now(chain);
+      t.start = at + lead;
+      // Running: the new period and duty from the pin's next rising edge on.
+      if (ch.train_on && ch.settings.enabled) t.start = ch.train.rise_tick(ch.train.rises_through(at + lead));
+      started = board_.drive_pulse_train(chain, chip, Pin::STCK, t);
+    }
+    if (started) {
       ch.train = t;
       ch.train_on = true;
     } else {

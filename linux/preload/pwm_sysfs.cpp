@@ -7,8 +7,14 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <sys/stat.h>
+#include <sys/syscall.h>
+
 #include <atomic>
+#include <memory>
+#include <algorithm>
 #include <charconv>
+#include <cstring>
 #include <mutex>
 #include <unordered_map>
 
@@ -97,6 +103,9 @@ struct OpenAttr {
   std::size_t chain;
   int channel;
   PwmAttr attr;
+  // Bytes of the memfd already taken (its contents at open, and what flush_pwm_fd passed on),
+  // shared by the copies of the descriptor.
+  std::shared_ptr<std::uint64_t> consumed;
 };
 
 std::mutex g_mutex;
@@ -180,7 +189,7 @@ bool open_pwm_file(std::string_view path, int flags, int& fd) {
     // memfd descriptors are read-write; the open's access mode decides what the program may do.
     std::lock_guard lock(g_mutex);
     if (!g_fds) g_fds = new std::unordered_map<int, OpenAttr>();
-    (*g_fds)[fd] = OpenAttr{p.chain, p.channel, p.attr};
+    (*g_fds)[fd] = OpenAttr{p.chain, p.channel, p.attr, std::make_shared<std::uint64_t>(content.size())};
     g_any.store(true, std::memory_order_release);
   }
   return true;
@@ -209,6 +218,63 @@ bool write_pwm_fd(int fd, const void* buf, std::size_t count, ssize_t& result) {
   const long r = b ? b->pwm_write(a.chain, a.channel, a.attr, text) : -ENODEV;
   result = r < 0 ? fail(static_cast<int>(-r)) : static_cast<ssize_t>(r);
   return true;
+}
+
+long flush_pwm_fd(int fd) {
+  if (!pwm_fds_exist()) return 0;
+  OpenAttr a{};
+  std::string text;
+  {
+    std::lock_guard lock(g_mutex);
+    if (!g_fds) return 0;
+    const auto it = g_fds->find(fd);
+    if (it == g_fds->end()) return 0;
+    a = it->second;
+    struct stat st {};
+    if (::syscall(SYS_fstat, fd, &st) != 0 || static_cast<std::uint64_t>(st.st_size) <= *a.consumed) return 0;
+    const std::uint64_t from = *a.consumed;
+    text.resize(std::min<std::uint64_t>(static_cast<std::uint64_t>(st.st_size) - from, 4095));
+    const long n = ::syscall(SYS_pread64, fd, text.data(), text.size(), static_cast<off_t>(from));
+    *a.consumed = static_cast<std::uint64_t>(st.st_size);
+    if (n <= 0) return 0;
+    text.resize(static_cast<std::size_t>(n));
+  }
+  Guard guard;
+  Backend* b = backend();
+  const long r = b ? b->pwm_write(a.chain, a.channel, a.attr, text) : -ENODEV;
+  if (r < 0) {
+    std::string path = "/sys/class/pwm/pwmchip" + std::to_string(a.chain) + "/";
+    if (a.channel >= 0) path += "pwm" + std::to_string(a.channel) + "/";
+    log_line(path + pwm_attr_name(a.attr) + ": a write at close refused: " + std::strerror(static_cast<int>(-r)));
+  }
+  return r < 0 ? r : 0;
+}
+
+namespace {
+
+// fopencookie's functions for a stream on a pwm attribute's descriptor.
+ssize_t stream_read(void* cookie, char* buf, std::size_t n) {
+  return ::syscall(SYS_read, static_cast<int>(reinterpret_cast<std::intptr_t>(cookie)), buf, n);
+}
+ssize_t stream_write(void* cookie, const char* buf, std::size_t n) {
+  ssize_t r = 0;
+  if (!write_pwm_fd(static_cast<int>(reinterpret_cast<std::intptr_t>(cookie)), buf, n, r)) return -1;
+  return r < 0 ? 0 : r;  // 0: the C library's error for the stream (errno set)
+}
+int stream_close(void* cookie) { return close(static_cast<int>(reinterpret_cast<std::intptr_t>(cookie))); }
+
+}  // namespace
+
+FILE* pwm_stream(int fd, const char* mode) {
+  {
+    std::lock_guard lock(g_mutex);
+    if (!g_fds || g_fds->find(fd) == g_fds->end()) return nullptr;
+  }
+  cookie_io_functions_t io{};
+  io.read = stream_read;
+  io.write = stream_write;
+  io.close = stream_close;
+  return fopencookie(reinterpret_cast<void*>(static_cast<std::intptr_t>(fd)), mode, io);
 }
 
 void forget_pwm_fd(int fd) {

@@ -237,5 +237,33 @@ TEST_F(PwmSysfs, BadWritesGetTheKernelsErrors) {
   for (const auto& [k, v] : expected) EXPECT_EQ(f.count(k) ? f.at(k) : "(missing)", v) << k << "\n" << r.out;
 }
 
+TEST_F(PwmSysfs, AStreamFopenMadeWritesToTheBoardAndItsFcloseFailsWithTheKernelsError) {
+  const RunResult r = run_program({client("pwm_stck"), "stdio"}, env("L6474"), 60);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto f = key_values(r.out);
+  EXPECT_EQ(f.at("export"), "0");
+  EXPECT_EQ(f.at("period"), "0");
+  EXPECT_EQ(f.at("duty_over_period"), std::to_string(EINVAL));
+  EXPECT_EQ(f.at("duty"), "0");
+  EXPECT_EQ(f.at("duty_read"), "1000");
+}
+
+TEST_F(PwmSysfs, AShellsEchoIntoTheFilesReachesTheBoardWhenTheRedirectionEndsAndARefusalIsSaidInTheLog) {
+  const std::string script =
+      "C=/sys/class/pwm/pwmchip0; echo 0 > $C/export; echo 1000000 > $C/pwm0/period; "
+      "echo 500000 > $C/pwm0/duty_cycle; echo 1 > $C/pwm0/enable; "
+      "read p < $C/pwm0/period; read d < $C/pwm0/duty_cycle; read e < $C/pwm0/enable; "
+      "echo period=$p duty_cycle=$d enable=$e; echo 3 > $C/pwm0/enable; read e < $C/pwm0/enable; echo after=$e";
+  const RunResult r = run_program({"/bin/bash", "-c", script}, env("L6474"), 60);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto f = key_values(r.out);
+  EXPECT_EQ(f.at("period"), "1000000");
+  EXPECT_EQ(f.at("duty_cycle"), "500000");
+  EXPECT_EQ(f.at("enable"), "1");
+  EXPECT_EQ(f.at("after"), "1");
+  EXPECT_NE(r.err.find("/sys/class/pwm/pwmchip0/pwm0/enable: a write at close refused: Invalid argument"), std::string::npos)
+      << r.err;
+}
+
 }  // namespace
 }  // namespace l6470emu::test

@@ -6,6 +6,8 @@
        values and abs_pos=ABS_POS (22-bit, sign-extended).
      pwm_stck errors
        prints name=result/errno of writes and opens the kernel refuses (and of some it takes).
+     pwm_stck stdio
+       the same through fopen/fprintf/fclose: prints name=result/errno of each fclose.
    Exits 1 on an unexpected failure. */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -153,10 +155,34 @@ static int errors(void) {
   return 0;
 }
 
+/* fopen, fprintf, fclose: 0 or fclose's errno. */
+static int put_stream(const char* path, const char* text) {
+  FILE* f = fopen(path, "w");
+  if (!f) return errno;
+  fputs(text, f);
+  errno = 0;
+  return fclose(f) == 0 ? 0 : errno;
+}
+
+static int stdio(void) {
+  SAY("export", put_stream(CHIP "/export", "0\n"));
+  SAY("period", put_stream(CHIP "/pwm0/period", "2000\n"));
+  SAY("duty_over_period", put_stream(CHIP "/pwm0/duty_cycle", "3000\n"));
+  SAY("duty", put_stream(CHIP "/pwm0/duty_cycle", "1000\n"));
+  FILE* f = fopen(CHIP "/pwm0/duty_cycle", "r");
+  char line[32] = "";
+  if (!f || !fgets(line, sizeof line, f)) return 1;
+  fclose(f);
+  line[strcspn(line, "\n")] = 0;
+  printf("duty_read=%s\n", line);
+  return 0;
+}
+
 int main(int argc, char** argv) {
   setvbuf(stdout, NULL, _IONBF, 0);
   if (argc == 6 && strcmp(argv[1], "steps") == 0) return steps(argv[2], argv[3], argv[4], (unsigned)atoi(argv[5]));
   if (argc == 2 && strcmp(argv[1], "errors") == 0) return errors();
-  fprintf(stderr, "usage: pwm_stck steps L6474|L6470 PERIOD_NS DUTY_NS SECONDS | pwm_stck errors\n");
+  if (argc == 2 && strcmp(argv[1], "stdio") == 0) return stdio();
+  fprintf(stderr, "usage: pwm_stck steps L6474|L6470 PERIOD_NS DUTY_NS SECONDS | pwm_stck errors | pwm_stck stdio\n");
   return 2;
 }
