@@ -31,7 +31,7 @@ class Backend {
   virtual long spi_read(std::uint64_t handle, std::span<std::uint8_t> rx) = 0;
   virtual long spi_write(std::uint64_t handle, std::span<const std::uint8_t> tx) = 0;
   /// The kernel's pwm sysfs class (DeviceBoard::pwm_write; the files: pwm_sysfs.hpp): how many
-  /// pwmchips there are (pwmchipN is chain N). The default, the daemon's backend today: none.
+  /// pwmchips there are (pwmchipN is chain N). The default: none.
   virtual std::size_t pwm_chips() { return 0; }
   /// Channels of pwmchip `chain` (its chips).
   virtual std::size_t pwm_channels(std::size_t) { return 0; }

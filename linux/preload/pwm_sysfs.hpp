@@ -5,8 +5,8 @@
 // (DeviceBoard::pwm_write) and fails with the kernel's errno, and so does a write of a stream
 // fopen() made. Bytes that reach the memfd past the preload (the C library's own writes: a shell's
 // echo into a redirection) go to the board when the last descriptor of the file is closed or
-// replaced (dup2), their error returned by close() and said in the log. Only with a backend that
-// offers pwmchips (Backend::pwm_chips: the board in process; not yet the daemon).
+// replaced (dup2), their error returned by close() and said in the log. The board's pwmchips
+// (Backend::pwm_chips): in process, or the daemon's (Op::pwm), whose channels outlive a program.
 #pragma once
 
 #include <stdio.h>

@@ -265,5 +265,24 @@ TEST_F(PwmSysfs, AShellsEchoIntoTheFilesReachesTheBoardWhenTheRedirectionEndsAnd
       << r.err;
 }
 
+TEST_F(PwmSysfs, ThroughTheDaemonAChannelOutlivesTheProgramThatSetItAndStepsTheChipOnTheWallClock) {
+  ServeDaemon d("bus=0 cs=0 chips=L6470");
+  ASSERT_TRUE(d.ready());
+  const RunResult set = run_program(
+      {"/bin/bash", "-c", "C=/sys/class/pwm/pwmchip0; echo 0 > $C/export; echo 2000000 > $C/pwm0/period"}, d.env(), 60);
+  ASSERT_EQ(set.status, 0) << set.out << set.err;
+  const RunResult read = run_program({"/bin/cat", "/sys/class/pwm/pwmchip0/pwm0/period"}, d.env(), 60);
+  EXPECT_EQ(read.out, "2000000\n") << read.err;
+  const RunResult again = run_program({"/bin/bash", "-c", "echo 0 > /sys/class/pwm/pwmchip0/export"}, d.env(), 60);
+  EXPECT_NE(again.err.find("export: a write at close refused: Device or resource busy"), std::string::npos) << again.err;
+  ASSERT_EQ(run_program({"/bin/bash", "-c", "echo 0 > /sys/class/pwm/pwmchip0/unexport"}, d.env(), 60).status, 0);
+  const RunResult r = run_program({client("pwm_stck"), "steps", "L6470", "1000000", "500000", "1"}, d.env(), 60);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  // On the wall clock: at least the 1001 pulses of the second slept, a few more for the time around it.
+  const int steps = std::stoi(key_values(r.out).at("abs_pos"));
+  EXPECT_GE(steps, 1001);
+  EXPECT_LT(steps, 1500);
+}
+
 }  // namespace
 }  // namespace l6470emu::test
