@@ -207,6 +207,8 @@ TEST_F(PwmSysfs, BadWritesGetTheKernelsErrors) {
       {"export", "0"},
       {"export_again", std::to_string(EBUSY)},
       {"stat_pwm0", "0"},
+      {"list_chip", "export,npwm,pwm0,unexport"},
+      {"list_pwm0", "duty_cycle,enable,period,polarity"},
       {"stat_period_mode", std::to_string(0644)},
       {"period_at_export", "0"},
       {"duty_without_period", std::to_string(EINVAL)},

@@ -10,6 +10,7 @@
        the same through fopen/fprintf/fclose: prints name=result/errno of each fclose.
    Exits 1 on an unexpected failure. */
 #define _GNU_SOURCE
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <linux/spi/spidev.h>
@@ -116,6 +117,29 @@ static int steps(const char* variant, const char* period, const char* duty, unsi
 
 #define SAY(name, call) printf("%s=%d\n", name, (call))
 
+/* The names opendir/readdir list in `dir`, sorted, joined with commas ("errnoN" on failure). */
+static const char* listing(const char* dir) {
+  static char out[256];
+  char names[16][32];
+  int n = 0;
+  DIR* d = opendir(dir);
+  if (!d) {
+    snprintf(out, sizeof out, "errno%d", errno);
+    return out;
+  }
+  struct dirent* e;
+  while ((e = readdir(d)) != NULL && n < 16)
+    if (e->d_name[0] != '.') snprintf(names[n++], sizeof names[0], "%.31s", e->d_name);
+  closedir(d);
+  qsort(names, (size_t)n, sizeof names[0], (int (*)(const void*, const void*))strcmp);
+  out[0] = 0;
+  for (int i = 0; i < n; ++i) {
+    if (i) strcat(out, ",");
+    strcat(out, names[i]);
+  }
+  return out;
+}
+
 static int errors(void) {
   struct stat st;
   printf("npwm=%s\n", get(CHIP "/npwm"));
@@ -126,6 +150,8 @@ static int errors(void) {
   SAY("export", put(CHIP "/export", "0"));
   SAY("export_again", put(CHIP "/export", "0"));
   SAY("stat_pwm0", stat(CHIP "/pwm0", &st) == 0 && S_ISDIR(st.st_mode) ? 0 : errno);
+  printf("list_chip=%s\n", listing(CHIP));
+  printf("list_pwm0=%s\n", listing(CHIP "/pwm0"));
   SAY("stat_period_mode", stat(CHIP "/pwm0/period", &st) == 0 ? (int)(st.st_mode & 0777) : -errno);
   printf("period_at_export=%s\n", get(CHIP "/pwm0/period"));
   SAY("duty_without_period", put(CHIP "/pwm0/duty_cycle", "1000"));
