@@ -159,6 +159,28 @@ TEST(PwmDeviceBoard, AnHourOf10kHzOnAnL6474StepsItOncePerPulseAppliedInBulkNotPu
   EXPECT_LT(counts.single_edges, 10u);
 }
 
+TEST(PwmDeviceBoard, ADutyCycleOfZeroMakesNoStepOneOfTheWholePeriodOneAndInversedPolarityAsManyAsNormal) {
+  Rig r("bus=0 cs=0 chips=L6474; time=virtual");
+  r.byte(0xB8);  // Enable
+  const std::int32_t start = r.abs_pos();
+  ASSERT_GT(r.put(-1, PwmAttr::export_channel, "0"), 0);
+  ASSERT_GT(r.put(0, PwmAttr::period, "1000000"), 0);
+  ASSERT_GT(r.put(0, PwmAttr::enable, "1"), 0);  // duty 0: STCK held low
+  r.sleep_ms(10);
+  EXPECT_EQ(r.abs_pos(), start);
+  ASSERT_GT(r.put(0, PwmAttr::duty_cycle, "1000000"), 0);  // the whole period: STCK held high
+  r.sleep_ms(10);
+  const std::int32_t one = r.abs_pos();
+  EXPECT_EQ(std::abs(one - start), 1);
+  ASSERT_GT(r.put(0, PwmAttr::enable, "0"), 0);
+  ASSERT_GT(r.put(0, PwmAttr::duty_cycle, "250000"), 0);
+  ASSERT_GT(r.put(0, PwmAttr::polarity, "inversed"), 0);  // high 750 µs of each millisecond
+  ASSERT_GT(r.put(0, PwmAttr::enable, "1"), 0);
+  r.sleep_ms(10);
+  ASSERT_GT(r.put(0, PwmAttr::enable, "0"), 0);
+  EXPECT_EQ(std::abs(r.abs_pos() - one), 11);  // rising at 0, 1, ..., 10 ms
+}
+
 // ---- a program under the preload library -----------------------------------------------
 
 class PwmSysfs : public ::testing::Test {
@@ -186,6 +208,15 @@ TEST_F(PwmSysfs, AProgramStepsAnL6474TenThousandAndOneTimesWithTenSecondsOfAOneM
   // Rising edges at 0, 1, ..., 10000 ms after the enable: the one at the disable's instant counts.
   // DIR is low (nothing drives it): the L6474 steps in reverse.
   EXPECT_EQ(f.at("abs_pos"), "-10001") << r.out;
+}
+
+TEST_F(PwmSysfs, AProgramSleepingAnHourOf10kHzStepsAnL6474ThirtySixMillionAndOneTimes) {
+  const RunResult r = run_program({client("pwm_stck"), "steps", "L6474", "100000", "50000", "3600"}, env("L6474"), 60);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  const auto f = key_values(r.out);
+  EXPECT_EQ(f.at("slept_ns"), "3600000000000");
+  // -36 000 001 in ABS_POS's 22 bits.
+  EXPECT_EQ(std::stoi(f.at("abs_pos")), wrap22(-36'000'001)) << r.out;
 }
 
 TEST_F(PwmSysfs, AnL6470InStepClockModeMovesOneMicrostepForwardPerPulse) {
