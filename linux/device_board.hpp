@@ -31,6 +31,7 @@
 #include "linux/clock.hpp"
 #include "linux/gpio_lines.hpp"
 #include "linux/log.hpp"
+#include "linux/pwm_state.hpp"
 #include "linux/spidev_rules.hpp"
 #include "spi/trace.hpp"
 
@@ -193,6 +194,34 @@ class DeviceBoard {
   /// being recorded. False for a bad index or a chip without an axis.
   bool set_axis_load(std::size_t chain, std::size_t chip, const LoadSpec& load);
 
+  // ---- PWM (device_board_pwm.cpp): the kernel's pwm sysfs class on the chips' STCK ----------
+
+  /// PWM channels of chain `chain`'s pwmchip: one per chip, channel K driving chip K's STCK (chain
+  /// index, 0 nearest MISO, as the gpiochip numbers the chips' lines). 0 for a bad chain.
+  std::size_t pwm_channels(std::size_t chain) const;
+  /// A write of `text` to `attr` of chain `chain`'s pwmchip, as drivers/pwm/sysfs.c takes it:
+  /// export/unexport (`channel` ignored: the text names it) or a channel's period, duty_cycle,
+  /// enable, polarity. Returns text.size() or the kernel's -errno: -ENODEV for a channel past
+  /// npwm or an unexport of one not exported, -EBUSY for a second export, -EINVAL/-ERANGE for bad
+  /// text or a state pwm_apply refuses (pwm_state.hpp), -ENOENT for a channel not exported.
+  /// An enabled channel drives a pulse train on the chip's STCK (Board::drive_pulse_train) with
+  /// a 1 GHz count clock: period and duty are exact in nanoseconds, each edge at the board tick
+  /// (250 ns) at or before it, without drift. Enabling starts a period (the pin rises) now (on
+  /// the wall clock a microsecond on: the board's time moves while the call runs); a
+  /// change while enabled takes effect at the pin's next rising edge (the next period, as a
+  /// kernel PWM's); disabling or unexporting drives STCK low now, the pulses that rose up to now
+  /// (one rising now included) counted.
+  long pwm_write(std::size_t chain, int channel, PwmAttr attr, std::string_view text);
+  /// A read of `attr` (npwm, or a channel's file): 0 with the text in `out`, or -errno (-ENOENT:
+  /// a channel not exported; -ENODEV: a bad chain or channel; -EACCES: export/unexport).
+  long pwm_read(std::size_t chain, int channel, PwmAttr attr, std::string& out);
+  /// Whether channel `channel` of chain `chain` is exported.
+  bool pwm_exported(std::size_t chain, std::size_t channel);
+  /// The rising edges channel `channel`'s trains have made on STCK so far (Board::pulse_train_rises of the train on now).
+  std::uint64_t pwm_rises(std::size_t chain, std::size_t channel);
+  /// How the board's trains reached the chips (Board::pulse_train_counts: bulk or edge by edge).
+  Board::PulseTrainCounts pulse_train_counts();
+
   // ---- trace recording (the Board's, under the lock) ---------------------------------
 
   /// Starts recording chain `chain` into a native trace at `path` (truncated; a recording in
@@ -303,6 +332,19 @@ class DeviceBoard {
   /// index), in offset order; returns the tick the call lasts to (0: it drove no SPI line).
   Tick apply_values(Handle& h, const std::vector<unsigned>& indices, const std::vector<bool>& levels);
 
+  // PWM (device_board_pwm.cpp)
+  struct PwmChannel {
+    bool exported = false;
+    PwmSettings settings;
+    bool train_on = false;     ///< a pulse train drives STCK (else a steady level)
+    PulseTrain train;          ///< the train last started
+  };
+  PwmChannel* pwm_channel(std::size_t chain, std::size_t chip);
+  /// Makes the STCK of chip `chip` follow `next` (the channel's settings before in `ch`).
+  void apply_pwm(std::size_t chain, std::size_t chip, PwmChannel& ch, const PwmSettings& next);
+  /// Drives STCK of chip `chip` steadily to `level` now (through its gpio line when it has one).
+  void set_stck_level(std::size_t chain, std::size_t chip, bool level);
+
   // SPI at the pins (device_board_spi_pins.cpp): the host drives CS, SCK, MOSI (or MISO,
   // which the chips ignore); `at_request`: set by a line request's default output value.
   void set_spi_line(GpioDev& g, SpiLine line, bool level, bool at_request);
@@ -320,6 +362,7 @@ class DeviceBoard {
   MessageObserver observer_;
   std::unique_ptr<ScenarioRunner> scenario_;
   std::optional<std::string> first_unended_check_failure_;
+  std::vector<std::vector<PwmChannel>> pwm_;  // chain x chip, made on first use
 
   std::mutex m_;
   // Buses a sliced message owns until it ends (its caller sleeping between slices, the lock

@@ -255,6 +255,23 @@ void serve_request(DeviceBoard& board, const ControlHandler& control, std::span<
     }
     case Op::attach_shm:  // a matter of the connection (serve/daemon.cpp), not of the board
       break;
+    case Op::pwm: {
+      const int channel = static_cast<int>(static_cast<std::uint32_t>(req.arg)) - 1;
+      const std::uint64_t attr = (req.arg >> 32) & 0xFF;
+      if (attr > static_cast<std::uint64_t>(PwmAttr::polarity) || req.handle > board.chain_count()) {
+        reply.result = -EINVAL;
+        return;
+      }
+      if ((req.arg >> 40) & 1) {
+        const std::string text(payload.begin(), payload.end());
+        reply.result = board.pwm_write(static_cast<std::size_t>(req.handle), channel, static_cast<PwmAttr>(attr), text);
+      } else {
+        std::string text;
+        reply.result = board.pwm_read(static_cast<std::size_t>(req.handle), channel, static_cast<PwmAttr>(attr), text);
+        out.assign(text.begin(), text.end());
+      }
+      return;
+    }
   }
   reply.result = -EPROTO;
 }

@@ -35,7 +35,15 @@ enum class Op : std::uint32_t {
   spi_write = 7,    ///< handle, payload = tx data
   control = 8,      ///< payload = a ctl command line; reply: exit status and text
   attach_shm = 9,   ///< reply: result = region bytes, the region's memfd (see shm_channel.hpp)
+  pwm = 10,         ///< handle = chain, arg = pwm_request_arg(); payload = text written; reply payload = text read
 };
+
+/// Op::pwm's arg: the channel (-1: a pwmchip's own file), the attribute, and whether it is a
+/// write (DeviceBoard::pwm_write) or a read (DeviceBoard::pwm_read).
+inline std::uint64_t pwm_request_arg(int channel, PwmAttr attr, bool write) {
+  return static_cast<std::uint32_t>(channel + 1) | std::uint64_t{static_cast<std::uint8_t>(attr)} << 32 |
+         std::uint64_t{write} << 40;
+}
 
 inline constexpr std::uint64_t kOpenCloexec = std::uint64_t{1} << 63;
 

@@ -1,10 +1,14 @@
 // Replaced directory listing: opendir/readdir/closedir and scandir of /dev (and the sysfs
 // directories of the emulated view) also list the emulated nodes, so gpiodetect, gpiofind
-// and globbing for /dev/spidev* find them. Other directories are untouched.
+// and globbing for /dev/spidev* find them. A directory only the emulated view has
+// (/sys/class/pwm/pwmchip0 on a machine without PWM) lists its entries alone: its DIR is a
+// stand-in on "/" whose real entries are hidden (dirfd() of it is "/"). Other directories are
+// untouched.
 #include <dirent.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <mutex>
 #include <set>
@@ -24,6 +28,7 @@ namespace {
 struct Listing {
   std::vector<std::pair<std::string, unsigned char>> extra;
   std::set<std::string> seen;
+  bool hide_real = false;  // a stand-in for a directory only the emulated view has
   std::size_t next = 0;
   dirent current{};
 };
@@ -38,6 +43,17 @@ std::vector<std::pair<std::string, unsigned char>> extras_for(const char* path) 
     return virtual_dir_entries(path);
   } catch (...) {
     return {};
+  }
+}
+
+// Whether `path` is a directory only the emulated view has.
+bool virtual_only_dir(const char* path) {
+  if (!path || inside() || !active() || strncmp(path, "/sys/", 5) != 0) return false;
+  Guard guard;
+  try {
+    return lookup_virtual(path, true).type == VirtualPath::Type::directory && real::access(path, F_OK) != 0;
+  } catch (...) {
+    return false;
   }
 }
 
@@ -57,7 +73,7 @@ dirent* readdir_impl(DIR* dir) {
     if (it != g_listings->end()) l = &it->second;
   }
   const int saved = errno;
-  dirent* d = real::readdir(dir);
+  dirent* d = l && l->hide_real ? nullptr : real::readdir(dir);
   if (!l) return d;
   if (d) {
     l->seen.insert(d->d_name);
@@ -78,7 +94,7 @@ int scandir_impl(const char* path, dirent*** out, int (*filter)(const dirent*),
   auto extra = extras_for(path);
   if (extra.empty()) return real::scandir(path, out, filter, compar);
   dirent** list = nullptr;
-  const int n = real::scandir(path, &list, nullptr, nullptr);
+  const int n = virtual_only_dir(path) ? 0 : real::scandir(path, &list, nullptr, nullptr);
   if (n < 0) return n;
   std::vector<dirent*> kept;
   std::set<std::string> names;
@@ -121,7 +137,15 @@ extern "C" {
 
 __attribute__((visibility("default"))) DIR* opendir(const char* path) {
   DIR* d = real::opendir(path);
-  if (!d) return d;
+  bool hide_real = false;
+  if (!d) {
+    const int e = errno;
+    if (e != ENOENT || !virtual_only_dir(path) || !(d = real::opendir("/"))) {
+      errno = e;
+      return nullptr;
+    }
+    hide_real = true;
+  }
   try {
     auto extra = extras_for(path);
     if (!extra.empty()) {
@@ -130,9 +154,15 @@ __attribute__((visibility("default"))) DIR* opendir(const char* path) {
       Listing& l = (*g_listings)[d];
       l = Listing{};
       l.extra = std::move(extra);
+      l.hide_real = hide_real;
     }
   } catch (...) {
-    // Out of memory: list the real directory only.
+    // Out of memory: list the real directory only (a stand-in has none: no directory then).
+    if (hide_real) {
+      real::closedir(d);
+      errno = ENOMEM;
+      return nullptr;
+    }
   }
   return d;
 }

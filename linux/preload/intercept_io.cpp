@@ -12,6 +12,7 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <cstring>
@@ -19,6 +20,7 @@
 
 #include "linux/preload/descriptor_wait.hpp"
 #include "linux/preload/real.hpp"
+#include "linux/preload/pwm_sysfs.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/user_memory.hpp"
 #include "linux/preload/virtual_time.hpp"
@@ -266,7 +268,11 @@ __attribute__((visibility("default"))) ssize_t __read_chk(int fd, void* buf, siz
 
 __attribute__((visibility("default"))) ssize_t write(int fd, const void* buf, size_t count) {
   FdEntry* e = fd_entry(fd);
-  if (!e || inside()) return real::write(fd, buf, count);
+  if (!e || inside()) {
+    ssize_t r = 0;
+    if (!e && pwm_fds_exist() && !inside() && write_pwm_fd(fd, buf, count, r)) return r;
+    return real::write(fd, buf, count);
+  }
   Guard guard;
   try {
     return emulated_write(*e, buf, count);
@@ -274,6 +280,19 @@ __attribute__((visibility("default"))) ssize_t write(int fd, const void* buf, si
     errno = ENOMEM;
     return -1;
   }
+}
+
+// A sysfs attribute ignores the offset (pwm_sysfs.hpp); other files go to the C library.
+__attribute__((visibility("default"))) ssize_t pwrite(int fd, const void* buf, size_t count, off_t offset) {
+  ssize_t r = 0;
+  if (pwm_fds_exist() && !inside() && write_pwm_fd(fd, buf, count, r)) return r;
+  return syscall(SYS_pwrite64, fd, buf, count, offset);
+}
+
+__attribute__((visibility("default"))) ssize_t pwrite64(int fd, const void* buf, size_t count, off64_t offset) {
+  ssize_t r = 0;
+  if (pwm_fds_exist() && !inside() && write_pwm_fd(fd, buf, count, r)) return r;
+  return syscall(SYS_pwrite64, fd, buf, count, offset);
 }
 
 }  // extern "C"

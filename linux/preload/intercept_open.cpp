@@ -17,6 +17,7 @@
 #include "linux/preload/node_path.hpp"
 #include "linux/preload/check_exit.hpp"
 #include "linux/preload/real.hpp"
+#include "linux/preload/pwm_sysfs.hpp"
 #include "linux/preload/state.hpp"
 #include "linux/preload/sysfs.hpp"
 #include "linux/preload/virtual_time.hpp"
@@ -66,6 +67,7 @@ bool try_open(int dirfd, const char* path, int flags, int& fd) {
     if (walk == NodeWalk::not_ours) {
       note_missing_node(path);  // a /dev/spidev or gpiochip path the board lacks: said once
       if (std::strncmp(path, "/sys/", 5) != 0) return false;
+      if (open_pwm_file(path, flags, fd)) return true;
       const VirtualPath v = lookup_virtual(path, true);
       if (v.type == VirtualPath::Type::file) {
         fd = open_virtual_file(v, flags);
@@ -111,11 +113,13 @@ mode_t mode_arg(int flags, va_list ap) {
 void forget_fd(int fd) {
   if (FdEntry* e = fd_take(fd)) fd_release(e);
   forget_virtual_timerfd(fd);
+  forget_pwm_fd(fd);
 }
 
 // A descriptor the C library just handed out must not look emulated (stale entry).
 int fresh(int fd) {
   if (fd >= 0 && fd_entry(fd) && !in_vfork_child()) forget_fd(fd);
+  if (fd >= 0 && pwm_fds_exist() && !in_vfork_child()) forget_pwm_fd(fd);
   return fd;
 }
 
@@ -127,6 +131,7 @@ int dup_entry(int from, int to) {
     fd_store(to, e);
   } else {
     fresh(to);
+    if (pwm_fds_exist() && !in_vfork_child()) dup_pwm_fd(from, to);
   }
   return to;
 }
@@ -208,7 +213,8 @@ static FILE* fopen_impl(const char* path, const char* mode) {
     int fd;
     if (try_open(AT_FDCWD, path, flags, fd)) {
       if (fd < 0) return nullptr;
-      FILE* f = fdopen(fd, mode);
+      FILE* f = pwm_fds_exist() ? pwm_stream(fd, mode) : nullptr;
+      if (!f) f = fdopen(fd, mode);
       if (!f) {
         const int e = errno;
         close(fd);
@@ -230,8 +236,14 @@ __attribute__((visibility("default"))) int close(int fd) {
     return 0;
   }
   FdEntry* e = fd_entry(fd) && !in_vfork_child() ? fd_take(fd) : nullptr;
+  const long flushed = pwm_fds_exist() && !in_vfork_child() ? flush_pwm_fd(fd) : 0;
   const int r = real::close(fd);
   forget_virtual_timerfd(fd);
+  if (pwm_fds_exist() && !in_vfork_child()) forget_pwm_fd(fd);
+  if (r == 0 && flushed < 0) {  // a sysfs write refused: the kernel would have said so at write()
+    errno = static_cast<int>(-flushed);
+    return -1;
+  }
   if (e) {
     const int saved = errno;
     fd_release(e);
@@ -263,6 +275,7 @@ __attribute__((visibility("default"))) int dup(int fd) { return dup_entry(fd, re
 __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
   if (fd == fd2) return real::dup2(fd, fd2);
   FdEntry* old = fd_entry(fd2) && !in_vfork_child() ? fd_take(fd2) : nullptr;
+  if (pwm_fds_exist() && !in_vfork_child()) flush_pwm_fd(fd2);
   const int r = real::dup2(fd, fd2);
   if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {
@@ -276,6 +289,7 @@ __attribute__((visibility("default"))) int dup2(int fd, int fd2) {
 
 __attribute__((visibility("default"))) int dup3(int fd, int fd2, int flags) {
   FdEntry* old = (fd != fd2 && fd_entry(fd2) && !in_vfork_child()) ? fd_take(fd2) : nullptr;
+  if (fd != fd2 && pwm_fds_exist() && !in_vfork_child()) flush_pwm_fd(fd2);
   const int r = real::dup3(fd, fd2, flags);
   if (r >= 0) forget_virtual_timerfd(fd2);
   if (old) {

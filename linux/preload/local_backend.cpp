@@ -62,6 +62,14 @@ class LocalBackend final : public Backend {
     if (progress_kept()) progress_message(board_.time().now());
     return r;
   }
+  std::size_t pwm_chips() override { return board_.chain_count(); }
+  std::size_t pwm_channels(std::size_t chain) override { return board_.pwm_channels(chain); }
+  long pwm_write(std::size_t chain, int channel, PwmAttr attr, std::string_view text) override {
+    return board_.pwm_write(chain, channel, attr, text);
+  }
+  long pwm_read(std::size_t chain, int channel, PwmAttr attr, std::string& out) override {
+    return board_.pwm_read(chain, channel, attr, out);
+  }
   // The scheduler's lock before the board's: the scheduler moves the board while holding it.
   void before_fork() override {
     if (virtual_time_) virtual_time_->before_fork();

@@ -6,6 +6,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdlib>
@@ -127,6 +128,37 @@ class RemoteBackend final : public Backend {
     std::lock_guard lock(m_);
     if (!roundtrip_locked(req, tx, {}, rep, scratch_, fd, true)) return -ENODEV;
     return checked(rep.result);
+  }
+
+  // The daemon's pwmchips: one per chain (a spidev node each), their channels its npwm.
+  std::size_t pwm_chips() override {
+    return static_cast<std::size_t>(std::count_if(nodes_.begin(), nodes_.end(),
+                                                  [](const DeviceNode& n) { return n.type == DeviceNode::Type::spidev; }));
+  }
+  std::size_t pwm_channels(std::size_t chain) override {
+    std::string text;
+    if (pwm_read(chain, -1, PwmAttr::npwm, text) < 0) return 0;
+    return static_cast<std::size_t>(std::strtoul(text.c_str(), nullptr, 10));
+  }
+  long pwm_write(std::size_t chain, int channel, PwmAttr attr, std::string_view text) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::pwm), static_cast<std::uint32_t>(text.size()), chain,
+                      pwm_request_arg(channel, attr, true)};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()}, {}, rep, scratch_, fd,
+                          true))
+      return -ENODEV;
+    return static_cast<long>(rep.result);
+  }
+  long pwm_read(std::size_t chain, int channel, PwmAttr attr, std::string& out) override {
+    RequestHeader req{static_cast<std::uint32_t>(Op::pwm), 0, chain, pwm_request_arg(channel, attr, false)};
+    ReplyHeader rep;
+    int fd = -1;
+    std::lock_guard lock(m_);
+    if (!roundtrip_locked(req, {}, {}, rep, scratch_, fd, true)) return -ENODEV;
+    if (rep.result >= 0) out.assign(scratch_.begin(), scratch_.end());
+    return static_cast<long>(rep.result);
   }
 
   // check=error on the daemon's board: the reply carries the sanitizer's report instead of the

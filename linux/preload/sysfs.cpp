@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "linux/preload/node_path.hpp"
+#include "linux/preload/pwm_sysfs.hpp"
 #include "linux/preload/real.hpp"
 #include "linux/preload/state.hpp"
 
@@ -92,6 +93,8 @@ VirtualPath lookup_virtual(std::string_view path, bool follow) {
     return v;
   }
   if (path.size() < 5 || path.compare(0, 5, "/sys/") != 0) return v;
+  if (path.compare(0, 14, "/sys/class/pwm") == 0)
+    if (v = lookup_pwm(path); v.type != VirtualPath::Type::none) return v;
   const auto& ns = nodes();
   const std::string p = canonical(path, follow);
   for (const DeviceNode& n : ns) {
@@ -157,6 +160,9 @@ std::vector<std::pair<std::string, unsigned char>> virtual_dir_entries(std::stri
       if (parent_of(link) == d) out.emplace_back(link.substr(link.rfind('/') + 1), DT_LNK);
     if (d == kDevicesDir) out.emplace_back(n.name, DT_DIR);
   }
+  if (d.compare(0, 14, "/sys/class/pwm") == 0)
+    for (auto& e : pwm_dir_entries(d)) out.push_back(std::move(e));
+  if (d == "/sys/class" && !pwm_dir_entries("/sys/class/pwm").empty()) out.emplace_back("pwm", DT_DIR);
   return out;
 }
 
@@ -179,7 +185,7 @@ void fill_stat(const VirtualPath& v, struct stat* st) {
       st->st_nlink = 2;
       break;
     case VirtualPath::Type::file:
-      st->st_mode = S_IFREG | 0444;
+      st->st_mode = S_IFREG | (v.mode ? v.mode : 0444);
       st->st_size = 4096;  // sysfs attributes report a page
       break;
     case VirtualPath::Type::symlink:

@@ -1,7 +1,8 @@
 // The file-system view libgpiod and friends check before trusting a device node: the
 // /dev nodes themselves (character devices) and the sysfs entries that vouch for them
 // (/sys/bus/gpio/devices/gpiochipN/{dev,subsystem,uevent}, /sys/dev/char/MAJ:MIN,
-// /sys/class/spidev/spidevB.C). Everything is derived from the device-node catalogue.
+// /sys/class/spidev/spidevB.C). Everything is derived from the device-node catalogue; and
+// /sys/class/pwm, from the board's chains (pwm_sysfs.hpp).
 #pragma once
 
 #include <sys/stat.h>
@@ -20,6 +21,7 @@ struct VirtualPath {
   std::string content;  ///< file contents, or the symlink target
   unsigned major = 0, minor = 0;
   int node = -1;        ///< device node index for char devices
+  unsigned mode = 0;    ///< a file's permission bits (0: 0444)
 };
 
 /// What `path` is in the emulated view (Type::none: not ours, ask the real file system).
