@@ -13,7 +13,6 @@
 #include "board/scenario_runner.hpp"
 #include "daisychain/chip_numbering.hpp"
 #include "firmware/run.hpp"
-#include "firmware/spin_watch.hpp"
 
 extern char** environ;  // POSIX's, declared here: <unistd.h> is not for the OS-free fronts
 
@@ -234,7 +233,6 @@ void FirmwareRuntime::set_now(Tick tick) {
 void FirmwareRuntime::call() { spend(timing_.call_ticks); }
 
 void FirmwareRuntime::spend(Tick ticks) {
-  entries_ = entries_ + 1;
   if (now_ + ticks >= limit_ticks_) {
     set_now(std::max(now_, limit_ticks_));  // the run ends at the limit itself
     stop_at_limit();
@@ -254,7 +252,6 @@ void FirmwareRuntime::catch_up() {
 }
 
 void FirmwareRuntime::sleep_until(Tick tick) {
-  entries_ = entries_ + 1;
   const Tick target = std::min(tick, limit_ticks_);
   constexpr Tick kPollTicks = ticks_from_ms(1);
   while (now_ < target) {
@@ -948,12 +945,6 @@ FirmwareRuntime* open_firmware_runtime(const char* description, FirmwareFront fr
   if (!config.coverage.empty()) runtime->board().enable_coverage();
   g_runtime = runtime.release();  // lives until the program ends
   std::atexit(finish_at_exit);
-  static const std::string spinning =
-      "l6470emu: firmware: the program has run " + std::to_string(kSpinWatchSeconds) +
-      " s of CPU time without calling the Arduino, HAL or C API: virtual time stands still meanwhile, so a loop "
-      "waiting for a flag an interrupt or a timer callback sets never ends here (call delay(), yield() or any API "
-      "function in it; docs/firmware.md, \"Time\")\n";
-  start_spin_watch(g_runtime->entries(), spinning.c_str());
   // Under `l6470emu run`: its scenario, its time limit, its report (at exit, before finish_at_exit).
   if (const std::string why = join_run(*g_runtime); !why.empty()) fail_to_start(why);
   return g_runtime;

@@ -196,9 +196,6 @@ class FirmwareRuntime {
   void set_end_hook(std::function<void(RunEnd cause, std::string_view detail)> hook);
   /// Whether the program has clocked SPI bytes on the board.
   bool clocked_bytes() const { return clocked_; }
-  /// How many times the program has entered the runtime (every API call, every delay): the
-  /// spin watch (firmware/spin_watch.hpp) reads it from its signal handler.
-  const volatile std::uint64_t* entries() const { return &entries_; }
 
  private:
   struct Line;
@@ -278,7 +275,6 @@ class FirmwareRuntime {
   Tick limit_ticks_ = 0;   // the earlier of limit= and the run's limit
   std::function<void(RunEnd, std::string_view)> end_hook_;
   bool clocked_ = false;
-  volatile std::uint64_t entries_ = 0;
   std::string serial_in_;      // Serial input arrived: read up to serial_at_
   std::size_t serial_at_ = 0;
   std::unique_ptr<FirmwareTimers> timers_;
