@@ -124,8 +124,7 @@ std::string Board::chain_summary(std::size_t chain) const {
   const ChainState& c = state(chain);
   std::ostringstream o;
   o << c.config.path << ": " << c.chain.size() << " chip" << (c.chain.size() == 1 ? "" : "s") << " (";
-  for (std::size_t k = 0; k < c.config.chips.size(); ++k) o << (k ? "," : "") << c.config.chips[k]->name;
-  o << ")";
+  o << chip_list_text(c.config.chips) << ")";
   return o.str();
 }
 

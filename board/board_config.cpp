@@ -837,18 +837,23 @@ ParseResult parse_board_config(std::string_view text, std::string_view origin) {
   return {std::move(cfg), {}};
 }
 
+std::string chip_list_text(const std::vector<const Variant*>& chips) {
+  std::string out;
+  for (std::size_t i = 0; i < chips.size();) {
+    std::size_t run = 1;
+    while (i + run < chips.size() && chips[i + run] == chips[i]) ++run;
+    if (i) out += ',';
+    if (run > 1) out += std::to_string(run) + "x";
+    out += chips[i]->name;
+    i += run;
+  }
+  return out;
+}
+
 std::string describe_board_config(const BoardConfig& config) {
   std::ostringstream o;
   for (const auto& c : config.chains) {
-    o << "bus=" << c.bus << " cs=" << c.cs << " path=" << c.path << " chips=";
-    for (std::size_t i = 0; i < c.chips.size();) {
-      std::size_t run = 1;
-      while (i + run < c.chips.size() && c.chips[i + run] == c.chips[i]) ++run;
-      o << (i ? "," : "");
-      if (run > 1) o << run << "x";
-      o << c.chips[i]->name;
-      i += run;
-    }
+    o << "bus=" << c.bus << " cs=" << c.cs << " path=" << c.path << " chips=" << chip_list_text(c.chips);
     o << " gpiochip=" << (c.gpiochip ? std::to_string(*c.gpiochip) : std::string("none")) << " speed=" << c.max_speed_hz
       << " mode=" << unsigned{c.mode} << " bufsiz=" << c.bufsiz;
     for (const auto& [k, spec] : c.axes) {

@@ -111,6 +111,9 @@ std::string shown_text(std::string_view text, std::size_t max_chars = kQuotedTex
 /// shown_text in single quotes, followed by " (N bytes)" when cut.
 std::string quoted_text(std::string_view text);
 
+/// A chain's chips as chips= writes them, runs of one variant counted: "3xL6470,L6480".
+std::string chip_list_text(const std::vector<const Variant*>& chips);
+
 /// The config text of a board, as parse_board_config reads it back (for `serve` to print):
 /// scale= in wall time, idle= in virtual time when not the default 1 s, log/socket/trace when set,
 /// check= when not warn, check.allow= when it allows any rule.
