@@ -305,6 +305,11 @@ TEST(L6474Board, APinForAChipThatLacksItIsRefusedWithOneLineNamingIt) {
   EXPECT_TRUE(parse_board_config("chips=L6470,L6474 dir_pin=D4 busy_pin=D3", "T").config);
 }
 
+TEST(L6474Board, AChainSummaryCountsRunsOfAVariantAsChipsEqualsWritesThem) {
+  VirtualBoard v("bus=0 cs=0 chips=253xL6474,L6470,2xL6480; time=virtual");
+  EXPECT_EQ(v.board.chain_summary(0), "/dev/spidev0.0: 256 chips (253xL6474,L6470,2xL6480)");
+}
+
 TEST(L6474Board, StckAndDirDrivenThroughTheBoardMoveAbsPosByExactlyThePulses) {
   VirtualBoard v("bus=0 cs=0 chips=L6470,2xL6474; time=virtual");
   v.board.with_chain(0, [](Chain& c) {
