@@ -2,6 +2,7 @@
 #include "linux/protocol.hpp"
 
 #include "linux/clock.hpp"
+#include "linux/packet_memfd.hpp"
 #include "linux/shm_channel.hpp"
 
 #include <sys/socket.h>
@@ -66,27 +67,57 @@ std::string check_server_owner(int sock, const std::string& path) {
          "), not by you (user " + std::to_string(me) + ") or root: not talking to it";
 }
 
-bool send_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload, int fd) {
-  iovec iov[2] = {{const_cast<void*>(header), header_size},
-                  {const_cast<std::uint8_t*>(payload.data()), payload.size()}};
+namespace {
+
+// One datagram: `iov` with up to two descriptors (-1: none) in one SCM_RIGHTS message.
+bool send_datagram(int sock, iovec* iov, std::size_t iovlen, int fd0, int fd1) {
   msghdr msg{};
   msg.msg_iov = iov;
-  msg.msg_iovlen = payload.empty() ? 1 : 2;
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
-  if (fd >= 0) {
+  msg.msg_iovlen = iovlen;
+  alignas(cmsghdr) char control[CMSG_SPACE(2 * sizeof(int))] = {};
+  if (fd0 >= 0) {
+    const int fds[2] = {fd0, fd1};
+    const std::size_t count = fd1 >= 0 ? 2 : 1;
     msg.msg_control = control;
-    msg.msg_controllen = sizeof control;
+    msg.msg_controllen = CMSG_SPACE(count * sizeof(int));
     cmsghdr* c = CMSG_FIRSTHDR(&msg);
     c->cmsg_level = SOL_SOCKET;
     c->cmsg_type = SCM_RIGHTS;
-    c->cmsg_len = CMSG_LEN(sizeof(int));
-    std::memcpy(CMSG_DATA(c), &fd, sizeof fd);
+    c->cmsg_len = CMSG_LEN(count * sizeof(int));
+    std::memcpy(CMSG_DATA(c), fds, count * sizeof(int));
   }
   for (;;) {
     const ssize_t n = sendmsg(sock, &msg, MSG_NOSIGNAL);
     if (n >= 0) return true;
     if (errno != EINTR) return false;
   }
+}
+
+// The packet in a sealed memfd, under a BigPacketEnvelope: the memfd first, then `fd`.
+bool send_big_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload,
+                     int fd) {
+  const int memfd = seal_packet(header, header_size, payload);
+  if (memfd < 0) return false;
+  BigPacketEnvelope envelope;
+  envelope.size = header_size + payload.size();
+  iovec iov{&envelope, sizeof envelope};
+  const bool sent = send_datagram(sock, &iov, 1, memfd, fd);
+  const int e = errno;
+  ::close(memfd);  // the peer has its copy now (or is gone)
+  errno = e;
+  return sent;
+}
+
+}  // namespace
+
+bool send_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload, int fd) {
+  if (header_size + payload.size() > kInlinePacket) return send_big_packet(sock, header, header_size, payload, fd);
+  iovec iov[2] = {{const_cast<void*>(header), header_size},
+                  {const_cast<std::uint8_t*>(payload.data()), payload.size()}};
+  if (send_datagram(sock, iov, payload.empty() ? 1 : 2, fd, -1)) return true;
+  // A socket buffer smaller than kInlinePacket (a lowered wmem_default): the memfd way.
+  if (errno == EMSGSIZE) return send_big_packet(sock, header, header_size, payload, fd);
+  return false;
 }
 
 bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t spin_ns) {
@@ -100,7 +131,7 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
     msghdr msg{};
     msg.msg_iov = &iov;
     msg.msg_iovlen = 1;
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+    alignas(cmsghdr) char control[CMSG_SPACE(2 * sizeof(int))] = {};
     msg.msg_control = control;
     msg.msg_controllen = sizeof control;
     // Spinning a few microseconds before sleeping saves two scheduler wake-ups per round trip
@@ -117,23 +148,48 @@ bool recv_packet(int sock, Packet& packet, int& fd, bool cloexec, std::int64_t s
       continue;
     }
     if (n <= 0) return false;
-    // Every descriptor received is owned: the first is the packet's, any more (a peer that sent
-    // several) are closed at once, never kept open for good.
+    // Every descriptor received is owned: the first is the packet's (after a big packet's memfd,
+    // which comes first under a BigPacketEnvelope), any more (a peer that sent several) are
+    // closed at once, never kept open for good.
+    BigPacketEnvelope envelope{};
+    envelope.magic = 0;
+    if (static_cast<std::size_t>(n) == sizeof envelope) std::memcpy(&envelope, packet.data.get(), sizeof envelope);
+    const bool big = envelope.magic == kBigPacketMagic;
+    int memfd = -1;
     for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
       if (c->cmsg_level != SOL_SOCKET || c->cmsg_type != SCM_RIGHTS || c->cmsg_len < CMSG_LEN(0)) continue;
       const std::size_t count = (c->cmsg_len - CMSG_LEN(0)) / sizeof(int);
       for (std::size_t i = 0; i < count; ++i) {
         int received = -1;
         std::memcpy(&received, CMSG_DATA(c) + i * sizeof(int), sizeof received);
-        if (fd < 0)
+        if (big && memfd < 0)
+          memfd = received;
+        else if (fd < 0)
           fd = received;
         else
           ::close(received);
       }
     }
-    if (msg.msg_flags & MSG_TRUNC) {
+    if (msg.msg_flags & MSG_TRUNC) {  // no packet: nothing that came with it is kept
+      if (memfd >= 0) ::close(memfd);
+      if (fd >= 0) ::close(fd);
+      fd = -1;
       errno = EMSGSIZE;
       return false;
+    }
+    if (big) {
+      // The packet is the memfd's: checked (a memfd, sealed, of the size said, at most
+      // kMaxPacket) and read whole into the buffer, or the packet is refused with all it carried.
+      const bool loaded = envelope.reserved == 0 && load_packet(memfd, envelope.size, packet.data.get());
+      if (memfd >= 0) ::close(memfd);
+      if (!loaded) {
+        if (fd >= 0) ::close(fd);
+        fd = -1;
+        errno = EPROTO;
+        return false;
+      }
+      packet.size = static_cast<std::size_t>(envelope.size);
+      return true;
     }
     packet.size = static_cast<std::size_t>(n);
     return true;

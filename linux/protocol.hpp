@@ -1,7 +1,8 @@
 // The wire protocol between the preload library and `l6470emu serve`: one SOCK_SEQPACKET
 // connection per host process, strictly request/reply. A request is a RequestHeader and a
 // payload; a reply is a ReplyHeader, a payload and, for new files, one descriptor passed
-// with SCM_RIGHTS. After Op::attach_shm the same packets travel through a region of shared
+// with SCM_RIGHTS. A packet larger than kInlinePacket travels in a sealed memfd instead
+// (packet_memfd.hpp), whatever the socket's buffer. After Op::attach_shm the same packets travel through a region of shared
 // memory (shm_channel.hpp) instead, and the socket carries only what the region cannot:
 // descriptors and packets larger than its areas. Both ends are built from this one header
 // (same machine, same build).
@@ -80,6 +81,10 @@ std::string encode_catalogue(const std::vector<DeviceNode>& nodes);
 std::vector<DeviceNode> decode_catalogue(const std::string& text);
 
 /// Sends `header` + `payload` (+ `fd` if >= 0) as one packet. Returns false on error (errno set).
+/// A packet of at most kInlinePacket bytes is one datagram, as it always was; a larger one (or
+/// one the socket's buffer refuses with EMSGSIZE) travels in a sealed memfd under a
+/// BigPacketEnvelope (packet_memfd.hpp), the memfd first in its SCM_RIGHTS message and `fd`
+/// second. EMSGSIZE for a packet larger than kMaxPacket.
 bool send_packet(int sock, const void* header, std::size_t header_size, std::span<const std::uint8_t> payload, int fd);
 /// A receive buffer as large as the largest packet (allocated, not touched: pages are used on demand).
 struct Packet {
@@ -99,6 +104,10 @@ std::optional<std::string> decode_refusal(std::span<const std::uint8_t> packet);
 std::string check_server_owner(int sock, const std::string& path);
 
 /// Receives one packet; `fd` gets a passed descriptor or -1 (`cloexec` sets close-on-exec on it).
+/// A big packet (BigPacketEnvelope) is read from its memfd into `packet`, the memfd closed; one
+/// whose memfd is missing, not a sealed memfd, of another size than its envelope says or larger
+/// than kMaxPacket is refused: false with errno EPROTO, every descriptor that came with it closed.
+/// Descriptors beyond the packet's one (and the memfd) are always closed.
 /// Polls without sleeping for up to `spin_ns` first. Returns false on EOF or error. A packet the
 /// peer sent before it closed the connection is still received (a refusal), even when the kernel
 /// reports the reset first.

@@ -3,6 +3,7 @@
 // says exactly what is wrong. (The fuzz harness covers the packet decoder itself.)
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -20,6 +21,7 @@
 #include <filesystem>
 #include <gtest/gtest.h>
 
+#include "linux/packet_memfd.hpp"
 #include "linux/protocol.hpp"
 #include "raw_client.hpp"
 #include "run_program.hpp"
@@ -226,6 +228,97 @@ TEST_F(DaemonLimits, DescriptorsAClientSendsWithAPacketAreNeverKeptOpen) {
   }
   EXPECT_LE(after, before + 2) << "50 packets of two descriptors each";
   close(spare);
+}
+
+TEST_F(DaemonLimits, ForgedBigPacketEnvelopesAreRefusedWithoutAnyDescriptorKept) {
+  ServeDaemon d(kChain);
+  ASSERT_TRUE(d.ready()) << d.process().out();
+  const RequestHeader hello{static_cast<std::uint32_t>(Op::hello), 0, 0, kProtocolVersion};
+  // A memfd holding a hello of `size` bytes (the header, then zeros), sealed or not.
+  auto memfd = [&](std::size_t size, bool seal) {
+    const int fd = memfd_create("forged", MFD_CLOEXEC | MFD_ALLOW_SEALING);
+    if (fd < 0 || ftruncate(fd, static_cast<off_t>(size)) != 0) return -1;
+    (void)pwrite(fd, &hello, std::min(size, sizeof hello), 0);
+    if (seal) (void)fcntl(fd, F_ADD_SEALS, F_SEAL_WRITE | F_SEAL_GROW | F_SEAL_SHRINK);
+    return fd;
+  };
+  // Sends an envelope saying `size` with `fds` (closed after) and, when `wait`, waits for the
+  // hang-up (the daemon reaps a finished connection within a second). Whether the daemon
+  // answered with a packet (it must not).
+  bool wait = true;
+  auto forged = [&](std::uint64_t size, std::vector<int> fds) {
+    const int fd = connect_to(d.socket());
+    if (fd < 0) return true;
+    BigPacketEnvelope e;
+    e.size = size;
+    iovec iov{&e, sizeof e};
+    alignas(cmsghdr) char control[CMSG_SPACE(2 * sizeof(int))] = {};
+    msghdr msg{};
+    msg.msg_iov = &iov;
+    msg.msg_iovlen = 1;
+    if (!fds.empty()) {
+      msg.msg_control = control;
+      msg.msg_controllen = CMSG_SPACE(fds.size() * sizeof(int));
+      cmsghdr* c = CMSG_FIRSTHDR(&msg);
+      c->cmsg_level = SOL_SOCKET;
+      c->cmsg_type = SCM_RIGHTS;
+      c->cmsg_len = CMSG_LEN(fds.size() * sizeof(int));
+      std::memcpy(CMSG_DATA(c), fds.data(), fds.size() * sizeof(int));
+    }
+    (void)sendmsg(fd, &msg, MSG_NOSIGNAL);
+    for (int f : fds) close(f);
+    if (!wait) {  // the packet stays queued for the daemon after we close
+      close(fd);
+      return false;
+    }
+    char buf[256];
+    timeval tv{5, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    const ssize_t n = recv(fd, buf, sizeof buf, 0);
+    close(fd);
+    return n > 0;
+  };
+  auto all_forgeries = [&] {
+    int pipe_fds[2];
+    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return true;
+    bool answered = forged(200000, {});                                   // no memfd
+    answered |= forged(200000, {memfd(100000, true)});                    // another size
+    answered |= forged(kMaxPacket + 1, {memfd(kMaxPacket + 1, true)});    // larger than a packet
+    answered |= forged(200000, {memfd(200000, false)});                   // not sealed
+    answered |= forged(200000, {pipe_fds[0], pipe_fds[1]});               // not a memfd
+    answered |= forged(200000, {memfd(100000, true), memfd(10, true)});   // wrong, with a second
+    return answered;
+  };
+  EXPECT_FALSE(all_forgeries());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const std::size_t before = open_descriptors(d.process().pid());
+  wait = false;
+  for (int i = 0; i < 10; ++i) all_forgeries();
+  wait = true;
+  EXPECT_FALSE(forged(200000, {memfd(100000, true), memfd(10, true)}));  // the daemon read them all
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));          // and reaped their connections
+  std::size_t after = open_descriptors(d.process().pid());
+  for (int i = 0; i < 40 && after > before + 2; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    after = open_descriptors(d.process().pid());
+  }
+  EXPECT_LE(after, before + 2) << "61 forged envelopes";
+  // A well-formed big packet (a hello padded past the inline limit is refused by its size, but
+  // answered) and an ordinary client are still served.
+  const int fd = connect_to(d.socket());
+  ASSERT_GE(fd, 0);
+  const std::vector<std::uint8_t> padding(kInlinePacket + 1);
+  ASSERT_TRUE(send_packet(fd, &hello, sizeof hello, padding, -1));
+  Packet reply;
+  int passed = -1;
+  ASSERT_TRUE(recv_packet(fd, reply, passed, true));
+  EXPECT_EQ(passed, -1);
+  ReplyHeader rep;
+  ASSERT_GE(reply.size, sizeof rep);
+  std::memcpy(&rep, reply.data.get(), sizeof rep);
+  EXPECT_EQ(rep.result, -EPROTO) << "the header says no payload, the packet has one";
+  close(fd);
+  EXPECT_TRUE(served_within_5s(d.socket()));
 }
 
 TEST_F(DaemonLimits, OutOfMemoryForAClientRefusesItAndTheDaemonServesOn) {

@@ -92,6 +92,31 @@ TEST_F(DaemonSharedMemory, MessagesLargerThanTheRegionGoByTheSocketWithTheSameAn
   EXPECT_NE(daemon.out.find("GetStatus: r=3 "), std::string::npos) << daemon.out;
 }
 
+TEST_F(DaemonSharedMemory, MessagesLargerThanTheSocketBufferTravelInAMemfdWithTheSameAnswers) {
+  // More than one datagram can carry (wmem_default, about 208 KiB), up to bufsiz's largest; a
+  // fresh daemon for each run, as in process (the chip's status flags carry over between runs).
+  const std::string chain = std::string(kChain) + " bufsiz=4194304";
+  for (const std::string bytes : {"300000", "4000000"}) {
+    const RunResult in_process =
+        run_program({client("spidev_large"), "/dev/spidev0.0", bytes},
+                    {{"LD_PRELOAD", preload_library()}, {"L6470EMU_CHAIN", chain + "; time=virtual"}, {"L6470EMU_LOG", "off"}});
+    ASSERT_EQ(in_process.status, 0) << in_process.err;
+    EXPECT_NE(in_process.out.find("message: r=" + bytes + " "), std::string::npos) << in_process.out;
+    EXPECT_NE(in_process.out.find("write: r=" + bytes + "\n"), std::string::npos) << in_process.out;
+    EXPECT_NE(in_process.out.find("read: r=" + bytes + " "), std::string::npos) << in_process.out;
+    EXPECT_NE(in_process.out.find("GetStatus: r=3 "), std::string::npos) << in_process.out;
+    for (int shared = 0; shared < 2; ++shared) {
+      ServeDaemon d(chain, {"--virtual-time"});
+      ASSERT_TRUE(d.ready()) << d.process().out();
+      const RunResult daemon =
+          run_program({client("spidev_large"), "/dev/spidev0.0", bytes}, shared ? d.env() : socket_only(d));
+      ASSERT_EQ(daemon.status, 0) << daemon.err;
+      EXPECT_EQ(daemon.out, in_process.out) << bytes << (shared ? " bytes, shared region" : " bytes, socket only");
+      EXPECT_EQ(d.ctl({"clients"}).status, 0) << "the daemon still serves";
+    }
+  }
+}
+
 TEST_F(DaemonSharedMemory, AClientKilledWhileTheDaemonSleepsOnItsFutexEndsOnlyItsConnection) {
   ServeDaemon d(kChain);
   ASSERT_TRUE(d.ready()) << d.process().out();
