@@ -116,7 +116,7 @@ std::optional<Scenario> deserialize_scenario(std::string_view text, std::string&
       if (js.contains("do")) {
         const json& a = js.at("do");
         ScenarioAction act;
-        act.kind = enum_at<ScenarioAction::Kind>(a, "kind", 7);
+        act.kind = enum_at<ScenarioAction::Kind>(a, "kind", static_cast<unsigned>(ScenarioAction::Kind::dir) + 1);  // dir: the last
         act.chip = chip_of(a.at("chip"));
         act.level = a.at("level").get<bool>();
         act.fault = enum_at<TraceFault>(a, "fault", kTraceFaultCount);

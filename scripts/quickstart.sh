@@ -76,8 +76,8 @@ case "$what" in
         tests build-asan -LE '^docs$'  # the site: built once, above
     }
     stage "tests under AddressSanitizer + UndefinedBehaviorSanitizer" sanitized_tests
-    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, every harness 18 s, $(nproc) at a time)" \
-      env L6470EMU_FUZZ_TREE=build-asan scripts/fuzz.sh 18
+    stage "bounded fuzz pass (libFuzzer + ASan/UBSan, every harness 12 s, $(nproc) at a time)" \
+      env L6470EMU_FUZZ_TREE=build-asan scripts/fuzz.sh 12
     ;;
   *)
     echo "usage: scripts/quickstart.sh demo|test" >&2

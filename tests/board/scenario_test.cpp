@@ -561,6 +561,11 @@ TEST(ScenarioRunner, ADirStepTurnsTheWayAnL6474StepsAndIsRefusedForAChipWithoutT
     ADD_FAILURE() << f.where << ": " << f.what << ": expected " << f.expected << ", seen " << f.seen;
   EXPECT_EQ(runner.judged(), 1u);
   EXPECT_NE(runner.log().at(0).find("DIR low (reverse)"), std::string::npos) << runner.log().at(0);
+  // run's exchange form carries the step (the fuzzer found it refused as "bad kind").
+  std::string error;
+  const std::optional<Scenario> back = deserialize_scenario(serialize_scenario(s), error);
+  ASSERT_TRUE(back) << error;
+  EXPECT_EQ(*back, s);
 
   VirtualBoard l6470("chips=L6470; time=virtual");
   try {
