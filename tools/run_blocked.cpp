@@ -1,5 +1,6 @@
 // What a run's threads are blocked in, from /proc (tools/run_blocked.hpp).
 #include "tools/run_blocked.hpp"
+#include "tools/proc_files.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -16,21 +17,8 @@
 namespace l6470emu {
 namespace {
 
-bool is_number(const char* s) {
-  if (!*s) return false;
-  for (; *s; ++s)
-    if (*s < '0' || *s > '9') return false;
-  return true;
-}
-
 std::string read_text(const std::string& path) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return {};
-  char buf[512];
-  const ssize_t n = read(fd, buf, sizeof buf - 1);
-  close(fd);
-  if (n <= 0) return {};
-  std::string s(buf, static_cast<std::size_t>(n));
+  std::string s = read_small_file(path, 511);
   while (!s.empty() && (s.back() == '\n' || s.back() == '\0')) s.pop_back();
   return s;
 }
@@ -39,7 +27,7 @@ std::vector<std::string> numbered_entries(const std::string& dir) {
   std::vector<std::string> out;
   if (DIR* d = opendir(dir.c_str())) {
     while (const dirent* e = readdir(d))
-      if (is_number(e->d_name)) out.emplace_back(e->d_name);
+      if (is_pid_name(e->d_name)) out.emplace_back(e->d_name);
     closedir(d);
   }
   return out;

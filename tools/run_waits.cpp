@@ -17,26 +17,10 @@
 
 #include "linux/process_waits.hpp"
 #include "linux/unix_socket_diag.hpp"
+#include "tools/proc_files.hpp"
 
 namespace l6470emu {
 namespace {
-
-bool is_number(const char* s) {
-  if (!*s) return false;
-  for (; *s; ++s)
-    if (*s < '0' || *s > '9') return false;
-  return true;
-}
-
-std::string read_small_file(const std::string& path, std::size_t limit = 1 << 20) {
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return {};
-  std::string text;
-  char buf[4096];
-  for (ssize_t n; text.size() < limit && (n = read(fd, buf, sizeof buf)) > 0;) text.append(buf, static_cast<std::size_t>(n));
-  close(fd);
-  return text;
-}
 
 struct ProcessInfo {
   pid_t parent = 0;
@@ -50,7 +34,7 @@ std::map<pid_t, ProcessInfo> all_processes() {
   DIR* d = opendir("/proc");
   if (!d) return out;
   while (const dirent* e = readdir(d)) {
-    if (!is_number(e->d_name)) continue;
+    if (!is_pid_name(e->d_name)) continue;
     const std::string stat = read_small_file(std::string("/proc/") + e->d_name + "/stat", 4096);
     const std::size_t open_paren = stat.find('('), close_paren = stat.rfind(')');
     if (open_paren == std::string::npos || close_paren == std::string::npos || close_paren < open_paren) continue;
@@ -92,7 +76,7 @@ std::set<pid_t> holders(const std::map<pid_t, ProcessInfo>& all, const std::stri
     DIR* d = opendir(dir.c_str());
     if (!d) continue;
     while (const dirent* e = readdir(d)) {
-      if (!is_number(e->d_name)) continue;
+      if (!is_pid_name(e->d_name)) continue;
       char link[64];
       const ssize_t n = readlink((dir + "/" + e->d_name).c_str(), link, sizeof link - 1);
       if (n > 0 && std::string(link, static_cast<std::size_t>(n)) == target) {
@@ -141,7 +125,7 @@ std::map<pid_t, ProcessWaits> RunWaits::published() const {
   std::map<pid_t, ProcessWaits> out;
   if (DIR* d = opendir(dir_.c_str())) {
     while (const dirent* e = readdir(d))
-      if (is_number(e->d_name))
+      if (is_pid_name(e->d_name))
         if (const auto w = parse_process_waits(read_small_file(dir_ + "/" + e->d_name)))
           out[static_cast<pid_t>(std::atol(e->d_name))] = *w;
     closedir(d);
