@@ -282,7 +282,7 @@ while not status() & 0x0002:
       {{"--faults", "ocd"}, {c, "deadlock"}, 1},
       {{"--faults", "ocd,reset"}, {system_python(), py, "one"}, 1},
       {{"--faults", "ocd"}, {system_python(), py, "threads"}, 0},
-      {{"--faults", "ocd", "--at", "during_motion", "--wall-timeout", "2"}, {system_python(), py, "fifo", dir_.string()}, 1},
+      {{"--faults", "ocd", "--at", "during_motion", "--wall-timeout", "4"}, {system_python(), py, "fifo", dir_.string()}, 1},
   };
   for (const Case& k : cases) {
     std::string json[2];
@@ -324,7 +324,7 @@ TEST_F(Campaign, WhatARerunEndedAtItsWallClockLimitLeftRunningInASessionOfItsOwn
                            "  setsid sh -c 'echo $$ > \"$1\"; read x < \"$2\"' sh \"$2/left.$$\" \"$2/held.$$\" &\n"
                            "  mkfifo \"$2/fifo.$$\"; read x < \"$2/fifo.$$\"\nfi\n";
   const RunResult r = run_program({l6470emu_program(), "campaign", "--chain", "chips=L6470 check=warn", "--faults", "ocd", "--at",
-                                   "during_motion", "--wall-timeout", "2", "--json", path("c.json"), "--", "/bin/sh",
+                                   "during_motion", "--wall-timeout", "4", "--json", path("c.json"), "--", "/bin/sh",
                                    script, client("campaign_driver"), dir_.string()},
                                   {}, 120);
   EXPECT_EQ(r.status, 1) << r.err;  // the rerun: hang

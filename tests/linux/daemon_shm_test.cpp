@@ -153,7 +153,11 @@ TEST_F(DaemonSharedMemory, ADaemonKilledWhileAClientWaitsOnTheRegionGivesTheClie
   ServeDaemon d(kChain);
   ASSERT_TRUE(d.ready()) << d.process().out();
   Background reader({client("spidev_reader"), "/dev/spidev0.0", "100000000", "0x01", "0"}, d.env());
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // Killed once the reader is on the shared region (not before it has connected: that is another
+  // error, from open).
+  for (int i = 0; i < 500 && shared_requests(d.ctl({"clients"}).out) < 1; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
   d.process().stop(SIGKILL);
   const RunResult r = reader.wait(10);
   EXPECT_EQ(r.status, 1) << "the client hung (killed after 10 s) or went on: " << r.out << r.err;

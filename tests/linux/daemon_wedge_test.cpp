@@ -85,7 +85,7 @@ TEST_F(DaemonWedge, ALiveClientNeverWaitsOutTheBusTimeOfADeadOne) {
                   d.env());
   for (int i = 0; i < 1000 && slow.out().find("start") == std::string::npos; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // in the middle of its message
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));  // in the middle of its message (8.6 s, started well before)
   EXPECT_EQ(slow.stop(SIGKILL).out, "start\n");
   const RunResult fast = run_program(
       {system_python(), "-c",

@@ -3,6 +3,7 @@
 // vendor example that sleeps, and BUSY edges arriving as libgpiod events. Bounds are one-sided
 // where the design guarantees them (the board never runs ahead of the host) and generous where
 // the scheduler adds noise, so they cannot flake.
+#include <functional>
 #include <map>
 #include <sstream>
 
@@ -43,33 +44,44 @@ class HostTime : public ::testing::TestWithParam<bool> {
 };
 
 /// A polled Move, as the host measured it: never shorter than the profile (the board cannot run
-/// ahead of the host's clock), and within 5 % plus scheduling noise of it.
-void expect_move_seen_to_last_its_profile(const std::map<std::string, std::string>& f, std::uint32_t full_steps,
-                                          double poll_s) {
-  ASSERT_TRUE(f.count("released")) << "no result";
+/// ahead of the host's clock), and within 5 % plus scheduling noise of it. `measure` runs the move
+/// and returns what the host printed. The lower bound holds on every run; the upper one is load's
+/// to break (a stall of the host between the Move and its poll), so it must hold on one of three.
+void expect_move_seen_to_last_its_profile(const std::function<std::map<std::string, std::string>()>& measure,
+                                          std::uint32_t full_steps, double poll_s) {
   const double profile = seconds(move_profile_ticks(true, full_steps * 128));
-  const double seen = std::stod(f.at("released")) - std::stod(f.at("start"));
-  EXPECT_GE(seen, profile) << full_steps << " full steps";
-  EXPECT_LE(seen, profile * 1.05 + poll_s + 0.25) << full_steps << " full steps";
+  const double bound = profile * 1.05 + poll_s + 0.25;
+  double seen = 0;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const auto f = measure();
+    ASSERT_TRUE(f.count("released")) << "no result";
+    seen = std::stod(f.at("released")) - std::stod(f.at("start"));
+    EXPECT_GE(seen, profile) << full_steps << " full steps";
+    if (seen <= bound) return;
+  }
+  ADD_FAILURE() << full_steps << " full steps: seen " << seen << " s, more than " << bound << " s, three times";
 }
 
 TEST_P(HostTime, PySpidevPollingAMoveSeesBusyReleasedAfterTheProfileDuration) {
-  for (std::uint32_t steps : {200u, 1000u}) {
-    const auto f = python({"poll-move", std::to_string(steps), "5000000"});
-    expect_move_seen_to_last_its_profile(f, steps, 0.001);
-  }
+  for (std::uint32_t steps : {200u, 1000u})
+    expect_move_seen_to_last_its_profile([&] { return python({"poll-move", std::to_string(steps), "5000000"}); },
+                                         steps, 0.001);
 }
 
 TEST_P(HostTime, PySpidevPollingAt10kHzSeesTheSameDuration) {
-  const auto f = python({"poll-move", "200", "10000"});
-  expect_move_seen_to_last_its_profile(f, 200, 3 * 8 / 10'000.0 + 0.001);  // one GetStatus at 10 kHz
+  expect_move_seen_to_last_its_profile([&] { return python({"poll-move", "200", "10000"}); }, 200,
+                                       3 * 8 / 10'000.0 + 0.001);  // one GetStatus at 10 kHz
 }
 
 TEST_P(HostTime, ACDriverPollingAMoveSeesBusyReleasedAfterTheProfileDuration) {
   for (const char* hz : {"10000", "5000000"}) {
-    const RunResult r = run_program({client("poll_move"), "/dev/spidev0.0", "200", hz}, env(), 60);
-    ASSERT_EQ(r.status, 0) << r.out << r.err;
-    expect_move_seen_to_last_its_profile(key_values(r.out), 200, 0.003);
+    expect_move_seen_to_last_its_profile(
+        [&] {
+          const RunResult r = run_program({client("poll_move"), "/dev/spidev0.0", "200", hz}, env(), 60);
+          EXPECT_EQ(r.status, 0) << r.out << r.err;
+          return key_values(r.out);
+        },
+        200, 0.003);
   }
 }
 
@@ -90,17 +102,24 @@ TEST_P(HostTime, AVendorExampleThatRunsSleepsAndReadsSpeedSeesFullSpeed) {
 }
 
 TEST_P(HostTime, ABusyEdgeAfterHeavyPollingArrivesOnTimeStampedWithTheHostClock) {
-  const auto f = python({"edge-after-poll"});
-  ASSERT_NE(f.count("edge"), 0u);
-  ASSERT_NE(f.at("edge"), "None") << "no rising edge within 5 s";
-  const double profile = seconds(move_profile_ticks(false, 200 * 128));
-  const double start = std::stod(f.at("start")) / 1e9, sent = std::stod(f.at("sent")) / 1e9;
-  const double edge = std::stod(f.at("edge")) / 1e9, received = std::stod(f.at("received")) / 1e9;
-  // The Move was decoded between start and sent; its edge is stamped at the host's clock then.
-  EXPECT_GE(edge - start, profile - 0.001);
-  EXPECT_LE(edge - sent, profile + 0.001);
-  EXPECT_GE(received, edge);
-  EXPECT_LT(received - edge, 0.2) << "the edge reached the host late";
+  // The stamps hold on every run; the delivery's lateness is load's to break, so it must be under
+  // 0.2 s on one of three runs.
+  double late = 0;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const auto f = python({"edge-after-poll"});
+    ASSERT_NE(f.count("edge"), 0u);
+    ASSERT_NE(f.at("edge"), "None") << "no rising edge within 5 s";
+    const double profile = seconds(move_profile_ticks(false, 200 * 128));
+    const double start = std::stod(f.at("start")) / 1e9, sent = std::stod(f.at("sent")) / 1e9;
+    const double edge = std::stod(f.at("edge")) / 1e9, received = std::stod(f.at("received")) / 1e9;
+    // The Move was decoded between start and sent; its edge is stamped at the host's clock then.
+    EXPECT_GE(edge - start, profile - 0.001);
+    EXPECT_LE(edge - sent, profile + 0.001);
+    EXPECT_GE(received, edge);
+    late = received - edge;
+    if (late < 0.2) return;
+  }
+  ADD_FAILURE() << "the edge reached the host late three times, the last by " << late << " s";
 }
 
 INSTANTIATE_TEST_SUITE_P(InProcessAndThroughTheDaemon, HostTime, ::testing::Values(false, true),

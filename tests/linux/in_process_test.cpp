@@ -165,16 +165,21 @@ TEST_F(InProcess, PythonLibgpiodSeesBusyWhileAMoveRunsAndReleaseWhenItEnds) {
 
 TEST_F(InProcess, TimeScaleMakesTheMoveTakeLessWallTime) {
   const RunResult slow = run_program({system_python(), script("busy_during_move.py"), "0", "0"}, env());
-  const RunResult fast =
-      run_program({system_python(), script("busy_during_move.py"), "0", "0"}, env("bus=0 cs=0 chips=L6470; scale=20"));
-  ASSERT_EQ(fast.status, 0) << fast.err;
   auto seconds = [](const std::string& out) {
     const auto at = out.find("move_seconds=");
     return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 13));
   };
   EXPECT_GT(seconds(slow.out), 0.15) << slow.out;  // 3200 microsteps at the reset profile: about 0.22 s
-  EXPECT_LT(seconds(fast.out), 0.1) << fast.out;  // 20 times faster: about 0.011 s plus scheduling
-  EXPECT_TRUE(has_line(fast.out, "abs_pos=-3200")) << fast.out;
+  // 20 times faster: about 0.011 s plus scheduling, which a loaded machine can stretch on one run
+  // (not on three: an unscaled move always takes its 0.22 s).
+  RunResult fast;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    fast = run_program({system_python(), script("busy_during_move.py"), "0", "0"}, env("bus=0 cs=0 chips=L6470; scale=20"));
+    ASSERT_EQ(fast.status, 0) << fast.err;
+    EXPECT_TRUE(has_line(fast.out, "abs_pos=-3200")) << fast.out;
+    if (seconds(fast.out) >= 0 && seconds(fast.out) < 0.1) break;
+  }
+  EXPECT_LT(seconds(fast.out), 0.1) << fast.out;
 }
 
 TEST_F(InProcess, StckPulsesAndStbyFromTheHostReachTheChipConfiguredByAFile) {

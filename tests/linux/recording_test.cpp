@@ -106,9 +106,9 @@ TEST_F(Recording, AHostKilledMidRunLeavesATraceCompleteUpToItsLastFrame) {
                     {{"LD_PRELOAD", preload_library()},
                      {"L6470EMU_CHAIN", "bus=0 cs=0 chips=L6470"},
                      {"L6470EMU_TRACE", trace_}});
-  for (int i = 0; i < 300 && hammer.out().find("running") == std::string::npos; ++i)
+  for (int i = 0; i < 1000 && hammer.out().find("running") == std::string::npos; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));  // a few thousand frames, more than 100 even under ASan
   hammer.stop(SIGKILL);
   // Written through a shared mapping: the file keeps its chunk's length, the unwritten rest
   // zero bytes where readers stop. The text before them ends with a whole line.

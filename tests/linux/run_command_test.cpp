@@ -258,15 +258,17 @@ TEST_F(RunCommand, InWallTimeRunEnforcesTheLimitItself) {
 }
 
 TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClockGuard) {
+  // (1.5 s: the program must be blocked before the guard ends it, and Python with the preload under
+  // ASan on a loaded machine takes some hundred milliseconds to get there.)
   // In wall time pause() waits for a signal where nothing can see it: the guard ends it, with the
   // simulated time limit's status and its own words. (A read on its own pipe the same way: wall
   // time has no view of the waits.)
   for (const std::string& program : {std::string("import signal\nsignal.pause()\n"),
                                      std::string("import os\nr, w = os.pipe()\nos.read(r, 1)\n")}) {
-    const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
+    const RunResult r = run({"--time", "wall", "--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "1500ms"},
                             python(program));
     EXPECT_EQ(r.status, kRunTimedOut) << r.err;
-    EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s of the host's time (--wall-timeout)"),
+    EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 1.500000 s of the host's time (--wall-timeout)"),
               std::string::npos)
         << r.err;
     EXPECT_EQ(r.err.find("of virtual time"), std::string::npos) << r.err;  // when, in board time, nobody knows
@@ -283,10 +285,10 @@ TEST_F(RunCommand, AProgramBlockedWhereVirtualTimeCannotSeeItIsEndedByTheWallClo
 
 TEST_F(RunCommand, InVirtualTimeACallTheLibraryDoesNotCoverIsEndedByTheGuardWhichSaysWhatEachThreadWasBlockedIn) {
   // sigwait() is no covered call: the thread counts as running, virtual time cannot judge it.
-  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "300ms"},
+  const RunResult r = run({"--chain", "chips=L6470", "--timeout", "10s", "--wall-timeout", "1500ms"},
                           python("import signal\nsignal.sigwait([signal.SIGUSR1])\n"));
   EXPECT_EQ(r.status, kRunTimedOut) << r.err;
-  EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 0.300000 s"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("was stopped by the wall-clock guard after 1.500000 s"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("(the kernel's view, from /proc"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(" (python3) thread "), std::string::npos) << r.err;
 #if defined(__x86_64__)
@@ -556,7 +558,7 @@ TEST_F(RunCommand, EndsWhatTheProgramLeftRunningSetsidGrandchildrenTooAndSaysSoI
   // sleeps take the host's time.
   const std::string ends = path("ends.pid"), termed = path("termed.pid"), killed = path("killed.pid");
   const std::string program = file(
-      "leaves.sh", "setsid /bin/sh -c 'echo $$ > " + ends + "; exec env -u LD_PRELOAD sleep 0.3' &\n"
+      "leaves.sh", "setsid /bin/sh -c 'echo $$ > " + ends + "; exec env -u LD_PRELOAD sleep 0.05' &\n"
                    "setsid /bin/sh -c 'echo $$ > " + termed + "; exec env -u LD_PRELOAD sleep 60' &\n"
                    "setsid /bin/sh -c 'trap \"\" TERM; echo $$ > " + killed + "; exec env -u LD_PRELOAD sleep 60' &\n"
                    "while [ ! -s " + ends + " ] || [ ! -s " + termed + " ] || [ ! -s " + killed + " ]; do :; done\n");

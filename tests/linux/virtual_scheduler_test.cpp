@@ -379,15 +379,18 @@ struct WakePipe {
 std::vector<std::string> both_wait_on(FakeBoard& board, VirtualScheduler::Hooks hooks, const WakePipe& pipe,
                                       bool outside = false) {
   std::vector<std::string> reports;
+  std::atomic<bool> reported{false};
   hooks.deadlock = [&](const std::string& report) {
     reports.push_back(report);
+    reported = true;
     pipe.wake();  // the hook must end the process; this one ends the waits instead
   };
   VirtualScheduler s(std::move(hooks), 0, 1);
   // A thread the scheduler does not count (another process, as far as it knows) wakes them
-  // when no deadlock ends the waits.
+  // when no deadlock ends the waits (once both wait: up to 10 s for a loaded machine to get there).
   std::thread outsider([&] {
-    for (int i = 0; i < 200 && s.waiting() < 2; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    for (int i = 0; i < 10000 && s.waiting() < 2 && !reported; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     pipe.wake();
   });

@@ -155,7 +155,11 @@ TEST(ServeCommand, NamesThePreloadLibraryItFindsBesideItself) {
   test::TempDir dir;
   const std::string binary = L6470EMU_BINARY;
   const std::string preload = binary.substr(0, binary.rfind('/')) + "/libl6470emu-preload.so";
-  const RunResult r = run_command("env -u L6470EMU_PRELOAD timeout 2 " + binary + " serve --socket " + dir.file("s.sock"));
+  // Ended as soon as it has said it (or after 10 s).
+  const std::string said = dir.file("said");
+  const RunResult r = run_command("env -u L6470EMU_PRELOAD " + binary + " serve --socket " + dir.file("s.sock") + " > " +
+                                  said + " & p=$!; for i in $(seq 200); do grep -q 'run programs with' " + said +
+                                  " && break; sleep 0.05; done; kill $p; wait $p; cat " + said);
   EXPECT_NE(r.out.find("run programs with: LD_PRELOAD=" + preload + " L6470EMU_SOCKET=" + dir.file("s.sock")),
             std::string::npos)
       << r.out;
