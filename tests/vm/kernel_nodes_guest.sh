@@ -10,6 +10,9 @@ fail() { echo "FAIL: $*"; cat /tmp/serve.log 2>/dev/null; exit 1; }
 step() { echo "== $*"; }
 
 start_daemon() {
+  # Emptied here, not only by the redirection below: that happens in the background child, and a
+  # loaded machine can run the loop below on the last daemon's log first.
+  : > /tmp/serve.log
   "$B/l6470emu" serve --chain "bus=0 cs=0 chips=2xL6470 mode=3" --cuse --uhid --node-group 0 --node-mode 0660 \
     --socket /tmp/l6470emu.sock > /tmp/serve.log 2>&1 &
   serve=$!
