@@ -144,7 +144,7 @@ std::string shown(double v) {
 }
 
 std::string hex_field(const UnitScale& s, std::uint32_t n) {
-  char buf[16];
+  char buf[80];  // "0x", up to 64 digits of width (bits is at most 255: every field is narrower), NUL
   std::snprintf(buf, sizeof buf, "0x%0*X", static_cast<int>((s.bits + 3) / 4), n);
   return buf;
 }

@@ -272,12 +272,13 @@ TEST(SanitizerBoard, AReservedBitWrittenOneIsNamedWhereTheVariantReservesItAndNo
     for (std::uint8_t b : {0x16, 0x0F}) f.frame(b);  // SetParam(STEP_MODE, 1/128 with bit 3 set)
     const bool named = std::string(chips) == "L6470" || std::string(chips) == "L6480";
     ASSERT_EQ(v.log.size(), named ? 1u : 0u) << chips << ": " << (v.log.empty() ? "" : v.log[0]);
-    if (named)
+    if (named) {
       EXPECT_EQ(v.log[0].rfind("spidev0.0: chip 0: RESERVED_BITS: SetParam(STEP_MODE) value 0x0F sets bit 3, which is "
                                "to be written 0: ",
                                0),
                 0u)
           << v.log[0];
+    }
     v.log.clear();
     const std::uint8_t config = std::string(chips) == "L6470" ? 0x18 : 0x1A;
     for (std::uint8_t b : {config, std::uint8_t{0x2E}, std::uint8_t{0xC8}}) f.frame(b);  // 0x2E88 with bit 6 set

@@ -55,7 +55,9 @@ TEST(StckPulses, NPulsesAtOnceEqualNSingleEdgesForEveryVariantStepModeAndDirecti
             single.chip().set_stck_pin(true);
             single.chip().set_stck_pin(false);
           }
-          if (n) ASSERT_NE(single.chip().peek(Reg::ABS_POS), start) << "the chip is in step-clock mode";
+          if (n) {
+            ASSERT_NE(single.chip().peek(Reg::ABS_POS), start) << "the chip is in step-clock mode";
+          }
           expect_same(bulk.chip(), single.chip(),
                       std::string(v->name) + " STEP_SEL " + std::to_string(sel) + (forward ? " forward " : " back ") +
                           std::to_string(n) + " pulses");

@@ -92,7 +92,9 @@ TEST(BoardTime, WallTicksAndHostTimeMapBothWaysExactlyAtAnyScale) {
     EXPECT_EQ(t.now(), 0u);
     for (Tick tick : {Tick{0}, Tick{1}, Tick{7}, Tick{4'000'000}, Tick{123'456'789}}) {
       EXPECT_EQ(t.tick_of(t.host_ns_of(tick)), tick) << "scale " << scale;  // never seen early
-      if (tick > 0) EXPECT_LT(t.tick_of(t.host_ns_of(tick) - 1), tick) << "scale " << scale;
+      if (tick > 0) {
+        EXPECT_LT(t.tick_of(t.host_ns_of(tick) - 1), tick) << "scale " << scale;
+      }
     }
     clock.now += 1'000'000'000;  // one host second
     EXPECT_EQ(t.now(), static_cast<Tick>(4'000'000 * scale)) << "scale " << scale;

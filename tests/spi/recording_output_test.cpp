@@ -60,7 +60,9 @@ TEST(RecordingOutput, AnOpenRunsCountIsRightAfterEveryRepetitionThroughEveryCarr
   };
   for (std::uint64_t count = 1; count <= kMaxOpenRepeatCount; ++count, ++frames) {
     w.write(nop_at(frames * kPeriod));
-    if (checked(count)) ASSERT_EQ(open_count(test::read_text(path)), right_aligned(count)) << "after " << count;
+    if (checked(count)) {
+      ASSERT_EQ(open_count(test::read_text(path)), right_aligned(count)) << "after " << count;
+    }
   }
   // The field is full: the next frames are a line of their own and then a new run.
   for (int i = 0; i < 5; ++i, ++frames) w.write(nop_at(frames * kPeriod));

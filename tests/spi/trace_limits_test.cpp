@@ -46,7 +46,9 @@ TEST(NativeTraceLimits, WhatTheWriterWritesAtTheExtremesTheReaderReadsBack) {
   t.write(frame_at(kMaxNativeTraceTick - 7, 7, d0, st));
   for (const bool compact : {true, false}) {
     const std::string text = written(t, compact);
-    if (compact) EXPECT_NE(text.find(" repeat 1 frame 1 time every 250000000000000000.00us\n"), std::string::npos) << text;
+    if (compact) {
+      EXPECT_NE(text.find(" repeat 1 frame 1 time every 250000000000000000.00us\n"), std::string::npos) << text;
+    }
     expect_same(t, read_native_trace(text, "extreme.trace"));
   }
 }

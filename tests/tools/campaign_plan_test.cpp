@@ -217,7 +217,7 @@ TEST(CampaignReport, TheJUnitReportHasOneCaseForEachFaultAndChipNamedTheSameWhat
   const std::string failing = campaign_junit(r, FailOn{});
   for (auto& x : r.reruns) x.verdict = Verdict::survived;
   const std::string passing = campaign_junit(r, FailOn{});
-  for (const std::string& name : {"ocd spidev0.0 chip 0", "uvlo spidev0.0 chip 0"}) {
+  for (const std::string name : {"ocd spidev0.0 chip 0", "uvlo spidev0.0 chip 0"}) {
     EXPECT_NE(failing.find("name=\"" + name + "\""), std::string::npos) << failing;
     EXPECT_NE(passing.find("name=\"" + name + "\""), std::string::npos) << passing;
   }
