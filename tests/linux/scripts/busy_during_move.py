@@ -21,7 +21,7 @@ for b in (0xD0, 0, 0):  # GetStatus clears the power-up UVLO: FLAG rises
     s.xfer2([b])
 print(f"flag_after_getstatus={flag.get_value()}")
 t0 = time.monotonic()
-for b in (0x40, 0x00, 0x0C, 0x80):  # Move REV 3200 microsteps
+for b in (0x40, 0x00, 0x64, 0x00):  # Move REV 25600 microsteps: about 0.63 s, room for a loaded host
     s.xfer2([b])
 print(f"busy_during={busy.get_value()}")
 edges = []
