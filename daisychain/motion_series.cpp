@@ -7,6 +7,7 @@
 #include "core/counted.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <stdexcept>
 
@@ -17,6 +18,10 @@
 
 namespace l6470emu {
 namespace {
+
+/// The shortest window a chip without a SPEED register (the L6474) has its step rate averaged
+/// over: 10 ms, ten pulses of a 1 kHz step clock.
+constexpr Tick kMinRateWindow = kTicksPerSecond / 100;
 
 /// Boundary-only stops allowed between two grid ticks before the rest are skipped (a rule
 /// that changes every tick, as at the end of a stop, would otherwise cost a sample per tick).
@@ -144,6 +149,7 @@ class Sampler {
       m.number = u;
       m.variant = std::string(chain.chip(k).variant().name);
       series_.push_back(std::move(m));
+      rates_.push_back({!chain.chip(k).variant().has(Reg::SPEED)});
     }
     max_commands_ = o.max_commands;
     max_points_ = std::max<std::size_t>(o.max_points, 64);
@@ -154,8 +160,10 @@ class Sampler {
 
   void sample(std::size_t chip, Tick t) {
     if (!wanted(chip) || !in_window(t)) return;
-    std::vector<MotionSample>& v = series_[static_cast<std::size_t>(wanted_[chip])].samples;
-    const MotionSample s = sample_of(chain_.chip(chip), t);
+    const auto index = static_cast<std::size_t>(wanted_[chip]);
+    std::vector<MotionSample>& v = series_[index].samples;
+    MotionSample s = sample_of(chain_.chip(chip), t);
+    if (rates_[index].derived) s.speed = rates_[index].at(chain_.chip(chip), t, s.abs_pos, std::max(step_, kMinRateWindow));
     if (!v.empty() && v.back().tick == t)
       v.back() = s;  // the later state at the same tick wins
     else
@@ -237,10 +245,41 @@ class Sampler {
   }
 
  private:
+  /// The step rate of a chip without a SPEED register, in SPEED's units: ABS_POS's change over
+  /// the last window of at least `window` ticks, held until the next window closes.
+  struct StepRate {
+    bool derived = false;
+    bool anchored = false;
+    Tick anchor_tick = 0;
+    std::int32_t anchor_pos = 0;
+    std::int32_t rate = 0;
+
+    std::int32_t at(const Chip& c, Tick t, std::int32_t pos, Tick window) {
+      if (!anchored || t < anchor_tick) {
+        anchored = true;
+        anchor_tick = t;
+        anchor_pos = pos;
+        return rate = 0;
+      }
+      if (t - anchor_tick < window) return rate;
+      // ABS_POS is 22 bits and wraps: the change is the short way round.
+      std::int64_t d = static_cast<std::int64_t>(static_cast<std::uint32_t>(pos - anchor_pos) & 0x3FFFFFu);
+      if (d & 0x200000) d -= 0x400000;
+      const unsigned sel = std::min<unsigned>(c.peek(Reg::STEP_MODE) & 7u, c.variant().max_step_sel);
+      const __int128 per_tick = static_cast<__int128>(d) * (std::int64_t{1} << 28) /
+                                (static_cast<__int128>(t - anchor_tick) << sel);
+      rate = static_cast<std::int32_t>(std::clamp<__int128>(per_tick, INT32_MIN, INT32_MAX));
+      anchor_tick = t;
+      anchor_pos = pos;
+      return rate;
+    }
+  };
+
   Chain& chain_;
   Tick from_, to_, step_;
   std::vector<int> wanted_;  // index into series_, -1 = not sampled
   std::vector<ChipMotion> series_;
+  std::vector<StepRate> rates_;  // beside series_
   std::size_t max_commands_ = 0;
   std::size_t max_points_ = 64;
 };

@@ -22,7 +22,11 @@ namespace l6470emu {
 struct MotionSample {
   Tick tick = 0;
   std::int32_t abs_pos = 0;    ///< ABS_POS, microsteps of the STEP_SEL in force
-  std::int32_t speed = 0;      ///< SPEED register (2^-28 full step/tick), negative while turning in reverse
+  /// SPEED register (2^-28 full step/tick), negative while turning in reverse. A chip without
+  /// one (the L6474, moved by STCK pulses) has its step rate in the same units instead: ABS_POS's
+  /// change over the last window of at least 10 ms (or the grid step, when longer), held until
+  /// the next window closes.
+  std::int32_t speed = 0;
   std::uint8_t mot_status = 0; ///< MOT_STATUS: 0 stopped, 1 accelerating, 2 decelerating, 3 constant speed
   bool busy = true;            ///< BUSY pin level (false = pulled low: a command is running)
   bool flag = true;            ///< FLAG pin level (false = pulled low: an enabled alarm)

@@ -8,6 +8,7 @@
 #include "daisychain/chain_spec.hpp"
 #include "daisychain/decode.hpp"
 #include "daisychain/explain.hpp"
+#include "daisychain/motion_series.hpp"
 #include "daisychain/recording_chain.hpp"
 #include "daisychain/replay.hpp"
 #include "spi/trace_native.hpp"
@@ -44,9 +45,9 @@ struct Session {
     }
     return out;
   }
-  void pulses(std::size_t k, int n) {
+  void pulses(std::size_t k, int n, Tick period = 400) {  // 100 µs apart unless said
     for (int i = 0; i < n; ++i) {
-      rec.advance_to(rec.now() + 400);  // 100 µs apart
+      rec.advance_to(rec.now() + period);
       rec.set_stck_pin(k, true);
       rec.advance_to(rec.now() + 8);
       rec.set_stck_pin(k, false);
@@ -97,6 +98,54 @@ TEST(L6474Trace, RecordsDirEdgesAndTheChainsVariantsAndReplaysByteExact) {
   EXPECT_TRUE(r.matched()) << (r.divergences.empty() ? "" : r.divergences[0].report);
   EXPECT_EQ(fresh.chip(1).position(), 25) << "the DIR and STCK lines replayed";
   EXPECT_EQ(fresh.chip(1).peek(Reg::EL_POS), s.chain.chip(1).peek(Reg::EL_POS));
+}
+
+TEST(L6474Trace, ItsPlottedSpeedIsTheStepRateOfItsPulsesWithTheSignOfDir) {
+  // The L6474 has no SPEED register: plots and the report page show its step rate instead.
+  Session s;
+  s.to(1, {0xD0, 0x00, 0x00});
+  s.to(1, {0x16, 0x8C});  // 1/16 step
+  s.to(1, {0x09, 0x20});
+  s.to(1, {0xB8});  // Enable
+  s.rec.set_dir_pin(1, true);
+  const Tick forward_from = s.rec.now();
+  s.pulses(1, 500, 4000);  // 1 kHz for 0.5 s: 62.5 full step/s
+  s.rec.set_dir_pin(1, false);
+  const Tick back_from = s.rec.now();
+  s.pulses(1, 1000, 2000);  // 2 kHz for 0.5 s, back: 125 full step/s
+  const Tick stopped_from = s.rec.now();
+  s.rec.advance_to(stopped_from + kTicksPerSecond / 10);
+  s.to(1, {0xA8});  // Disable: a sample 0.1 s after the last pulse
+
+  Chain fresh(2, l6474());
+  auto pass = s.trace.reader();
+  const Tick end = trace_end_tick(*pass);
+  auto reader = s.trace.reader();
+  MotionOptions o;
+  o.chips = {1};
+  const MotionSeries series = sample_motion(*reader, fresh, end, o);
+  ASSERT_EQ(series.chips.size(), 1u);
+  const ChipMotion& m = series.chips[0];
+  // SPEED's units, 2^-28 full step per 250 ns tick: 62.5 step/s is 4194.3.
+  auto step_per_s = [](std::int32_t speed) { return speed * 4e6 / (1 << 28); };
+  int forward = 0, back = 0, still = 0;
+  for (const MotionSample& x : m.samples) {
+    const double v = step_per_s(x.speed);
+    if (x.tick >= forward_from + kTicksPerSecond / 20 && x.tick < back_from) {
+      EXPECT_NEAR(v, 62.5, 62.5 * 0.12) << "at tick " << x.tick;
+      ++forward;
+    } else if (x.tick >= back_from + kTicksPerSecond / 20 && x.tick < stopped_from) {
+      EXPECT_NEAR(v, -125, 125 * 0.12) << "at tick " << x.tick;
+      ++back;
+    } else if (x.tick >= stopped_from + kTicksPerSecond / 20) {
+      EXPECT_EQ(x.speed, 0) << "at tick " << x.tick;
+      ++still;
+    }
+  }
+  EXPECT_GT(forward, 20);
+  EXPECT_GT(back, 20);
+  EXPECT_GE(still, 1);
+  EXPECT_EQ(fresh.chip(1).position(), 500 - 1000);
 }
 
 TEST(L6474Trace, ReplayingWithoutTheDirLinesEndsElsewhere) {
