@@ -1115,7 +1115,7 @@ Json chain_json(const ReportChain& d) {
     cj["registers"] = std::move(regs);
     cj["register_changes_dropped"] = c.register_changes_dropped;
     Json inputs = Json::array();
-    for (const PinEdge& p : c.inputs) inputs.push_back({p.tick, p.pin, p.level ? 1 : 0});
+    for (const TraceInputEdge& p : c.inputs) inputs.push_back({p.tick, p.pin, p.level ? 1 : 0});
     cj["inputs"] = std::move(inputs);
     cj["inputs_dropped"] = c.inputs_dropped;
     Json stimuli = Json::array();

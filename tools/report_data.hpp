@@ -113,7 +113,7 @@ struct StatusField {
 };
 
 /// An input edge the trace drove (SW, STCK, STBY) or an observation it holds (BUSY, FLAG, SW of the axis).
-struct PinEdge {
+struct TraceInputEdge {  // not board.hpp's PinEdge: one name, one definition in a program
   Tick tick = 0;
   std::string pin;  ///< "SW", "STCK", "STBY"
   bool level = true;
@@ -139,7 +139,7 @@ struct ReportChip {
   std::vector<PhaseSample> phase;
   std::vector<RegisterChange> registers;  ///< the power-up values at tick 0 first
   std::uint64_t register_changes_dropped = 0;
-  std::vector<PinEdge> inputs;
+  std::vector<TraceInputEdge> inputs;
   std::uint64_t inputs_dropped = 0;
   std::vector<Stimulus> stimuli;
   ChipMotion motion;  ///< sample_motion's series
