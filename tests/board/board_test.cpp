@@ -13,6 +13,7 @@
 #include "daisychain/host.hpp"
 #include "spi/message.hpp"
 #include "support/test_support.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
@@ -24,12 +25,6 @@ class StillHostClock final : public HostClock {
   std::int64_t realtime_ns() override { return 0; }
   void sleep_until(std::int64_t) override {}
 };
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 struct VirtualBoard {
   explicit VirtualBoard(const std::string& description)

@@ -12,15 +12,10 @@
 #include <vector>
 
 #include "firmware/runtime.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 constexpr const char* kThreeChips = "chips=3xL6470 cs_pin=D4 sck_pin=D5 mosi_pin=D6 miso_pin=D7 check=warn";
 

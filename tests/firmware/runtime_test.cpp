@@ -11,15 +11,10 @@
 
 #include "firmware/runtime.hpp"
 #include "support/test_support.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 struct Rig {
   explicit Rig(const std::string& description, FirmwareFront front = FirmwareFront::arduino,

@@ -12,6 +12,7 @@
 #include "linux/device_board.hpp"
 #include "spi/message.hpp"
 #include "support/test_support.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
@@ -31,12 +32,6 @@ class FakeHostClock final : public HostClock {
     if (sleeping_moves_time && deadline > now) now = deadline;
   }
 };
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 /// A board on a fake clock with one spidev file open per chain.
 struct Rig {

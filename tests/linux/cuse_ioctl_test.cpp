@@ -12,15 +12,10 @@
 
 #include "linux/device_board.hpp"
 #include "linux/kernel/cuse_ioctl.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 /// A virtual-time board (messages take no wall time) with one spidev file open.
 struct Node {

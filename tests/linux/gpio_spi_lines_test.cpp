@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "linux/device_board.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
@@ -26,12 +27,6 @@ class StillHostClock final : public HostClock {
     if (deadline > now) now = deadline;
   }
 };
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 /// A board on a still clock with its gpiochip open; `request` asks for lines as a v2 request.
 struct Rig {

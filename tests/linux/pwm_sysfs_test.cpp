@@ -15,6 +15,7 @@
 #include "linux/device_board.hpp"
 #include "linux/pwm_state.hpp"
 #include "run_program.hpp"
+#include "support/board_config_support.hpp"
 
 namespace l6470emu::test {
 namespace {
@@ -57,12 +58,6 @@ TEST(PwmState, AStateWithoutAPeriodOrWithMoreDutyThanPeriodIsRefusedAsPwmApplyRe
 }
 
 // ---- a DeviceBoard in virtual time -------------------------------------------------------
-
-BoardConfig config_of(const std::string& text) {
-  ParseResult p = parse_board_config(text, "test");
-  EXPECT_TRUE(p.config) << p.error.message;
-  return *p.config;
-}
 
 struct Rig {
   DiagnosticLog log{"off"};
