@@ -218,7 +218,7 @@ void Board::drive_spi_clock(std::size_t chain, bool level) {
   if (level == pins.ck()) return;
   const Tick now = time_.now();
   if (!pins.selected()) {
-    pins.set_ck(level, now, *c.bus, c.chain);  // counted, nothing shifts
+    pins.set_ck(level, *c.bus, c.chain);  // counted, nothing shifts
     return;
   }
   // Only the eighth rising edge of a byte reaches the chips; the others are the bus's own.
@@ -230,7 +230,7 @@ void Board::drive_spi_clock(std::size_t chain, bool level) {
     record_outputs(c);
     c.bus->set_device(spi_of(c));
   }
-  if (pins.set_ck(level, now, *c.bus, c.chain)) c.checker->first_clock_edge(now);
+  if (pins.set_ck(level, *c.bus, c.chain)) c.checker->first_clock_edge(now);
   if (byte_ends) emit_changes(c, c.chain.now());
 }
 

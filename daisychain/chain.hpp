@@ -91,8 +91,7 @@ class Chain final : public SpiDevice {
   /// it, most significant bit first), 0 when none: for a host that reads MISO a bit at a time.
   std::uint8_t miso_flip_mask(std::uint64_t byte) const {
     std::uint8_t mask = 0;
-    for (const auto& [k, m] : flips_)
-      if (k == byte) mask = static_cast<std::uint8_t>(mask | m);
+    apply_flips(byte, {&mask, 1});  // the byte path's rule
     return mask;
   }
 

@@ -116,13 +116,8 @@ void Chain::exchange_wire_bytes(std::span<const std::uint8_t> tx, std::span<std:
 
 void Chain::falling_clock_edge() {
   if (!selected_) return;  // CS high: the chips ignore the clock
-  if (!standby_in_frame_) {
-    latch_at_ = LatchAt::register_msb;
-    return;
-  }
-  if (latch_.size() != chips_.size()) latch_.assign(chips_.size(), 0);
-  for (std::size_t i = 0; i < chips_.size(); ++i) latch_[i] = listening(i) ? static_cast<std::uint8_t>(shift_register(i) >> 7) : 0;
-  latch_at_ = LatchAt::stored;
+  latch_at_ = LatchAt::register_msb;
+  if (standby_in_frame_) store_latches();  // with a chip in standby in the frame: kept as they are now
 }
 
 void Chain::deselect_wire() {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/fast_motion.hpp"
+#include "core/registers.hpp"
 #include "daisychain/divergence.hpp"
 #include "daisychain/explain.hpp"
 #include "daisychain/protocol_tracker.hpp"
@@ -237,8 +238,7 @@ class Sampler {
   std::vector<ChipMotion> finish(Tick to) {
     for (ChipMotion& m : series_) {
       const Chip& c = chain_.chip(m.chip);
-      const unsigned sel = std::min<unsigned>(c.peek(Reg::STEP_MODE) & 7u, c.variant().max_step_sel);
-      m.microsteps_per_step = 1u << sel;
+      m.microsteps_per_step = 1u << c.profile().step_sel;
       m.samples = thin(m.samples, from_, to, max_points_);
     }
     return std::move(series_);
@@ -263,11 +263,9 @@ class Sampler {
       }
       if (t - anchor_tick < window) return rate;
       // ABS_POS is 22 bits and wraps: the change is the short way round.
-      std::int64_t d = static_cast<std::int64_t>(static_cast<std::uint32_t>(pos - anchor_pos) & 0x3FFFFFu);
-      if (d & 0x200000) d -= 0x400000;
-      const unsigned sel = std::min<unsigned>(c.peek(Reg::STEP_MODE) & 7u, c.variant().max_step_sel);
+      const std::int32_t d = sign_extend(static_cast<std::uint32_t>(pos - anchor_pos), 22);
       const __int128 per_tick = static_cast<__int128>(d) * (std::int64_t{1} << 28) /
-                                (static_cast<__int128>(t - anchor_tick) << sel);
+                                (static_cast<__int128>(t - anchor_tick) << c.profile().step_sel);
       rate = static_cast<std::int32_t>(std::clamp<__int128>(per_tick, INT32_MIN, INT32_MAX));
       anchor_tick = t;
       anchor_pos = pos;

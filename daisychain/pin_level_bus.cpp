@@ -27,8 +27,7 @@ unsigned PinLevelBus::cs_rising() {
   return dropped;
 }
 
-bool PinLevelBus::set_ck(bool level, Tick tick, SpiDevice& device, Chain& chain) {
-  (void)tick;
+bool PinLevelBus::set_ck(bool level, SpiDevice& device, Chain& chain) {
   if (level == ck_) return false;
   ck_ = level;
   if (!selected_) {

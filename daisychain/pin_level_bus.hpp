@@ -7,7 +7,6 @@
 
 #include <cstdint>
 
-#include "core/tick.hpp"
 #include "daisychain/chain.hpp"
 #include "spi/spi_device.hpp"
 #include "spi/wire.hpp"
@@ -28,10 +27,10 @@ class PinLevelBus {
   void cs_fell(const Chain& chain);
   /// CS is about to rise: the bits of an unfinished byte are dropped. Returns how many (0..7).
   unsigned cs_rising();
-  /// CK goes to `level` at `tick`. While CS is low a rising edge samples SDI; the eighth of a
+  /// CK goes to `level`. While CS is low a rising edge samples SDI; the eighth of a
   /// byte clocks the byte on `device` (whose chain is `chain`). Returns true when this edge was
   /// the first clock edge of the frame (the t_setCS check). No effect when the level is unchanged.
-  bool set_ck(bool level, Tick tick, SpiDevice& device, Chain& chain);
+  bool set_ck(bool level, SpiDevice& device, Chain& chain);
   /// SDI (MOSI) goes to `level`; sampled at the next rising CK edge.
   void set_sdi(bool level) { sdi_ = level; }
   /// The level chip 0 drives on SDO now (its latch, with a MISO flip fault of the frame

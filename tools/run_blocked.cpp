@@ -33,26 +33,6 @@ std::vector<std::string> numbered_entries(const std::string& dir) {
   return out;
 }
 
-// A process's parent and whether it is a zombie (/proc/PID/stat), nullopt when it is gone.
-struct Stat {
-  pid_t parent = 0;
-  bool zombie = false;
-  std::string name;
-};
-std::optional<Stat> stat_of(const std::string& pid) {
-  const std::string stat = read_text("/proc/" + pid + "/stat");
-  const std::size_t open_paren = stat.find('('), close_paren = stat.rfind(')');
-  if (open_paren == std::string::npos || close_paren == std::string::npos || close_paren < open_paren) return std::nullopt;
-  Stat s;
-  s.name = stat.substr(open_paren + 1, close_paren - open_paren - 1);
-  char state = 0;
-  long parent = 0;
-  if (std::sscanf(stat.c_str() + close_paren + 1, " %c %ld", &state, &parent) != 2) return std::nullopt;
-  s.parent = static_cast<pid_t>(parent);
-  s.zombie = state == 'Z' || state == 'X';
-  return s;
-}
-
 // System calls whose first argument is a descriptor.
 bool takes_fd(long n) {
   switch (n) {
@@ -61,8 +41,8 @@ bool takes_fd(long n) {
   }
 }
 
-}  // namespace
-
+/// The name of x86-64 system call `number` among those a program blocks in ("read", "wait4"),
+/// or "system call N" (another architecture's numbers are not named).
 std::string blocking_syscall_name(long number) {
 #if defined(__x86_64__)
   static const std::map<long, const char*> names = {
@@ -77,24 +57,12 @@ std::string blocking_syscall_name(long number) {
   return "system call " + std::to_string(number);
 }
 
+}  // namespace
+
+
 std::vector<std::string> blocked_threads(const std::map<pid_t, std::vector<std::string>>& said) {
-  // The live descendants of this process.
-  std::map<pid_t, Stat> all;
-  for (const std::string& p : numbered_entries("/proc"))
-    if (const auto s = stat_of(p)) all[static_cast<pid_t>(std::atol(p.c_str()))] = *s;
-  std::set<pid_t> run;
-  for (const auto& [pid, s] : all) {
-    if (s.zombie) continue;
-    for (pid_t p = s.parent, hops = 0; p > 0 && hops < 4096; ++hops) {
-      if (p == getpid()) {
-        run.insert(pid);
-        break;
-      }
-      const auto it = all.find(p);
-      if (it == all.end()) break;
-      p = it->second.parent;
-    }
-  }
+  const std::map<pid_t, ProcessInfo> all = all_processes();
+  const std::set<pid_t> run = live_descendants(all, getpid());
   std::vector<std::string> lines;
   for (const pid_t pid : run) {
     const std::string proc = "/proc/" + std::to_string(pid);

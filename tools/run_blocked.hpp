@@ -20,8 +20,4 @@ namespace l6470emu {
 /// nothing.
 std::vector<std::string> blocked_threads(const std::map<pid_t, std::vector<std::string>>& said = {});
 
-/// The name of x86-64 system call `number` among those a program blocks in ("read", "wait4"),
-/// or "system call N" (another architecture's numbers are not named).
-std::string blocking_syscall_name(long number);
-
 }  // namespace l6470emu

@@ -22,51 +22,6 @@
 namespace l6470emu {
 namespace {
 
-struct ProcessInfo {
-  pid_t parent = 0;
-  char state = 0;
-  std::string name;
-};
-
-// Every process's parent, state and name (/proc/PID/stat).
-std::map<pid_t, ProcessInfo> all_processes() {
-  std::map<pid_t, ProcessInfo> out;
-  DIR* d = opendir("/proc");
-  if (!d) return out;
-  while (const dirent* e = readdir(d)) {
-    if (!is_pid_name(e->d_name)) continue;
-    const std::string stat = read_small_file(std::string("/proc/") + e->d_name + "/stat", 4096);
-    const std::size_t open_paren = stat.find('('), close_paren = stat.rfind(')');
-    if (open_paren == std::string::npos || close_paren == std::string::npos || close_paren < open_paren) continue;
-    ProcessInfo p;
-    p.name = stat.substr(open_paren + 1, close_paren - open_paren - 1);
-    long parent = 0;
-    if (std::sscanf(stat.c_str() + close_paren + 1, " %c %ld", &p.state, &parent) != 2) continue;
-    p.parent = static_cast<pid_t>(parent);
-    out[static_cast<pid_t>(std::atol(e->d_name))] = p;
-  }
-  closedir(d);
-  return out;
-}
-
-// The live (not zombie) descendants of `root`.
-std::set<pid_t> live_descendants(const std::map<pid_t, ProcessInfo>& all, pid_t root) {
-  std::set<pid_t> out;
-  for (const auto& [pid, info] : all) {
-    if (info.state == 'Z' || info.state == 'X') continue;
-    for (pid_t p = info.parent, hops = 0; p > 0 && hops < 4096; ++hops) {
-      if (p == root) {
-        out.insert(pid);
-        break;
-      }
-      const auto it = all.find(p);
-      if (it == all.end()) break;
-      p = it->second.parent;
-    }
-  }
-  return out;
-}
-
 // The processes holding `target` ("pipe:[123]", "socket:[124]": their /proc/PID/fd links), as
 // lsof finds them.
 std::set<pid_t> holders(const std::map<pid_t, ProcessInfo>& all, const std::string& target) {

@@ -27,7 +27,7 @@ struct BitBanger {
   void tick() { chain.advance_to(chain.now() + 1); }
   void set_ck(bool level) {
     tick();
-    pins.set_ck(level, chain.now(), chain, chain);
+    pins.set_ck(level, chain, chain);
   }
   void cs_low() {
     tick();
@@ -139,16 +139,16 @@ TEST(PinLevelBus, SdoShowsEachBitFromTheFallingEdgeThatLatchesIt) {
   chain.frame(Bytes{0x38});  // GetParam(CONFIG)
   chain.advance_to(chain.now() + 10);
   PinLevelBus pins;
-  pins.set_ck(true, 0, chain, chain);
+  pins.set_ck(true, chain, chain);
   chain.select_wire();
   pins.cs_fell(chain);
   // 0x2E = 0010 1110: before each rising edge, after the falling one, SDO shows the next bit.
   std::uint8_t seen = 0;
   for (int b = 7; b >= 0; --b) {
-    pins.set_ck(false, 0, chain, chain);
+    pins.set_ck(false, chain, chain);
     seen = static_cast<std::uint8_t>(seen | (pins.sdo(chain) ? 1u : 0u) << b);
     pins.set_sdi(false);
-    pins.set_ck(true, 0, chain, chain);
+    pins.set_ck(true, chain, chain);
   }
   EXPECT_EQ(seen, 0x2E);
 }
@@ -173,8 +173,8 @@ TEST(PinLevelBus, ClockEdgesWithCsHighShiftNothingAndAreCounted) {
   Chain chain(1);
   PinLevelBus pins;
   for (int k = 0; k < 8; ++k) {
-    pins.set_ck(true, 0, chain, chain);
-    pins.set_ck(false, 0, chain, chain);
+    pins.set_ck(true, chain, chain);
+    pins.set_ck(false, chain, chain);
   }
   EXPECT_EQ(pins.rising_edges_deselected(), 8u);
   EXPECT_EQ(chain.frames(), 0u);
