@@ -118,6 +118,7 @@ struct VirtualScheduler::Waiter {
   End end = End::timed_out;
   bool deciding = false;  // its own thread is deciding: no need to wake it through the eventfd
   bool woken = false;     // the eventfd was written for it
+  bool counted = false;   // counted as waiting (running_ lowered for it)
 };
 
 VirtualScheduler::VirtualScheduler(Hooks hooks, std::int64_t idle_ns, int threads)
@@ -141,18 +142,32 @@ VirtualScheduler::End VirtualScheduler::wait(const Wait& w) {
     if (w.deadline <= hooks_.now()) return End::timed_out;
     me.seq = next_seq_++;
     waiters_.push_back(&me);
-    --running_;
-    touch();
-    me.deciding = true;
-    decide_locked(false);
-    me.deciding = false;
+    // With after_register (a condition variable releasing its mutex) the thread is registered,
+    // so a notify cannot be lost, but counts as running until that has run: a thread blocked on
+    // the mutex can take it only then, and time must not jump to this wait's timeout before.
+    if (!w.after_register) count_waiting_locked(me);
   }
   const OnExit leave([&] { leave_wait(me); });
-  if (w.after_register && !w.after_register()) {
+  if (w.after_register) {
+    const bool registered = w.after_register();
     Locked lock(m_);
-    if (!me.done.load(std::memory_order_acquire)) end_locked(me, End::aborted);
+    if (!me.done.load(std::memory_order_acquire)) {
+      if (registered)
+        count_waiting_locked(me);
+      else
+        end_locked(me, End::aborted);
+    }
   }
   return block(me);
+}
+
+void VirtualScheduler::count_waiting_locked(Waiter& me) {
+  me.counted = true;
+  --running_;
+  touch();
+  me.deciding = true;
+  decide_locked(false);
+  me.deciding = false;
 }
 
 void VirtualScheduler::leave_wait(Waiter& me) {
@@ -160,7 +175,7 @@ void VirtualScheduler::leave_wait(Waiter& me) {
     Locked lock(m_);
     if (!me.done.load(std::memory_order_acquire)) {  // a thread cancelled in its wait, or wait_in
       me.done.store(true, std::memory_order_release);
-      ++running_;
+      if (me.counted) ++running_;
     }
     remove_locked(me);
     touch();
@@ -241,6 +256,7 @@ void VirtualScheduler::wait_in(const Wait& w, const std::function<void()>& block
       counted = true;
       me.seq = next_seq_++;
       waiters_.push_back(&me);
+      me.counted = true;
       --running_;
       touch();
       decide_locked(false);
@@ -256,7 +272,7 @@ void VirtualScheduler::end_locked(Waiter& w, End how) {
   running_again_locked();
   w.end = how;
   w.done.store(true, std::memory_order_release);
-  ++running_;
+  if (w.counted) ++running_;
   if (w.fd >= 0 && !w.deciding) {
     const std::uint64_t one = 1;
     [[maybe_unused]] const ssize_t n = ::write(w.fd, &one, sizeof one);

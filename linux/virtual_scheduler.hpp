@@ -120,7 +120,9 @@ class VirtualScheduler {
     /// Checked under the scheduler's lock before registering: true ends the wait at once (ready).
     std::function<bool()> try_now;
     /// Called outside the lock once the wait is registered (a condition variable releases its
-    /// mutex here, so a notify after it cannot be lost). false aborts the wait.
+    /// mutex here, so a notify after it cannot be lost). The thread counts as running until it
+    /// returns, so time does not move while a thread blocked on that mutex cannot have it yet.
+    /// false aborts the wait.
     std::function<bool()> after_register;
     /// In-process readiness besides `fds` (e.g. a semaphore taken for the waiter): checked before
     /// every jump and every `recheck_ns` of real time; true ends the wait (ready).
@@ -184,6 +186,7 @@ class VirtualScheduler {
 
   End block(Waiter& me);
   void leave_wait(Waiter& me);
+  void count_waiting_locked(Waiter& me);
   void decide_locked(bool forced);
   void check_deadlock_locked(bool outside);
   bool waits_outside_locked() const;

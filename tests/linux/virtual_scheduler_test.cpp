@@ -166,6 +166,48 @@ TEST(VirtualScheduler, ANotifiedWaiterRunsOnAtTheNotifiersTimeNotAtItsTimeout) {
   }
 }
 
+// CPython's GIL, caught at the wrong moment: thread A holds the GIL's mutex between seeing the GIL
+// taken and its timed condition wait; the holder, B, dropping the GIL, blocks on that mutex. A's
+// wait releases the mutex once registered, and until then A still runs: time must not jump to
+// A's timeout meanwhile (it did, and a threaded Python program ran 5 ms late once in many runs).
+TEST(VirtualScheduler, AConditionWaitCountsAsRunningUntilItHasReleasedItsMutex) {
+  FakeBoard board;
+  VirtualScheduler s(board.hooks(), 0, 1);  // the test's thread is B, the GIL's holder
+  std::mutex gil_mutex;
+  int gil_cond = 0;  // stands for the condition variable's address
+  std::atomic<bool> a_holds_mutex{false};
+  End a_end = End::aborted;
+  Tick a_woke = kNever;
+  Worker a(s, [&] {
+    gil_mutex.lock();
+    a_holds_mutex = true;
+    wait_until_waiting(s, 1);  // B waits for the mutex
+    VirtualScheduler::Wait w;
+    w.deadline = 5'000;
+    w.object = &gil_cond;
+    w.after_register = [&] {
+      gil_mutex.unlock();
+      s.notify(&gil_mutex, false);
+      return true;
+    };
+    a_end = s.wait(w);
+    a_woke = board.now.load();
+  });
+  while (!a_holds_mutex) std::this_thread::sleep_for(std::chrono::microseconds(100));
+  VirtualScheduler::Wait lock;
+  lock.object = &gil_mutex;
+  lock.try_now = [&] { return gil_mutex.try_lock(); };
+  lock.ready = lock.try_now;
+  while (s.wait(lock) != End::ready) {
+  }
+  EXPECT_EQ(s.notify(&gil_cond, false), 1);  // the GIL dropped: A is woken, not timed out
+  gil_mutex.unlock();
+  a.join();
+  EXPECT_EQ(a_end, End::notified);
+  EXPECT_EQ(a_woke, 0u);
+  EXPECT_TRUE(board.jumps.empty());
+}
+
 TEST(VirtualScheduler, APostIsGrantedToTheFirstWaiterInRegistrationOrder) {
   FakeBoard board;
   VirtualScheduler s(board.hooks(), 0, 1);
