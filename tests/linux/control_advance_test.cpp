@@ -13,15 +13,11 @@
 namespace l6470emu {
 namespace {
 
-DeviceBoard& virtual_board() {
-  static ParseResult p = parse_board_config("bus=0 cs=0 chips=L6470; time=virtual", "test");
-  static DiagnosticLog log("off");
-  static DeviceBoard board(*p.config, log);
-  return board;
-}
-
 TEST(ControlAdvance, AdvanceNearTheEndOfTheClockIsRefusedAndTheClockStaysPut) {
-  DeviceBoard& board = virtual_board();
+  const ParseResult p = parse_board_config("bus=0 cs=0 chips=L6470; time=virtual", "test");
+  ASSERT_TRUE(p.config);
+  DiagnosticLog log("off");
+  DeviceBoard board(*p.config, log);
   std::string out;
   ASSERT_EQ(run_control(board, "advance 1", out), 0) << out;
   EXPECT_EQ(out, "advanced 1 ms (4000 ticks)\n");
