@@ -1,4 +1,4 @@
-// is_pid_name, read_small_file, all_processes and live_descendants.
+// is_pid_name, numbered_entries, read_small_file, all_processes and live_descendants.
 #include "tools/proc_files.hpp"
 
 #include <dirent.h>
@@ -28,13 +28,20 @@ std::string read_small_file(const std::string& path, std::size_t limit) {
   return text;
 }
 
+std::vector<std::string> numbered_entries(const std::string& dir) {
+  std::vector<std::string> out;
+  if (DIR* d = opendir(dir.c_str())) {
+    while (const dirent* e = readdir(d))
+      if (is_pid_name(e->d_name)) out.emplace_back(e->d_name);
+    closedir(d);
+  }
+  return out;
+}
+
 std::map<pid_t, ProcessInfo> all_processes() {
   std::map<pid_t, ProcessInfo> out;
-  DIR* d = opendir("/proc");
-  if (!d) return out;
-  while (const dirent* e = readdir(d)) {
-    if (!is_pid_name(e->d_name)) continue;
-    const std::string stat = read_small_file(std::string("/proc/") + e->d_name + "/stat", 4096);
+  for (const std::string& pid : numbered_entries("/proc")) {
+    const std::string stat = read_small_file("/proc/" + pid + "/stat", 4096);
     const std::size_t open_paren = stat.find('('), close_paren = stat.rfind(')');
     if (open_paren == std::string::npos || close_paren == std::string::npos || close_paren < open_paren) continue;
     ProcessInfo p;
@@ -42,9 +49,8 @@ std::map<pid_t, ProcessInfo> all_processes() {
     long parent = 0;
     if (std::sscanf(stat.c_str() + close_paren + 1, " %c %ld", &p.state, &parent) != 2) continue;
     p.parent = static_cast<pid_t>(parent);
-    out[static_cast<pid_t>(std::atol(e->d_name))] = p;
+    out[static_cast<pid_t>(std::atol(pid.c_str()))] = p;
   }
-  closedir(d);
   return out;
 }
 

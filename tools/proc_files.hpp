@@ -1,5 +1,5 @@
 // Reading /proc for `run`'s looks at the program's processes (run_waits, run_blocked): which
-// directory entries are process or thread ids, a small file's text, the process table and the
+// directory entries are process or thread ids (and a directory's such entries), a small file's text, the process table and the
 // live descendants of a process.
 #pragma once
 
@@ -9,11 +9,16 @@
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace l6470emu {
 
 /// Whether a /proc directory entry's name is a process (or thread) id: digits only, not empty.
 bool is_pid_name(const char* name);
+
+/// The names of `dir`'s entries that are process or thread ids (or descriptor numbers), in the
+/// order the directory gives them; none when it cannot be read.
+std::vector<std::string> numbered_entries(const std::string& dir);
 
 /// The text of a small file (a /proc entry), at most `limit` bytes; "" when it cannot be read.
 std::string read_small_file(const std::string& path, std::size_t limit = 1 << 20);

@@ -2,17 +2,11 @@
 #include "tools/run_blocked.hpp"
 #include "tools/proc_files.hpp"
 
-#include <dirent.h>
-#include <fcntl.h>
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <map>
-#include <optional>
 #include <set>
-
 
 namespace l6470emu {
 namespace {
@@ -21,16 +15,6 @@ std::string read_text(const std::string& path) {
   std::string s = read_small_file(path, 511);
   while (!s.empty() && (s.back() == '\n' || s.back() == '\0')) s.pop_back();
   return s;
-}
-
-std::vector<std::string> numbered_entries(const std::string& dir) {
-  std::vector<std::string> out;
-  if (DIR* d = opendir(dir.c_str())) {
-    while (const dirent* e = readdir(d))
-      if (is_pid_name(e->d_name)) out.emplace_back(e->d_name);
-    closedir(d);
-  }
-  return out;
 }
 
 // System calls whose first argument is a descriptor.
@@ -58,7 +42,6 @@ std::string blocking_syscall_name(long number) {
 }
 
 }  // namespace
-
 
 std::vector<std::string> blocked_threads(const std::map<pid_t, std::vector<std::string>>& said) {
   const std::map<pid_t, ProcessInfo> all = all_processes();

@@ -28,18 +28,14 @@ std::set<pid_t> holders(const std::map<pid_t, ProcessInfo>& all, const std::stri
   std::set<pid_t> out;
   for (const auto& [pid, info] : all) {
     const std::string dir = "/proc/" + std::to_string(pid) + "/fd";
-    DIR* d = opendir(dir.c_str());
-    if (!d) continue;
-    while (const dirent* e = readdir(d)) {
-      if (!is_pid_name(e->d_name)) continue;
+    for (const std::string& fd : numbered_entries(dir)) {
       char link[64];
-      const ssize_t n = readlink((dir + "/" + e->d_name).c_str(), link, sizeof link - 1);
+      const ssize_t n = readlink((dir + "/" + fd).c_str(), link, sizeof link - 1);
       if (n > 0 && std::string(link, static_cast<std::size_t>(n)) == target) {
         out.insert(pid);
         break;
       }
     }
-    closedir(d);
   }
   return out;
 }
@@ -78,13 +74,9 @@ RunWaits::~RunWaits() {
 
 std::map<pid_t, ProcessWaits> RunWaits::published() const {
   std::map<pid_t, ProcessWaits> out;
-  if (DIR* d = opendir(dir_.c_str())) {
-    while (const dirent* e = readdir(d))
-      if (is_pid_name(e->d_name))
-        if (const auto w = parse_process_waits(read_small_file(dir_ + "/" + e->d_name)))
-          out[static_cast<pid_t>(std::atol(e->d_name))] = *w;
-    closedir(d);
-  }
+  for (const std::string& pid : numbered_entries(dir_))
+    if (const auto w = parse_process_waits(read_small_file(dir_ + "/" + pid)))
+      out[static_cast<pid_t>(std::atol(pid.c_str()))] = *w;
   return out;
 }
 
